@@ -1,0 +1,33 @@
+# Finds libg2p's dependencies. Every one of them is a Debian 12 package that
+# scripts/install-deps.sh installs; the error messages say which.
+
+function(g2p_require found package)
+  if(NOT ${found})
+    message(FATAL_ERROR "libg2p needs the Debian package '${package}'. "
+                        "Run scripts/install-deps.sh (as root or with sudo).")
+  endif()
+endfunction()
+
+# Public: Eigen appears in the public headers.
+find_package(Eigen3 3.4 NO_MODULE QUIET)
+g2p_require(Eigen3_FOUND libeigen3-dev)
+
+# Private: none of these types appear in the public headers.
+find_package(assimp QUIET)
+g2p_require(assimp_FOUND libassimp-dev)
+
+find_package(OpenCV 4.6 QUIET COMPONENTS core imgproc imgcodecs)
+g2p_require(OpenCV_FOUND libopencv-dev)
+
+find_package(nlohmann_json 3.10 QUIET)
+g2p_require(nlohmann_json_FOUND nlohmann-json3-dev)
+
+find_package(Threads REQUIRED)
+
+if(G2P_WITH_CGAL)
+  find_package(CGAL 5.5 QUIET)
+  if(NOT CGAL_FOUND)
+    message(FATAL_ERROR "G2P_WITH_CGAL=ON needs the Debian package 'libcgal-dev' "
+                        "(or configure with -DG2P_WITH_CGAL=OFF for a GPL-free build).")
+  endif()
+endif()

@@ -1,0 +1,40 @@
+# Installs libg2p as a CMake package (find_package(g2p)) and a pkg-config module.
+include(CMakePackageConfigHelpers)
+
+set(G2P_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/g2p)
+
+# Public headers: the hand-written ones plus the generated version.h.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/libg2p/include/g2p
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h")
+install(FILES ${PROJECT_BINARY_DIR}/libg2p/generated/include/g2p/version.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/g2p)
+install(FILES ${PROJECT_SOURCE_DIR}/libg2p/data/materials.json
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/g2p)
+
+install(TARGETS g2p EXPORT g2pTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT development
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+install(EXPORT g2pTargets NAMESPACE g2p:: DESTINATION ${G2P_INSTALL_CMAKEDIR})
+
+# Static builds make the private dependencies part of the link interface.
+if(BUILD_SHARED_LIBS)
+  set(G2P_STATIC_DEPENDENCIES "")
+else()
+  set(G2P_STATIC_DEPENDENCIES
+      "find_dependency(assimp)\nfind_dependency(OpenCV COMPONENTS core imgproc imgcodecs)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)")
+endif()
+
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/g2pConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/g2pConfig.cmake INSTALL_DESTINATION ${G2P_INSTALL_CMAKEDIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/g2pConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/g2pConfig.cmake ${PROJECT_BINARY_DIR}/g2pConfigVersion.cmake
+        DESTINATION ${G2P_INSTALL_CMAKEDIR})
+
+# The .pc file finds its prefix relative to itself, so the install tree is relocatable.
+file(RELATIVE_PATH G2P_PC_TO_PREFIX "/prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/prefix")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/g2p.pc.in ${PROJECT_BINARY_DIR}/g2p.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/g2p.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

@@ -1,0 +1,10 @@
+// Umbrella header: the whole public API of libg2p.
+#pragma once
+
+#include "g2p/image.h"
+#include "g2p/io.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/model.h"
+#include "g2p/status.h"
+#include "g2p/version.h"

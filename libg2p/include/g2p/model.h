@@ -1,0 +1,84 @@
+// Model: an imported asset. One merged Mesh (node transforms applied), the
+// source materials its faces refer to, and the record of how it was imported.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "g2p/image.h"
+#include "g2p/mesh.h"
+
+namespace g2p {
+
+enum class AlphaMode { kOpaque, kMask, kBlend };  // glTF alphaMode
+enum class WrapMode { kRepeat, kClampToEdge, kMirroredRepeat };
+
+// A texture referenced by a material, decoded to 8-bit RGBA.
+struct Texture {
+  std::string uri;                       // file path, or "*N" for the N-th embedded image
+  std::shared_ptr<const ImageU8> image;  // RGBA, 4 channels; null if absent or undecodable
+  int uv_set = 0;                        // which UV set it reads (libg2p keeps set 0)
+  WrapMode wrap_u = WrapMode::kRepeat;
+  WrapMode wrap_v = WrapMode::kRepeat;
+  bool empty() const { return image == nullptr; }
+};
+
+// A material as the input file describes it, in glTF's metallic-roughness
+// terms. Formats without PBR data get values derived from their Phong terms.
+struct SourceMaterial {
+  std::string name;
+  Eigen::Vector4f base_color{1.f, 1.f, 1.f, 1.f};  // linear RGBA factor
+  float metallic = 1.f;                            // 0..1 (glTF default 1)
+  float roughness = 1.f;                           // 0..1 (glTF default 1)
+  AlphaMode alpha_mode = AlphaMode::kOpaque;
+  float alpha_cutoff = 0.5f;                // for AlphaMode::kMask
+  float transmission = 0.f;                 // KHR_materials_transmission factor, 0..1
+  Eigen::Vector3f emissive{0.f, 0.f, 0.f};  // linear RGB
+  bool double_sided = false;
+  Texture base_color_texture;          // sRGB colour (times base_color)
+  Texture metallic_roughness_texture;  // glTF packing: G = roughness, B = metallic
+};
+
+// One placement of a source mesh in the scene: a node instancing a mesh.
+struct SourcePrimitive {
+  std::string mesh_name;
+  std::string node_name;
+  std::int32_t mesh = -1;       // FaceSource::mesh of its faces
+  std::int32_t material = -1;   // FaceSource::material of its faces
+  std::int32_t first_face = 0;  // its faces are Mesh::triangles[first_face, first_face + num_faces)
+  std::int32_t num_faces = 0;
+  std::int32_t first_vertex = 0;
+  std::int32_t num_vertices = 0;
+};
+
+// How the file was read.
+struct ImportInfo {
+  std::string path;                                             // as given to load_model
+  std::string format;                                           // e.g. "glb", "obj"
+  double unit_scale_m = 1.0;                                    // metres per file unit that was applied
+  char up_axis = 'Y';                                           // the file's up axis as used: 'X', 'Y' or 'Z'
+  Eigen::Matrix4d file_to_model = Eigen::Matrix4d::Identity();  // file coordinates -> Mesh::positions
+  int num_source_meshes = 0;
+  int num_degenerate_faces = 0;       // flagged, kept
+  int num_skipped_primitives = 0;     // points and lines, which have no area
+  std::vector<std::string> warnings;  // things that were recovered from, for the user to read
+};
+
+struct Model {
+  Mesh mesh;
+  std::vector<SourceMaterial> materials;  // indexed by FaceSource::material
+  std::vector<SourcePrimitive> primitives;
+  ImportInfo info;
+
+  // Name of the source material of `face`, or "" if it has none.
+  const std::string& material_name(int face) const {
+    static const std::string kNone;
+    const int m = mesh.face_source.empty() ? -1 : mesh.face_source[static_cast<std::size_t>(face)].material;
+    return m >= 0 && m < static_cast<int>(materials.size()) ? materials[static_cast<std::size_t>(m)].name : kNone;
+  }
+};
+
+}  // namespace g2p

@@ -1,0 +1,487 @@
+// Model import through assimp: scene graph -> one merged Mesh with per-face
+// provenance. assimp does the parsing; libg2p does the rest itself (node
+// transforms, triangulation, validation) so that every triangle keeps the
+// index of the face it came from and bad input is reported precisely.
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/Importer.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <new>
+#include <set>
+#include <sstream>
+#include <unordered_set>
+
+#include "assimp_convert.h"
+#include "g2p/io.h"
+#include "gltf_layout.h"
+#include "triangulate.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kMaxNodeDepth = 1024;  // deeper scene graphs are treated as malformed
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string extension_of(const std::string& path) {
+  std::string ext = lower(fs::path(path).extension().string());
+  return ext.empty() ? ext : ext.substr(1);
+}
+
+std::string vec_str(const aiVector3D& v) {
+  std::ostringstream s;
+  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return s.str();
+}
+
+Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d e;
+  e << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  return e;
+}
+
+// Rotation taking the file's up axis to +Z (right-handed, proper rotation).
+Eigen::Matrix3d up_to_z(char up) {
+  Eigen::Matrix3d r;
+  if (up == 'Y')
+    r << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // (x, y, z) -> (x, -z, y)
+  else if (up == 'X')
+    r << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // (x, y, z) -> (-z, y, x)
+  else
+    r.setIdentity();
+  return r;
+}
+
+template <typename T>
+bool metadata(const aiScene& scene, const char* key, T& out) {
+  return scene.mMetaData != nullptr && scene.mMetaData->Get(key, out);
+}
+
+// Resolves unit scale and up axis from the options and the format.
+void resolve_frame(const aiScene& scene, const std::string& ext, const ImportOptions& options, ImportInfo& info) {
+  info.unit_scale_m = 1.0;
+  if (options.unit_scale > 0.0) {
+    info.unit_scale_m = options.unit_scale;
+  } else if (ext == "fbx") {
+    double cm_per_unit = 0.0;
+    float cm_per_unit_f = 0.f;
+    if (metadata(scene, "UnitScaleFactor", cm_per_unit) && cm_per_unit > 0.0)
+      info.unit_scale_m = cm_per_unit / 100.0;
+    else if (metadata(scene, "UnitScaleFactor", cm_per_unit_f) && cm_per_unit_f > 0.f)
+      info.unit_scale_m = cm_per_unit_f / 100.0;
+  }
+  switch (options.up_axis) {
+    case UpAxis::kX: info.up_axis = 'X'; break;
+    case UpAxis::kY: info.up_axis = 'Y'; break;
+    case UpAxis::kZ: info.up_axis = 'Z'; break;
+    case UpAxis::kAuto: {
+      info.up_axis = (ext == "stl" || ext == "3mf") ? 'Z' : 'Y';
+      int axis = -1;
+      if (ext == "fbx" && metadata(scene, "UpAxis", axis) && axis >= 0 && axis <= 2) info.up_axis = "XYZ"[axis];
+      break;
+    }
+  }
+  Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
+  t.topLeftCorner<3, 3>() = (options.z_up ? up_to_z(info.up_axis) : Eigen::Matrix3d::Identity()) * info.unit_scale_m;
+  info.file_to_model = t;
+}
+
+// Walks the scene graph and appends every mesh instance to the model.
+class SceneFlattener {
+ public:
+  SceneFlattener(const aiScene& scene, const ImportOptions& options, Model& model)
+      : scene_(scene), options_(options), model_(model) {}
+
+  Status run() {
+    if (scene_.mRootNode == nullptr) return Status::ParseError("the scene has no root node");
+    return visit(*scene_.mRootNode, model_.info.file_to_model, 0);
+  }
+
+  // Vertices that came without a normal in the file (to be computed).
+  const std::vector<bool>& missing_normal() const { return missing_normal_; }
+
+ private:
+  Status visit(const aiNode& node, const Eigen::Matrix4d& parent, int depth) {
+    if (depth > kMaxNodeDepth)
+      return Status::ParseError("node '" + std::string(node.mName.C_Str()) + "': scene graph deeper than " +
+                                std::to_string(kMaxNodeDepth) + " levels (recursive nodes?)");
+    if (!on_path_.insert(&node).second)
+      return Status::ParseError("node '" + std::string(node.mName.C_Str()) + "' is its own ancestor (recursive nodes)");
+    const Eigen::Matrix4d world = parent * to_eigen(node.mTransformation);
+    if (!world.allFinite())
+      return Status::ParseError("node '" + std::string(node.mName.C_Str()) + "' has a non-finite transform");
+    for (unsigned k = 0; k < node.mNumMeshes; ++k) {
+      const unsigned index = node.mMeshes[k];
+      if (index >= scene_.mNumMeshes || scene_.mMeshes[index] == nullptr)
+        return Status::ParseError("node '" + std::string(node.mName.C_Str()) + "' refers to mesh " +
+                                  std::to_string(index) + " of " + std::to_string(scene_.mNumMeshes));
+      G2P_RETURN_IF_ERROR(add_mesh(*scene_.mMeshes[index], static_cast<int>(index), node, world));
+    }
+    for (unsigned c = 0; c < node.mNumChildren; ++c) {
+      if (node.mChildren[c] == nullptr) continue;
+      G2P_RETURN_IF_ERROR(visit(*node.mChildren[c], world, depth + 1));
+    }
+    on_path_.erase(&node);
+    return Status::Ok();
+  }
+
+  Status add_mesh(const aiMesh& src, int mesh_index, const aiNode& node, const Eigen::Matrix4d& world) {
+    const std::string where = "mesh " + std::to_string(mesh_index) + " '" + src.mName.C_Str() + "'";
+    Mesh& mesh = model_.mesh;
+    const int nv = static_cast<int>(src.mNumVertices);
+    if (src.mVertices == nullptr && nv > 0) return Status::ParseError(where + ": no vertex positions");
+    if (src.mMaterialIndex >= scene_.mNumMaterials && scene_.mNumMaterials > 0)
+      return Status::ParseError(where + ": material index " + std::to_string(src.mMaterialIndex) + " out of range (" +
+                                std::to_string(scene_.mNumMaterials) + " materials)");
+
+    const Eigen::Matrix3d linear = world.topLeftCorner<3, 3>();
+    const Eigen::Vector3d offset = world.topRightCorner<3, 1>();
+    const bool mirrored = linear.determinant() < 0.0;
+    const Eigen::Matrix3d normal_matrix = linear.inverse().transpose();
+
+    SourcePrimitive prim;
+    prim.mesh_name = src.mName.C_Str();
+    prim.node_name = node.mName.C_Str();
+    prim.mesh = mesh_index;
+    prim.material = scene_.mNumMaterials > 0 ? static_cast<std::int32_t>(src.mMaterialIndex) : -1;
+    prim.first_face = mesh.num_faces();
+    prim.first_vertex = mesh.num_vertices();
+
+    // Faces first: a mesh of points or lines adds nothing.
+    std::vector<std::array<int, 3>> local;
+    std::vector<std::int32_t> local_source;
+    std::vector<Eigen::Vector3d> polygon;
+    std::vector<std::array<int, 3>> pieces;
+    int skipped = 0;
+    for (unsigned f = 0; f < src.mNumFaces; ++f) {
+      const aiFace& face = src.mFaces[f];
+      if (face.mNumIndices < 3) {
+        ++skipped;
+        continue;
+      }
+      for (unsigned k = 0; k < face.mNumIndices; ++k) {
+        if (face.mIndices[k] >= src.mNumVertices)
+          return Status::ParseError(where + " face " + std::to_string(f) + ": index " +
+                                    std::to_string(face.mIndices[k]) + " out of range (" + std::to_string(nv) +
+                                    " vertices)");
+      }
+      if (face.mNumIndices == 3) {
+        local.push_back({static_cast<int>(face.mIndices[0]), static_cast<int>(face.mIndices[1]),
+                         static_cast<int>(face.mIndices[2])});
+        local_source.push_back(static_cast<std::int32_t>(f));
+        continue;
+      }
+      polygon.clear();
+      pieces.clear();
+      for (unsigned k = 0; k < face.mNumIndices; ++k) {
+        const aiVector3D& p = src.mVertices[face.mIndices[k]];
+        polygon.emplace_back(p.x, p.y, p.z);
+      }
+      detail::triangulate_polygon(polygon, pieces);
+      for (const auto& t : pieces) {
+        local.push_back({static_cast<int>(face.mIndices[t[0]]), static_cast<int>(face.mIndices[t[1]]),
+                         static_cast<int>(face.mIndices[t[2]])});
+        local_source.push_back(static_cast<std::int32_t>(f));
+      }
+    }
+    model_.info.num_skipped_primitives += skipped;
+    if (local.empty()) return Status::Ok();
+    if (static_cast<long long>(mesh.num_faces()) + static_cast<long long>(local.size()) > options_.max_faces)
+      return Status::Unsupported("more than " + std::to_string(options_.max_faces) +
+                                 " triangles (ImportOptions::max_faces)");
+
+    // Vertices, transformed into libg2p's frame.
+    const bool has_normals = src.mNormals != nullptr;
+    const bool has_uvs = src.mTextureCoords[0] != nullptr;
+    bool bad_normals = false;
+    for (int v = 0; v < nv; ++v) {
+      const aiVector3D& p = src.mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        return Status::ParseError(where + " vertex " + std::to_string(v) + ": non-finite position " + vec_str(p));
+      const Eigen::Vector3d q = linear * Eigen::Vector3d(p.x, p.y, p.z) + offset;
+      if (!q.allFinite())
+        return Status::ParseError(where + " vertex " + std::to_string(v) + ": position overflows after transform");
+      mesh.positions.push_back(q.cast<float>());
+      Eigen::Vector3f n = Eigen::Vector3f::Zero();
+      if (has_normals) {
+        const aiVector3D& a = src.mNormals[v];
+        const Eigen::Vector3d m = normal_matrix * Eigen::Vector3d(a.x, a.y, a.z);
+        const double len = m.norm();
+        if (std::isfinite(len) && len > 0.0)
+          n = (m / len).cast<float>();
+        else
+          bad_normals = true;
+      }
+      mesh.normals.push_back(n);
+      missing_normal_.push_back(!has_normals || n.isZero());
+      if (has_uvs) {
+        const aiVector3D& t = src.mTextureCoords[0][v];
+        const bool finite = std::isfinite(t.x) && std::isfinite(t.y);
+        mesh.uvs.emplace_back(finite ? t.x : 0.f, finite ? t.y : 0.f);
+        any_bad_uv_ |= !finite;
+      } else {
+        mesh.uvs.emplace_back(0.f, 0.f);
+      }
+    }
+    if (bad_normals) model_.info.warnings.push_back(where + ": zero or non-finite normals recomputed");
+    any_uvs_ |= has_uvs;
+
+    const int base = prim.first_vertex;
+    for (std::size_t i = 0; i < local.size(); ++i) {
+      const auto& t = local[i];
+      Eigen::Vector3i tri(base + t[0], base + t[1], base + t[2]);
+      if (mirrored) std::swap(tri[1], tri[2]);  // keep outward winding under reflections
+      mesh.triangles.push_back(tri);
+      mesh.face_source.push_back({mesh_index, local_source[i], prim.material});
+    }
+    prim.num_faces = mesh.num_faces() - prim.first_face;
+    prim.num_vertices = mesh.num_vertices() - prim.first_vertex;
+    model_.primitives.push_back(std::move(prim));
+    return Status::Ok();
+  }
+
+ public:
+  bool any_uvs() const { return any_uvs_; }
+  bool any_bad_uv() const { return any_bad_uv_; }
+
+ private:
+  const aiScene& scene_;
+  const ImportOptions& options_;
+  Model& model_;
+  std::unordered_set<const aiNode*> on_path_;
+  std::vector<bool> missing_normal_;
+  bool any_uvs_ = false;
+  bool any_bad_uv_ = false;
+};
+
+bool is_gltf(const std::string& ext) { return ext == "gltf" || ext == "glb"; }
+
+// The bytes of a glTF file that hold its JSON: the whole .gltf, or a .glb's
+// header and JSON chunk (not its binary chunk).
+std::string read_gltf_json_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(20, '\0');
+  in.read(head.data(), 20);
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.size() == 20 && head.compare(0, 4, "glTF") == 0) {
+    std::uint32_t chunk = 0;
+    std::memcpy(&chunk, head.data() + 12, 4);
+    std::string json(std::min<std::uint64_t>(chunk, fs::file_size(path) - 20), '\0');
+    in.read(json.data(), static_cast<std::streamsize>(json.size()));
+    return head + json;
+  }
+  std::ostringstream rest;
+  rest << in.rdbuf();
+  return head + rest.str();
+}
+
+// Checks the glTF primitives assimp may have cut short, and replaces assimp's
+// compacted material numbering by the file's own.
+Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bool strict, Model& model) {
+  Result<detail::GltfLayout> layout = detail::read_gltf_layout(gltf_bytes);
+  if (!layout.ok() || layout->primitives.size() != scene.mNumMeshes) {
+    model.info.warnings.push_back("could not match assimp's meshes to the glTF primitives (" +
+                                  (layout.ok() ? std::string("count differs") : layout.status().message()) +
+                                  "); material indices are assimp's, not the file's");
+    return Status::Ok();
+  }
+  for (const std::string& ext : layout->extensions_required) {
+    if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
+      return Status::Unsupported("the file requires " + ext + ", which this build's assimp cannot decode");
+  }
+  for (unsigned k = 0; k < scene.mNumMeshes; ++k) {
+    const detail::GltfPrimitive& p = layout->primitives[k];
+    std::string problem = p.problem;
+    long long kept = 0;
+    for (unsigned f = 0; f < scene.mMeshes[k]->mNumFaces; ++f) kept += scene.mMeshes[k]->mFaces[f].mNumIndices == 3;
+    if (problem.empty() && p.triangles > kept)
+      problem = std::to_string(p.triangles - kept) + " of " + std::to_string(p.triangles) +
+                " triangles dropped by the reader (indices out of range or arrays truncated)";
+    if (problem.empty()) continue;
+    const std::string where = "glTF mesh " + std::to_string(p.mesh) + " '" + p.mesh_name + "' primitive " +
+                              std::to_string(p.primitive) + ": " + problem;
+    if (strict) return Status::ParseError(where + " (ImportOptions::strict)");
+    model.info.warnings.push_back(where + "; the bad triangles were dropped");
+  }
+  std::vector<SourceMaterial> materials = std::move(layout->materials);
+  for (unsigned k = 0; k < scene.mNumMeshes; ++k) {
+    const int file_index = layout->primitives[k].material;
+    const unsigned assimp_index = scene.mMeshes[k]->mMaterialIndex;
+    if (file_index < 0 || assimp_index >= model.materials.size()) continue;
+    // Factors come from the file's JSON; decoded textures from assimp.
+    SourceMaterial& m = materials[static_cast<std::size_t>(file_index)];
+    m.base_color_texture = model.materials[assimp_index].base_color_texture;
+    m.metallic_roughness_texture = model.materials[assimp_index].metallic_roughness_texture;
+  }
+  for (FaceSource& s : model.mesh.face_source)
+    s.material = layout->primitives[static_cast<std::size_t>(s.mesh)].material;
+  for (SourcePrimitive& p : model.primitives)
+    p.material = layout->primitives[static_cast<std::size_t>(p.mesh)].material;
+  model.materials = std::move(materials);
+  return Status::Ok();
+}
+
+Status check_options(const ImportOptions& o) {
+  if (!(o.unit_scale >= 0.0) || !std::isfinite(o.unit_scale))
+    return Status::InvalidArgument("ImportOptions::unit_scale must be >= 0 (0 = from the format)");
+  if (!(o.min_extent_m >= 0.0 && o.min_extent_m < o.max_extent_m))
+    return Status::InvalidArgument("ImportOptions: need 0 <= min_extent_m < max_extent_m");
+  if (o.max_faces <= 0) return Status::InvalidArgument("ImportOptions::max_faces must be > 0");
+  return Status::Ok();
+}
+
+// Everything after assimp has parsed the file.
+Result<Model> convert_scene(const aiScene& scene, const std::string& ext, const std::string& model_dir,
+                            const std::string& gltf_bytes, const ImportOptions& options, ImportInfo info) {
+  if (scene.mFlags & AI_SCENE_FLAGS_INCOMPLETE) return Status::ParseError("the scene is incomplete (no geometry)");
+  Model model;
+  model.info = std::move(info);
+  model.info.num_source_meshes = static_cast<int>(scene.mNumMeshes);
+  resolve_frame(scene, ext, options, model.info);
+
+  SceneFlattener flattener(scene, options, model);
+  G2P_RETURN_IF_ERROR(flattener.run());
+  Mesh& mesh = model.mesh;
+  if (mesh.triangles.empty()) {
+    if (model.info.num_skipped_primitives > 0)
+      return Status::Unsupported("the model has only points or lines (" +
+                                 std::to_string(model.info.num_skipped_primitives) + " primitives), no triangles");
+    return Status::ParseError(scene.mNumMeshes == 0 ? "the scene is empty: no meshes"
+                                                    : "no mesh is placed in the scene by any node");
+  }
+  if (model.info.num_skipped_primitives > 0)
+    model.info.warnings.push_back(std::to_string(model.info.num_skipped_primitives) +
+                                  " point or line primitives skipped (no area)");
+
+  const Eigen::AlignedBox3d box = bounds(mesh);
+  const double extent = box.diagonal().norm();
+  if (!(extent >= options.min_extent_m && extent <= options.max_extent_m)) {
+    std::ostringstream msg;
+    msg << "bounding-box diagonal " << extent << " m (at " << model.info.unit_scale_m
+        << " m per file unit) is outside [" << options.min_extent_m << ", " << options.max_extent_m
+        << "] m: the file is probably in other units; set the unit (ImportOptions::unit_scale, --unit)";
+    return Status::InvalidArgument(msg.str());
+  }
+
+  // Normals the file lacked (or had broken) come from the geometry.
+  const std::vector<bool>& missing = flattener.missing_normal();
+  if (std::find(missing.begin(), missing.end(), true) != missing.end()) {
+    Mesh computed = mesh;
+    compute_vertex_normals(computed);
+    for (std::size_t v = 0; v < missing.size(); ++v)
+      if (missing[v]) mesh.normals[v] = computed.normals[v];
+  }
+  if (!flattener.any_uvs()) mesh.uvs.clear();
+  if (flattener.any_bad_uv()) model.info.warnings.push_back("non-finite texture coordinates replaced by (0, 0)");
+
+  model.info.num_degenerate_faces = flag_degenerate_faces(mesh);
+  if (model.info.num_degenerate_faces > 0)
+    model.info.warnings.push_back(std::to_string(model.info.num_degenerate_faces) +
+                                  " degenerate (zero-area) faces flagged and kept");
+
+  model.materials = detail::convert_materials(scene, model_dir, options.load_textures, model.info.warnings);
+  if (is_gltf(ext)) G2P_RETURN_IF_ERROR(apply_gltf_layout(scene, gltf_bytes, options.strict, model));
+  G2P_RETURN_IF_ERROR(validate(mesh).with_context("after import"));
+  return model;
+}
+
+constexpr unsigned kPostProcess = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices;
+
+// Runs `body`, turning exceptions (from assimp's or the standard library's
+// allocations, say) into a Status, so none crosses the public API.
+template <typename F>
+Result<Model> guarded(const std::string& where, F&& body) {
+  try {
+    Result<Model> r = body();
+    if (!r.ok()) return r.status().with_context(where);
+    return r;
+  } catch (const std::bad_alloc&) {
+    return Status::Internal(where + ": out of memory while importing");
+  } catch (const std::exception& e) {
+    return Status::Internal(where + ": unexpected failure while importing: " + e.what());
+  }
+}
+
+std::string assimp_error(const Assimp::Importer& importer) {
+  std::string e = importer.GetErrorString();
+  while (!e.empty() && std::isspace(static_cast<unsigned char>(e.back()))) e.pop_back();
+  return e.empty() ? "the file could not be parsed" : e;
+}
+
+}  // namespace
+
+bool is_supported_extension(const std::string& extension) {
+  if (extension.empty()) return false;
+  const std::string ext = extension[0] == '.' ? extension : "." + extension;
+  Assimp::Importer importer;
+  return importer.IsExtensionSupported(lower(ext).c_str());
+}
+
+Result<Model> load_model(const std::string& path, const ImportOptions& options) {
+  return guarded(path, [&]() -> Result<Model> {
+    G2P_RETURN_IF_ERROR(check_options(options));
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!fs::exists(st)) return Status::NotFound("no such file");
+    if (!fs::is_regular_file(st)) return Status::InvalidArgument("not a regular file");
+    if (fs::file_size(path, ec) == 0) return Status::ParseError("the file is empty");
+    const std::string ext = extension_of(path);
+    if (!is_supported_extension(ext))
+      return Status::Unsupported("unknown model format '" + (ext.empty() ? std::string("(no extension)") : "." + ext) +
+                                 "' (glTF/GLB, OBJ, PLY, STL, FBX, DAE, 3MF and other assimp formats are read)");
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path, kPostProcess);
+    if (scene == nullptr) return Status::ParseError(assimp_error(importer));
+    ImportInfo info;
+    info.path = path;
+    info.format = ext;
+    const std::string gltf_bytes = is_gltf(ext) ? read_gltf_json_bytes(path) : std::string();
+    return convert_scene(*scene, ext, fs::path(path).parent_path().string(), gltf_bytes, options, std::move(info));
+  });
+}
+
+Result<Model> load_model_from_memory(const void* data, std::size_t size, const std::string& format_hint,
+                                     const ImportOptions& options) {
+  const std::string ext = lower(format_hint.empty() || format_hint[0] != '.' ? format_hint : format_hint.substr(1));
+  return guarded("<memory>." + ext, [&]() -> Result<Model> {
+    G2P_RETURN_IF_ERROR(check_options(options));
+    if (data == nullptr || size == 0) return Status::InvalidArgument("no data");
+    if (!is_supported_extension(ext)) return Status::Unsupported("unknown model format '" + ext + "'");
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFileFromMemory(data, size, kPostProcess, ext.c_str());
+    if (scene == nullptr) return Status::ParseError(assimp_error(importer));
+    ImportInfo info;
+    info.path = "<memory>";
+    info.format = ext;
+    const std::string gltf_bytes = is_gltf(ext) ? std::string(static_cast<const char*>(data), size) : std::string();
+    return convert_scene(*scene, ext, ".", gltf_bytes, options, std::move(info));
+  });
+}
+
+Result<double> parse_unit(const std::string& unit) {
+  static const std::pair<const char*, double> kUnits[] = {
+      {"m", 1.0},       {"meter", 1.0},        {"meters", 1.0},        {"metre", 1.0},        {"metres", 1.0},
+      {"cm", 0.01},     {"centimeter", 0.01},  {"centimeters", 0.01},  {"centimetre", 0.01},  {"centimetres", 0.01},
+      {"mm", 0.001},    {"millimeter", 0.001}, {"millimeters", 0.001}, {"millimetre", 0.001}, {"millimetres", 0.001},
+      {"in", 0.0254},   {"inch", 0.0254},      {"inches", 0.0254},     {"ft", 0.3048},        {"foot", 0.3048},
+      {"feet", 0.3048}, {"km", 1000.0},
+  };
+  const std::string u = lower(unit);
+  for (const auto& [name, scale] : kUnits)
+    if (u == name) return scale;
+  return Status::InvalidArgument("unknown unit '" + unit + "' (use m, cm, mm, in or ft)");
+}
+
+}  // namespace g2p

@@ -1,0 +1,162 @@
+// assimp materials -> SourceMaterial (glTF metallic-roughness terms), with
+// texture decoding. Formats without PBR data are mapped from their Phong terms.
+#include <assimp/GltfMaterial.h>
+#include <assimp/material.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "assimp_convert.h"
+#include "image_io.h"
+
+namespace g2p::detail {
+namespace {
+
+WrapMode wrap_mode(int assimp_mode) {
+  switch (assimp_mode) {
+    case aiTextureMapMode_Clamp:
+    case aiTextureMapMode_Decal: return WrapMode::kClampToEdge;
+    case aiTextureMapMode_Mirror: return WrapMode::kMirroredRepeat;
+    default: return WrapMode::kRepeat;
+  }
+}
+
+// Decodes textures once per distinct reference: glTF files often share one
+// image between several materials.
+class TextureCache {
+ public:
+  TextureCache(const aiScene& scene, std::string model_dir) : scene_(scene), dir_(std::move(model_dir)) {}
+
+  // Returns the decoded image or null, with the reason in `error`.
+  std::shared_ptr<const ImageU8> get(const std::string& uri, std::string& error) {
+    auto it = cache_.find(uri);
+    if (it != cache_.end()) {
+      error = it->second.second;
+      return it->second.first;
+    }
+    Result<ImageU8> image = load(uri);
+    std::shared_ptr<const ImageU8> decoded;
+    if (image.ok()) decoded = std::make_shared<const ImageU8>(std::move(*image));
+    error = image.ok() ? std::string() : image.status().message();
+    cache_.emplace(uri, std::make_pair(decoded, error));
+    return decoded;
+  }
+
+ private:
+  Result<ImageU8> load(const std::string& uri) {
+    if (const aiTexture* embedded = scene_.GetEmbeddedTexture(uri.c_str())) {
+      if (embedded->mHeight == 0) return decode_image_rgba(embedded->pcData, embedded->mWidth);
+      // Uncompressed texels, BGRA8.
+      ImageU8 image(static_cast<int>(embedded->mWidth), static_cast<int>(embedded->mHeight), 4);
+      for (std::size_t i = 0; i < static_cast<std::size_t>(embedded->mWidth) * embedded->mHeight; ++i) {
+        const aiTexel& t = embedded->pcData[i];
+        std::uint8_t* p = image.data() + 4 * i;
+        p[0] = t.r, p[1] = t.g, p[2] = t.b, p[3] = t.a;
+      }
+      return image;
+    }
+    if (!uri.empty() && uri[0] == '*') return Status::NotFound("embedded texture " + uri + " is missing");
+    std::filesystem::path path(uri);
+    if (path.is_relative()) path = std::filesystem::path(dir_) / path;
+    return read_image_rgba(path.lexically_normal().string());
+  }
+
+  const aiScene& scene_;
+  std::string dir_;
+  std::map<std::string, std::pair<std::shared_ptr<const ImageU8>, std::string>> cache_;
+};
+
+Texture read_texture(const aiMaterial& mat, aiTextureType type, TextureCache* cache, const std::string& what,
+                     std::vector<std::string>& warnings) {
+  Texture tex;
+  aiString path;
+  aiTextureMapMode modes[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+  if (mat.GetTexture(type, 0, &path, nullptr, nullptr, nullptr, nullptr, modes) != AI_SUCCESS) return tex;
+  tex.uri = path.C_Str();
+  tex.wrap_u = wrap_mode(modes[0]);
+  tex.wrap_v = wrap_mode(modes[1]);
+  int uv_set = 0;
+  if (mat.Get(AI_MATKEY_UVWSRC(type, 0), uv_set) == AI_SUCCESS) tex.uv_set = uv_set;
+  if (cache == nullptr) return tex;  // textures not requested
+  std::string error;
+  tex.image = cache->get(tex.uri, error);
+  if (!tex.image)
+    warnings.push_back(what + " texture '" + tex.uri + "' not loaded (" + error + "); using the factor alone");
+  if (tex.uv_set != 0)
+    warnings.push_back(what + " texture '" + tex.uri + "' reads UV set " + std::to_string(tex.uv_set) +
+                       "; libg2p keeps UV set 0 only");
+  return tex;
+}
+
+}  // namespace
+
+std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::string& model_dir, bool load_textures,
+                                              std::vector<std::string>& warnings) {
+  TextureCache cache(scene, model_dir);
+  std::vector<SourceMaterial> materials;
+  materials.reserve(scene.mNumMaterials);
+  for (unsigned i = 0; i < scene.mNumMaterials; ++i) {
+    const aiMaterial& mat = *scene.mMaterials[i];
+    SourceMaterial m;
+    aiString name;
+    if (mat.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) m.name = name.C_Str();
+    const std::string what = "material " + std::to_string(i) + " '" + m.name + "'";
+
+    aiColor4D color(1.f, 1.f, 1.f, 1.f);
+    if (mat.Get(AI_MATKEY_BASE_COLOR, color) == AI_SUCCESS || mat.Get(AI_MATKEY_COLOR_DIFFUSE, color) == AI_SUCCESS) {
+      m.base_color = {color.r, color.g, color.b, color.a};
+    }
+    float opacity = 1.f;
+    const bool has_opacity = mat.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS;
+
+    float metallic = 0.f;
+    const bool is_pbr = mat.Get(AI_MATKEY_METALLIC_FACTOR, metallic) == AI_SUCCESS;
+    if (is_pbr) {
+      m.metallic = metallic;
+      float roughness = 1.f;
+      if (mat.Get(AI_MATKEY_ROUGHNESS_FACTOR, roughness) == AI_SUCCESS) m.roughness = roughness;
+    } else {
+      // Phong-only formats (OBJ, PLY, STL, DAE): dielectric, with roughness from
+      // the Phong exponent through the Blinn-Phong/Beckmann correspondence
+      // alpha = sqrt(2 / (n + 2)) (Walter et al. 2007, "Microfacet models for
+      // refraction through rough surfaces").
+      m.metallic = 0.f;
+      float shininess = 0.f;
+      m.roughness = mat.Get(AI_MATKEY_SHININESS, shininess) == AI_SUCCESS && shininess > 0.f
+                        ? std::clamp(std::sqrt(2.f / (shininess + 2.f)), 0.f, 1.f)
+                        : 0.8f;
+      if (has_opacity) m.base_color[3] = std::clamp(opacity, 0.f, 1.f);
+    }
+
+    aiString alpha_mode;
+    if (mat.Get(AI_MATKEY_GLTF_ALPHAMODE, alpha_mode) == AI_SUCCESS) {
+      const std::string mode = alpha_mode.C_Str();
+      m.alpha_mode = mode == "MASK" ? AlphaMode::kMask : mode == "BLEND" ? AlphaMode::kBlend : AlphaMode::kOpaque;
+    } else if (m.base_color[3] < 1.f) {
+      m.alpha_mode = AlphaMode::kBlend;
+    }
+    float cutoff = 0.5f;
+    if (mat.Get(AI_MATKEY_GLTF_ALPHACUTOFF, cutoff) == AI_SUCCESS) m.alpha_cutoff = cutoff;
+    float transmission = 0.f;
+    if (mat.Get(AI_MATKEY_TRANSMISSION_FACTOR, transmission) == AI_SUCCESS)
+      m.transmission = std::clamp(transmission, 0.f, 1.f);
+    aiColor3D emissive(0.f, 0.f, 0.f);
+    if (mat.Get(AI_MATKEY_COLOR_EMISSIVE, emissive) == AI_SUCCESS) m.emissive = {emissive.r, emissive.g, emissive.b};
+    int two_sided = 0;
+    if (mat.Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) m.double_sided = two_sided != 0;
+
+    TextureCache* textures = load_textures ? &cache : nullptr;
+    const aiTextureType colour_type =
+        mat.GetTextureCount(aiTextureType_BASE_COLOR) > 0 ? aiTextureType_BASE_COLOR : aiTextureType_DIFFUSE;
+    m.base_color_texture = read_texture(mat, colour_type, textures, what + ": base colour", warnings);
+    m.metallic_roughness_texture =
+        read_texture(mat, aiTextureType_UNKNOWN, textures, what + ": metallic-roughness", warnings);
+    materials.push_back(std::move(m));
+  }
+  return materials;
+}
+
+}  // namespace g2p::detail

@@ -1,0 +1,102 @@
+// Image reading and writing through OpenCV's codecs. Images are exchanged as
+// 8-bit with 1, 3 or 4 channels in RGB(A) order; OpenCV's BGR order stays here.
+#include "image_io.h"
+
+#include <cstring>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "g2p/io.h"
+
+namespace g2p {
+namespace detail {
+namespace {
+
+// Converts any decoded cv::Mat (1-4 channels, 8 or 16 bit) to RGBA8.
+ImageU8 to_rgba8(const cv::Mat& decoded) {
+  cv::Mat m = decoded;
+  if (m.depth() == CV_16U)
+    m.convertTo(m, CV_8U, 1.0 / 257.0);
+  else if (m.depth() != CV_8U)
+    m.convertTo(m, CV_8U, 255.0);
+  cv::Mat rgba;
+  switch (m.channels()) {
+    case 1: cv::cvtColor(m, rgba, cv::COLOR_GRAY2RGBA); break;
+    case 3: cv::cvtColor(m, rgba, cv::COLOR_BGR2RGBA); break;
+    case 4: cv::cvtColor(m, rgba, cv::COLOR_BGRA2RGBA); break;
+    default: {
+      cv::Mat first;
+      cv::extractChannel(m, first, 0);
+      cv::cvtColor(first, rgba, cv::COLOR_GRAY2RGBA);
+    }
+  }
+  ImageU8 out(rgba.cols, rgba.rows, 4);
+  for (int y = 0; y < rgba.rows; ++y) std::memcpy(out.pixel(0, y), rgba.ptr<std::uint8_t>(y), out.row_stride());
+  return out;
+}
+
+}  // namespace
+
+Result<ImageU8> decode_image_rgba(const void* bytes, std::size_t size) {
+  if (bytes == nullptr || size == 0) return Status::ParseError("empty image data");
+  try {
+    const cv::Mat buffer(1, static_cast<int>(size), CV_8U, const_cast<void*>(bytes));
+    const cv::Mat decoded = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
+    if (decoded.empty())
+      return Status::ParseError("image data (" + std::to_string(size) + " bytes) could not be decoded");
+    return to_rgba8(decoded);
+  } catch (const cv::Exception& e) {
+    return Status::ParseError(std::string("image decoder: ") + e.what());
+  }
+}
+
+Result<ImageU8> read_image_rgba(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return Status::NotFound(path + ": no such image file");
+  try {
+    const cv::Mat decoded = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (decoded.empty()) return Status::ParseError(path + ": not a readable image");
+    return to_rgba8(decoded);
+  } catch (const cv::Exception& e) {
+    return Status::ParseError(path + ": " + e.what());
+  }
+}
+
+}  // namespace detail
+
+Result<ImageU8> read_image(const std::string& path) { return detail::read_image_rgba(path); }
+
+Status write_image(const std::string& path, const ImageU8& image) {
+  if (image.empty()) return Status::InvalidArgument(path + ": cannot write an empty image");
+  const int c = image.channels();
+  if (c != 1 && c != 3 && c != 4)
+    return Status::InvalidArgument(path + ": cannot write an image with " + std::to_string(c) + " channels");
+  try {
+    const cv::Mat src(image.height(), image.width(), CV_8UC(c), const_cast<std::uint8_t*>(image.data()));
+    cv::Mat bgr;
+    if (c == 3)
+      cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
+    else if (c == 4)
+      cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGRA);
+    else
+      bgr = src;
+    // Write beside the target and rename, so a failure never leaves half a file.
+    const std::filesystem::path target(path);
+    const std::filesystem::path tmp = target.parent_path() / (".tmp." + target.filename().string());
+    if (!cv::imwrite(tmp.string(), bgr)) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      return Status::IoError(path + ": cannot write image (unknown extension or unwritable folder)");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, target, ec);
+    if (ec) return Status::IoError(path + ": " + ec.message());
+  } catch (const cv::Exception& e) {
+    return Status::IoError(path + ": " + e.what());
+  }
+  return Status::Ok();
+}
+
+}  // namespace g2p

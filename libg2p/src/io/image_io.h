@@ -1,0 +1,18 @@
+// Private: image decoding for textures (OpenCV stays inside the library).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "g2p/image.h"
+#include "g2p/status.h"
+
+namespace g2p::detail {
+
+// Decodes PNG/JPEG/... bytes to 8-bit RGBA.
+Result<ImageU8> decode_image_rgba(const void* bytes, std::size_t size);
+
+// Reads an image file to 8-bit RGBA.
+Result<ImageU8> read_image_rgba(const std::string& path);
+
+}  // namespace g2p::detail

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package that libg2p's build, tests, examples and
+# bindings need. Idempotent and non-interactive; run as root or with sudo.
+#
+#   scripts/install-deps.sh            # build + tests + examples (default)
+#   scripts/install-deps.sh --minimal  # only what the core library needs to build
+set -euo pipefail
+
+minimal=0
+for arg in "$@"; do
+  case "$arg" in
+    --minimal) minimal=1 ;;
+    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    *) echo "install-deps.sh: unknown option '$arg'" >&2; exit 2 ;;
+  esac
+done
+
+# Packages the library itself links (public: Eigen; private: the rest).
+core=(
+  build-essential cmake pkg-config ccache git
+  libeigen3-dev libassimp-dev libembree-dev libtbb-dev
+  libopencv-dev libcgal-dev libgmp-dev libmpfr-dev
+  nlohmann-json3-dev libcli11-dev libcurl4-openssl-dev
+  liburdfdom-dev
+)
+# Tests, validation with real consumers, benchmarks, bindings.
+extra=(
+  libgtest-dev libgmock-dev libbenchmark-dev
+  assimp-testmodels
+  libmujoco-dev libqhull-dev libgl-dev libopengl-dev
+  liburdfdom-tools libcpp-httplib-dev
+  pybind11-dev python3-dev python3-numpy
+)
+
+pkgs=("${core[@]}")
+[ "$minimal" = 1 ] || pkgs+=("${extra[@]}")
+
+# Skip apt entirely when everything is already there (fast re-runs, offline CI).
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#pkgs[@]} packages already installed"
+  exit 0
+fi
+
+run_root() { "$@"; }
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  run_root() { sudo DEBIAN_FRONTEND=noninteractive "$@"; }
+fi
+echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+run_root apt-get update -q
+run_root apt-get install -y -q --no-install-recommends "${missing[@]}"

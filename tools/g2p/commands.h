@@ -1,0 +1,21 @@
+// The g2p tool's subcommands. Each registers itself on the app and runs the
+// library; main() only dispatches.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace g2p::cli {
+
+// Documented exit codes of every subcommand.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitFailure = 1,  // the library reported an error (bad input file, ...)
+  kExitUsage = 2,    // bad command line
+};
+
+// Adds a subcommand; the returned function runs it after parsing.
+using Command = std::function<int()>;
+void add_info_command(CLI::App& app, Command& run);
+
+}  // namespace g2p::cli

@@ -1,0 +1,143 @@
+// g2p info FILE: what libg2p reads from a model file.
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.h"
+#include "g2p/io.h"
+
+namespace g2p::cli {
+namespace {
+
+struct InfoArgs {
+  std::string path;
+  std::string unit;  // "" = from the format
+  std::string up = "auto";
+  bool keep_axes = false;
+  bool no_textures = false;
+  bool json = false;
+};
+
+const char* alpha_name(AlphaMode m) {
+  return m == AlphaMode::kMask ? "MASK" : m == AlphaMode::kBlend ? "BLEND" : "OPAQUE";
+}
+
+std::string texture_desc(const Texture& t) {
+  if (t.uri.empty()) return "-";
+  if (!t.image) return t.uri + " (not loaded)";
+  return std::to_string(t.image->width()) + "x" + std::to_string(t.image->height());
+}
+
+nlohmann::json vec_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::json to_json(const Model& model, const std::vector<int>& faces_per_material) {
+  const Eigen::AlignedBox3d box = bounds(model.mesh);
+  nlohmann::json materials = nlohmann::json::array();
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    const SourceMaterial& m = model.materials[i];
+    materials.push_back({{"index", i},
+                         {"name", m.name},
+                         {"faces", faces_per_material[i]},
+                         {"base_color", {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}},
+                         {"metallic", m.metallic},
+                         {"roughness", m.roughness},
+                         {"alpha_mode", alpha_name(m.alpha_mode)},
+                         {"transmission", m.transmission},
+                         {"base_color_texture", texture_desc(m.base_color_texture)},
+                         {"metallic_roughness_texture", texture_desc(m.metallic_roughness_texture)}});
+  }
+  return {{"path", model.info.path},
+          {"format", model.info.format},
+          {"unit_scale_m", model.info.unit_scale_m},
+          {"up_axis", std::string(1, model.info.up_axis)},
+          {"source_meshes", model.info.num_source_meshes},
+          {"primitives", model.primitives.size()},
+          {"vertices", model.mesh.num_vertices()},
+          {"faces", model.mesh.num_faces()},
+          {"degenerate_faces", model.info.num_degenerate_faces},
+          {"has_uvs", model.mesh.has_uvs()},
+          {"bounds_m", {{"min", vec_json(box.min())}, {"max", vec_json(box.max())}}},
+          {"surface_area_m2", surface_area(model.mesh)},
+          {"materials", materials},
+          {"warnings", model.info.warnings}};
+}
+
+void print_text(const Model& model, const std::vector<int>& faces_per_material) {
+  const Eigen::AlignedBox3d box = bounds(model.mesh);
+  const Eigen::Vector3d size = box.sizes();
+  std::cout << std::setprecision(4);
+  std::cout << model.info.path << " (" << model.info.format << ")\n"
+            << "  frame:      " << model.info.unit_scale_m << " m per file unit, up axis " << model.info.up_axis
+            << (model.info.file_to_model.topLeftCorner<3, 3>().isDiagonal() ? "" : " -> +Z") << "\n"
+            << "  meshes:     " << model.info.num_source_meshes << " source meshes, " << model.primitives.size()
+            << " placed in the scene\n"
+            << "  faces:      " << model.mesh.num_faces() << " triangles (" << model.info.num_degenerate_faces
+            << " degenerate), " << model.mesh.num_vertices() << " vertices, UVs "
+            << (model.mesh.has_uvs() ? "yes" : "no") << "\n"
+            << "  bounds (m): min (" << box.min().transpose() << ")  max (" << box.max().transpose() << ")  size ("
+            << size.transpose() << ")\n"
+            << "  area:       " << surface_area(model.mesh) << " m^2\n"
+            << "  materials:  " << model.materials.size() << "\n";
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    const SourceMaterial& m = model.materials[i];
+    std::cout << "    [" << i << "] '" << m.name << "'  faces " << faces_per_material[i] << "  base ("
+              << m.base_color.transpose() << ")  metallic " << m.metallic << "  roughness " << m.roughness << "  "
+              << alpha_name(m.alpha_mode);
+    if (m.transmission > 0.f) std::cout << "  transmission " << m.transmission;
+    std::cout << "  textures: base " << texture_desc(m.base_color_texture) << ", metallic-roughness "
+              << texture_desc(m.metallic_roughness_texture) << "\n";
+  }
+  for (const std::string& w : model.info.warnings) std::cout << "  warning: " << w << "\n";
+}
+
+int run_info(const InfoArgs& args) {
+  ImportOptions options;
+  if (!args.unit.empty()) {
+    Result<double> scale = parse_unit(args.unit);
+    if (!scale.ok()) {
+      std::cerr << "g2p info: " << scale.status().message() << "\n";
+      return kExitUsage;
+    }
+    options.unit_scale = *scale;
+  }
+  static const std::map<std::string, UpAxis> kAxes = {
+      {"auto", UpAxis::kAuto}, {"x", UpAxis::kX}, {"y", UpAxis::kY}, {"z", UpAxis::kZ}};
+  options.up_axis = kAxes.at(args.up);
+  options.z_up = !args.keep_axes;
+  options.load_textures = !args.no_textures;
+
+  Result<Model> model = load_model(args.path, options);
+  if (!model.ok()) {
+    std::cerr << "g2p info: error: " << model.status().to_string() << "\n";
+    return kExitFailure;
+  }
+  std::vector<int> faces_per_material(model->materials.size(), 0);
+  for (const FaceSource& s : model->mesh.face_source)
+    if (s.material >= 0 && s.material < static_cast<int>(faces_per_material.size())) ++faces_per_material[s.material];
+  if (args.json)
+    std::cout << to_json(*model, faces_per_material).dump(2) << "\n";
+  else
+    print_text(*model, faces_per_material);
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, Command& run) {
+  auto args = std::make_shared<InfoArgs>();
+  CLI::App* cmd = app.add_subcommand("info", "Print the meshes, faces, materials and bounds libg2p reads from a model");
+  cmd->add_option("model", args->path, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, DAE, 3MF, ...)")->required();
+  cmd->add_option("--unit", args->unit, "Unit of the file's coordinates: m, cm, mm, in, ft (default: from the format)");
+  cmd->add_option("--up", args->up, "Up axis of the file: auto, x, y, z")
+      ->check(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
+  cmd->add_flag("--keep-axes", args->keep_axes, "Keep the file's axes (default: rotate its up axis to +Z)");
+  cmd->add_flag("--no-textures", args->no_textures, "Do not decode textures");
+  cmd->add_flag("--json", args->json, "Print a JSON summary instead of text");
+  cmd->callback([args, &run] { run = [args] { return run_info(*args); }; });
+}
+
+}  // namespace g2p::cli

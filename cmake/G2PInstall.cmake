@@ -28,7 +28,8 @@ else()
 endif()
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/g2pConfig.cmake.in
-  ${PROJECT_BINARY_DIR}/g2pConfig.cmake INSTALL_DESTINATION ${G2P_INSTALL_CMAKEDIR})
+  ${PROJECT_BINARY_DIR}/g2pConfig.cmake INSTALL_DESTINATION ${G2P_INSTALL_CMAKEDIR}
+  PATH_VARS CMAKE_INSTALL_DATADIR)
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/g2pConfigVersion.cmake
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/g2pConfig.cmake ${PROJECT_BINARY_DIR}/g2pConfigVersion.cmake

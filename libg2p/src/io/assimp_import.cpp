@@ -124,7 +124,7 @@ class SceneFlattener {
       return Status::ParseError("node '" + std::string(node.mName.C_Str()) + "' has a non-finite transform");
     for (unsigned k = 0; k < node.mNumMeshes; ++k) {
       const unsigned index = node.mMeshes[k];
-      if (index >= scene_.mNumMeshes || scene_.mMeshes[index] == nullptr)
+      if (index >= scene_.mNumMeshes || scene_.mMeshes == nullptr || scene_.mMeshes[index] == nullptr)
         return Status::ParseError("node '" + std::string(node.mName.C_Str()) + "' refers to mesh " +
                                   std::to_string(index) + " of " + std::to_string(scene_.mNumMeshes));
       G2P_RETURN_IF_ERROR(add_mesh(*scene_.mMeshes[index], static_cast<int>(index), node, world));
@@ -142,6 +142,7 @@ class SceneFlattener {
     Mesh& mesh = model_.mesh;
     const int nv = static_cast<int>(src.mNumVertices);
     if (src.mVertices == nullptr && nv > 0) return Status::ParseError(where + ": no vertex positions");
+    if (src.mFaces == nullptr && src.mNumFaces > 0) return Status::ParseError(where + ": no face array");
     if (src.mMaterialIndex >= scene_.mNumMaterials && scene_.mNumMaterials > 0)
       return Status::ParseError(where + ": material index " + std::to_string(src.mMaterialIndex) + " out of range (" +
                                 std::to_string(scene_.mNumMaterials) + " materials)");
@@ -164,9 +165,11 @@ class SceneFlattener {
     std::vector<std::int32_t> local_source;
     std::vector<Eigen::Vector3d> polygon;
     std::vector<std::array<int, 3>> pieces;
-    int skipped = 0;
+    int skipped = src.mNumFaces == 0 && nv > 0 ? 1 : 0;  // a bare point cloud
     for (unsigned f = 0; f < src.mNumFaces; ++f) {
       const aiFace& face = src.mFaces[f];
+      if (face.mIndices == nullptr && face.mNumIndices > 0)
+        return Status::ParseError(where + " face " + std::to_string(f) + ": no index array");
       if (face.mNumIndices < 3) {
         ++skipped;
         continue;
@@ -333,6 +336,24 @@ Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bo
   return Status::Ok();
 }
 
+// assimp invents a material named "DefaultMaterial" for formats whose faces
+// may have none (OBJ puts it first). Unused, it only shifts the file's own
+// material indices, so it goes.
+void drop_unused_default_material(Model& model) {
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    if (model.materials[i].name != AI_DEFAULT_MATERIAL_NAME) continue;
+    const int index = static_cast<int>(i);
+    auto uses = [index](const FaceSource& s) { return s.material == index; };
+    if (std::any_of(model.mesh.face_source.begin(), model.mesh.face_source.end(), uses)) continue;
+    model.materials.erase(model.materials.begin() + index);
+    for (FaceSource& s : model.mesh.face_source)
+      if (s.material > index) --s.material;
+    for (SourcePrimitive& p : model.primitives)
+      if (p.material > index) --p.material;
+    return;
+  }
+}
+
 Status check_options(const ImportOptions& o) {
   if (!(o.unit_scale >= 0.0) || !std::isfinite(o.unit_scale))
     return Status::InvalidArgument("ImportOptions::unit_scale must be >= 0 (0 = from the format)");
@@ -392,12 +413,18 @@ Result<Model> convert_scene(const aiScene& scene, const std::string& ext, const 
                                   " degenerate (zero-area) faces flagged and kept");
 
   model.materials = detail::convert_materials(scene, model_dir, options.load_textures, model.info.warnings);
-  if (is_gltf(ext)) G2P_RETURN_IF_ERROR(apply_gltf_layout(scene, gltf_bytes, options.strict, model));
+  if (is_gltf(ext))
+    G2P_RETURN_IF_ERROR(apply_gltf_layout(scene, gltf_bytes, options.strict, model));
+  else
+    drop_unused_default_material(model);
   G2P_RETURN_IF_ERROR(validate(mesh).with_context("after import"));
   return model;
 }
 
-constexpr unsigned kPostProcess = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices;
+// No aiProcess_ValidateDataStructure: its verdicts ("Mesh contains no faces")
+// are vaguer than libg2p's own checks in SceneFlattener, which also guard
+// every pointer and index assimp hands over.
+constexpr unsigned kPostProcess = aiProcess_JoinIdenticalVertices;
 
 // Runs `body`, turning exceptions (from assimp's or the standard library's
 // allocations, say) into a Status, so none crosses the public API.

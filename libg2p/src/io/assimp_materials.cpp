@@ -99,8 +99,12 @@ std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::s
   std::vector<SourceMaterial> materials;
   materials.reserve(scene.mNumMaterials);
   for (unsigned i = 0; i < scene.mNumMaterials; ++i) {
-    const aiMaterial& mat = *scene.mMaterials[i];
     SourceMaterial m;
+    if (scene.mMaterials == nullptr || scene.mMaterials[i] == nullptr) {
+      materials.push_back(std::move(m));
+      continue;
+    }
+    const aiMaterial& mat = *scene.mMaterials[i];
     aiString name;
     if (mat.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) m.name = name.C_Str();
     const std::string what = "material " + std::to_string(i) + " '" + m.name + "'";

@@ -1,0 +1,47 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "g2p/io.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+TEST(ImageIo, PngRoundTripIsLossless) {
+  const std::string dir = test::scratch_dir("ImageIo.RoundTrip");
+  for (int channels : {1, 3, 4}) {
+    ImageU8 img(17, 9, channels);
+    for (std::size_t i = 0; i < img.size(); ++i) img.data()[i] = static_cast<std::uint8_t>(i * 37 % 251);
+    const std::string path = dir + "/img" + std::to_string(channels) + ".png";
+    ASSERT_TRUE(write_image(path, img).ok());
+    Result<ImageU8> back = read_image(path);  // always RGBA
+    ASSERT_TRUE(back.ok()) << back.status().to_string();
+    ASSERT_EQ(back->width(), 17);
+    ASSERT_EQ(back->height(), 9);
+    ASSERT_EQ(back->channels(), 4);
+    for (int y = 0; y < 9; ++y)
+      for (int x = 0; x < 17; ++x)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(back->at(x, y, c), img.at(x, y, channels == 1 ? 0 : c)) << x << "," << y << "," << c;
+  }
+}
+
+TEST(ImageIo, ErrorsAndNoHalfWrittenFiles) {
+  const std::string dir = test::scratch_dir("ImageIo.Errors");
+  EXPECT_EQ(read_image(dir + "/none.png").status().code(), StatusCode::kNotFound);
+  test::write_file(dir + "/bad.png", "not a png");
+  EXPECT_EQ(read_image(dir + "/bad.png").status().code(), StatusCode::kParseError);
+  EXPECT_EQ(write_image(dir + "/x.png", ImageU8()).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(write_image(dir + "/x.png", ImageU8(2, 2, 2)).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(write_image(dir + "/x.unknownext", ImageU8(2, 2, 3)).code(), StatusCode::kIoError);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.unknownext"));
+  EXPECT_EQ(write_image(dir + "/no/such/dir/x.png", ImageU8(2, 2, 3)).code(), StatusCode::kIoError);
+  // Nothing but the input remains in the folder.
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 1);
+}
+
+}  // namespace
+}  // namespace g2p

@@ -1,0 +1,39 @@
+#include "support/test_data.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace g2p::test {
+
+std::string asset_path(const std::string& name) {
+  return std::string(G2P_TEST_SHARED_ASSETS) + "/" + name + "/" + name + ".glb";
+}
+std::string labels_json_path() { return std::string(G2P_TEST_SHARED_ASSETS) + "/labels.json"; }
+std::string assimp_model(const std::string& relative) { return std::string(G2P_TEST_ASSIMP_MODELS) + "/" + relative; }
+std::string source_path(const std::string& relative) { return std::string(G2P_TEST_SOURCE_DIR) + "/" + relative; }
+
+std::string scratch_dir(const std::string& test_name) {
+  const std::filesystem::path dir = std::filesystem::path(G2P_TEST_BINARY_DIR) / "scratch" / test_name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << bytes;
+  ASSERT_TRUE(out.good()) << "cannot write " << path;
+}
+
+}  // namespace g2p::test

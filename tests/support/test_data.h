@@ -1,0 +1,22 @@
+// Paths of the real data the tests use, and small helpers to make files.
+#pragma once
+
+#include <string>
+
+namespace g2p::test {
+
+// ../shared/assets/<name>/<name>.glb, e.g. asset_path("SheenChair").
+std::string asset_path(const std::string& name);
+std::string labels_json_path();
+// A file of Debian's assimp-testmodels, e.g. assimp_model("glTF2/MissingBin/BoxTextured.gltf").
+std::string assimp_model(const std::string& relative);
+// A file of the source tree, e.g. source_path("examples/data/hammer.obj").
+std::string source_path(const std::string& relative);
+
+// A fresh, empty folder for one test under the build tree.
+std::string scratch_dir(const std::string& test_name);
+
+std::string read_file(const std::string& path);
+void write_file(const std::string& path, const std::string& bytes);
+
+}  // namespace g2p::test

@@ -1,0 +1,88 @@
+// The g2p tool as a user runs it: exit codes, messages on stderr, JSON output.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+struct ToolRun {
+  int exit_code;
+  std::string out, err;
+};
+
+// Runs the g2p tool with `args` (already shell-quoted), capturing both streams.
+ToolRun run_tool(const std::string& args) {
+  static int counter = 0;  // ctest runs tests in parallel processes: one folder per run
+  const std::string dir = test::scratch_dir("tool_run_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
+  const std::string cmd = std::string("'") + G2P_TEST_TOOL + "' " + args + " >'" + dir + "/out' 2>'" + dir + "/err'";
+  const int status = std::system(cmd.c_str());
+  ToolRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, test::read_file(dir + "/out"), test::read_file(dir + "/err")};
+  return r;
+}
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+TEST(ToolInfo, PrintsMeshesFacesMaterialsAndBounds) {
+  ToolRun r = run_tool("info " + quote(test::asset_path("SheenChair")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("39936 triangles"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'fabric Mystere Mango Velvet'  faces 26176"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bounds (m)"), std::string::npos);
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(ToolInfo, JsonSummary) {
+  ToolRun r = run_tool("info --json --no-textures " + quote(test::source_path("examples/data/hammer.obj")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["faces"], 104);
+  EXPECT_EQ(j["materials"].size(), 2u);
+  EXPECT_EQ(j["materials"][1]["name"], "steel_head");
+  EXPECT_EQ(j["materials"][1]["faces"], 12);
+  EXPECT_NEAR(j["bounds_m"]["max"][2].get<double>(), 0.34, 1e-6);
+}
+
+TEST(ToolInfo, EveryMalformedGltfFailsWithAMessage) {
+  int checked = 0;
+  const std::string root = test::assimp_model("glTF2");
+  for (const char* f :
+       {"BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "IndexOutOfRange/IndexOutOfRange.gltf",
+        "IndexOutOfRange/AllIndicesOutOfRange.gltf", "IncorrectVertexArrays/Cube.gltf", "MissingBin/BoxTextured.gltf",
+        "RecursiveNodes/RecursiveNodes.gltf", "SchemaFailures/sceneWrongType.gltf", "TestNoRootNode/NoScene.gltf",
+        "TestNoRootNode/SceneWithoutNodes.gltf", "issue_3269/texcoord_crash.gltf"}) {
+    ToolRun r = run_tool("info " + quote(root + "/" + f));
+    EXPECT_EQ(r.exit_code, 1) << f;
+    EXPECT_NE(r.err.find("g2p info: error: "), std::string::npos) << f << ": " << r.err;
+    EXPECT_NE(r.err.find(f), std::string::npos) << "message does not name the file: " << r.err;
+    ++checked;
+  }
+  for (const auto& e : std::filesystem::directory_iterator(root + "/wrongTypes")) {
+    if (e.path().extension() != ".gltf") continue;
+    ToolRun r = run_tool("info " + quote(e.path().string()));
+    EXPECT_EQ(r.exit_code, 1) << e.path();
+    EXPECT_FALSE(r.err.empty()) << e.path();
+    ++checked;
+  }
+  EXPECT_EQ(checked, 16);
+}
+
+TEST(ToolInfo, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(run_tool("").exit_code, 2);
+  EXPECT_EQ(run_tool("info").exit_code, 2);
+  EXPECT_EQ(run_tool("info --up sideways x.glb").exit_code, 2);
+  ToolRun r = run_tool("info --unit parsec " + quote(test::asset_path("Avocado")));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown unit 'parsec'"), std::string::npos) << r.err;
+  EXPECT_EQ(run_tool("--help").exit_code, 0);
+}
+
+}  // namespace
+}  // namespace g2p

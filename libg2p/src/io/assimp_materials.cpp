@@ -5,9 +5,12 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
+#include <thread>
 
 #include "assimp_convert.h"
 #include "image_io.h"
@@ -30,6 +33,25 @@ class TextureCache {
  public:
   TextureCache(const aiScene& scene, std::string model_dir) : scene_(scene), dir_(std::move(model_dir)) {}
 
+  // Decodes the given textures concurrently (PNG/JPEG decoding dominates
+  // import time for textured models), filling the cache.
+  void prefetch(const std::vector<std::string>& uris) {
+    std::vector<std::string> todo;
+    for (const std::string& u : uris)
+      if (!cache_.count(u) && std::find(todo.begin(), todo.end(), u) == todo.end()) todo.push_back(u);
+    std::vector<std::optional<Result<ImageU8>>> results(todo.size());
+    std::atomic<std::size_t> next{0};
+    auto worker = [&] {
+      for (std::size_t i = next++; i < todo.size(); i = next++) results[i] = load(todo[i]);
+    };
+    const std::size_t threads = std::min<std::size_t>(todo.size(), std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+    for (std::size_t i = 0; i < todo.size(); ++i) store(todo[i], std::move(*results[i]));
+  }
+
   // Returns the decoded image or null, with the reason in `error`.
   std::shared_ptr<const ImageU8> get(const std::string& uri, std::string& error) {
     auto it = cache_.find(uri);
@@ -37,15 +59,24 @@ class TextureCache {
       error = it->second.second;
       return it->second.first;
     }
-    Result<ImageU8> image = load(uri);
-    std::shared_ptr<const ImageU8> decoded;
-    if (image.ok()) decoded = std::make_shared<const ImageU8>(std::move(*image));
-    error = image.ok() ? std::string() : image.status().message();
-    cache_.emplace(uri, std::make_pair(decoded, error));
-    return decoded;
+    const auto& entry = store(uri, load(uri));
+    error = entry.second;
+    return entry.first;
   }
 
  private:
+  using Entry = std::pair<std::shared_ptr<const ImageU8>, std::string>;  // image or error
+
+  const Entry& store(const std::string& uri, Result<ImageU8> image) {
+    Entry entry;
+    if (image.ok())
+      entry.first = std::make_shared<const ImageU8>(std::move(*image));
+    else
+      entry.second = image.status().message();
+    return cache_.emplace(uri, std::move(entry)).first->second;
+  }
+
+  // Thread-safe: reads the scene and the file system only.
   Result<ImageU8> load(const std::string& uri) {
     if (const aiTexture* embedded = scene_.GetEmbeddedTexture(uri.c_str())) {
       if (embedded->mHeight == 0) return decode_image_rgba(embedded->pcData, embedded->mWidth);
@@ -66,7 +97,7 @@ class TextureCache {
 
   const aiScene& scene_;
   std::string dir_;
-  std::map<std::string, std::pair<std::shared_ptr<const ImageU8>, std::string>> cache_;
+  std::map<std::string, Entry> cache_;
 };
 
 Texture read_texture(const aiMaterial& mat, aiTextureType type, TextureCache* cache, const std::string& what,
@@ -96,6 +127,18 @@ Texture read_texture(const aiMaterial& mat, aiTextureType type, TextureCache* ca
 std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::string& model_dir, bool load_textures,
                                               std::vector<std::string>& warnings) {
   TextureCache cache(scene, model_dir);
+  if (load_textures) {
+    std::vector<std::string> uris;
+    for (unsigned i = 0; i < scene.mNumMaterials; ++i) {
+      const aiMaterial* mat = scene.mMaterials != nullptr ? scene.mMaterials[i] : nullptr;
+      if (mat == nullptr) continue;
+      for (aiTextureType type : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, aiTextureType_UNKNOWN}) {
+        aiString path;
+        if (mat->GetTexture(type, 0, &path) == AI_SUCCESS) uris.emplace_back(path.C_Str());
+      }
+    }
+    cache.prefetch(uris);
+  }
   std::vector<SourceMaterial> materials;
   materials.reserve(scene.mNumMaterials);
   for (unsigned i = 0; i < scene.mNumMaterials; ++i) {

@@ -3,7 +3,7 @@
 # bindings need. Idempotent and non-interactive; run as root or with sudo.
 #
 #   scripts/install-deps.sh            # build + tests + examples (default)
-#   scripts/install-deps.sh --minimal  # only what the core library needs to build
+#   scripts/install-deps.sh --minimal  # only what libg2p itself links (all stages), no test/validation tools
 set -euo pipefail
 
 minimal=0

@@ -122,7 +122,12 @@ INSTANTIATE_TEST_SUITE_P(
                     BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5}, {"name": "a", "density_kg_m3": 6}]})",
                              StatusCode::kInvalidArgument, "classes[1]: name 'a' repeats classes[0]"},
                     BadTable{R"({"format": "g2p-material-table", "version": 99, "classes": []})",
-                             StatusCode::kUnsupported, "newer than this libg2p reads"}),
+                             StatusCode::kUnsupported, "newer than this libg2p reads"},
+                    BadTable{R"({"version": "1", "classes": []})", StatusCode::kParseError,
+                             "'version' must be an integer"},
+                    BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "restitutoin": 0.2}]})",
+                             StatusCode::kParseError, "classes[0]: unknown key 'restitutoin'"},
+                    BadTable{R"({"clases": []})", StatusCode::kParseError, "unknown key 'clases'"}),
     [](const testing::TestParamInfo<BadTable>& info) { return "case" + std::to_string(info.index); });
 
 TEST(MaterialTable, LoadAndSaveFiles) {
@@ -140,7 +145,8 @@ TEST(MaterialTable, LoadAndSaveFiles) {
   // The shipped data file is the embedded default.
   Result<MaterialTable> shipped = MaterialTable::load(test::source_path("libg2p/data/materials.json"));
   ASSERT_TRUE(shipped.ok()) << shipped.status().to_string();
-  EXPECT_EQ(shipped->to_json(), MaterialTable::paper_default().to_json());
+  EXPECT_TRUE(shipped->to_json() == MaterialTable::paper_default().to_json())
+      << "libg2p/data/materials.json differs from the table embedded in the library";
 
   // Saving into a folder that does not exist fails cleanly and leaves nothing.
   EXPECT_EQ(MaterialTable::paper_default().save(dir + "/no/such/dir/t.json").code(), StatusCode::kIoError);

@@ -84,5 +84,12 @@ TEST(ToolInfo, UsageErrorsExitWithTwo) {
   EXPECT_EQ(run_tool("--help").exit_code, 0);
 }
 
+TEST(ToolInfo, UpAxisIsCaseInsensitive) {
+  ToolRun r = run_tool("info --json --no-textures --up Z " + quote(test::source_path("examples/data/hammer.obj")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Declared Z-up, the Y-up hammer lies on its side: its 34 cm length stays along y.
+  EXPECT_NEAR(nlohmann::json::parse(r.out)["bounds_m"]["max"][1].get<double>(), 0.34, 1e-6);
+}
+
 }  // namespace
 }  // namespace g2p

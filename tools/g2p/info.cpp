@@ -106,7 +106,8 @@ int run_info(const InfoArgs& args) {
   }
   static const std::map<std::string, UpAxis> kAxes = {
       {"auto", UpAxis::kAuto}, {"x", UpAxis::kX}, {"y", UpAxis::kY}, {"z", UpAxis::kZ}};
-  options.up_axis = kAxes.at(args.up);
+  const auto axis = kAxes.find(args.up);
+  options.up_axis = axis != kAxes.end() ? axis->second : UpAxis::kAuto;
   options.z_up = !args.keep_axes;
   options.load_textures = !args.no_textures;
 
@@ -133,7 +134,7 @@ void add_info_command(CLI::App& app, Command& run) {
   cmd->add_option("model", args->path, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, DAE, 3MF, ...)")->required();
   cmd->add_option("--unit", args->unit, "Unit of the file's coordinates: m, cm, mm, in, ft (default: from the format)");
   cmd->add_option("--up", args->up, "Up axis of the file: auto, x, y, z")
-      ->check(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
+      ->transform(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
   cmd->add_flag("--keep-axes", args->keep_axes, "Keep the file's axes (default: rotate its up axis to +Z)");
   cmd->add_flag("--no-textures", args->no_textures, "Do not decode textures");
   cmd->add_flag("--json", args->json, "Print a JSON summary instead of text");

@@ -3,6 +3,8 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <iterator>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -52,8 +54,21 @@ Status check_class(const MaterialClass& c) {
 }
 
 // Reads one class object; `where` is "origin: classes[i]".
+// Keys a class object may have; anything else is a typo that would silently
+// leave a default in place, so it is an error.
+constexpr const char* kClassKeys[] = {"name",     "color",       "density_kg_m3", "density_range_kg_m3",
+                                      "friction", "restitution", "structure",     "wall_thickness_m",
+                                      "source"};
+
 Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   if (!j.is_object()) return Status::ParseError(where + ": expected an object");
+  for (const auto& item : j.items()) {
+    if (std::find(std::begin(kClassKeys), std::end(kClassKeys), item.key()) == std::end(kClassKeys)) {
+      std::string known;
+      for (const char* k : kClassKeys) known += std::string(known.empty() ? "" : ", ") + k;
+      return Status::ParseError(where + ": unknown key '" + item.key() + "' (known: " + known + ")");
+    }
+  }
   MaterialClass c;
   auto number = [&](const json& obj, const char* key, double& out, bool required) -> Status {
     auto it = obj.find(key);
@@ -140,9 +155,17 @@ Result<MaterialTable> MaterialTable::from_json(const std::string& json_text, con
   if (!doc.is_object()) return Status::ParseError(origin + ": expected a JSON object at the top level");
   if (auto f = doc.find("format"); f != doc.end() && (!f->is_string() || f->get<std::string>() != kFormat))
     return Status::ParseError(origin + ": 'format' must be \"" + std::string(kFormat) + "\"");
-  if (auto v = doc.find("version"); v != doc.end() && (!v->is_number_integer() || v->get<int>() > kFormatVersion))
+  if (auto v = doc.find("version"); v != doc.end() && !v->is_number_integer())
+    return Status::ParseError(origin + ": 'version' must be an integer");
+  if (auto v = doc.find("version"); v != doc.end() && v->get<int>() > kFormatVersion)
     return Status::Unsupported(origin + ": table version " + v->dump() + " is newer than this libg2p reads (" +
                                std::to_string(kFormatVersion) + ")");
+  for (const auto& item : doc.items()) {
+    static const char* const kTopKeys[] = {"format", "version", "name", "about", "classes"};
+    if (std::find(std::begin(kTopKeys), std::end(kTopKeys), item.key()) == std::end(kTopKeys))
+      return Status::ParseError(origin + ": unknown key '" + item.key() +
+                                "' (known: format, version, name, about, classes)");
+  }
   auto classes = doc.find("classes");
   if (classes == doc.end() || !classes->is_array()) return Status::ParseError(origin + ": missing array 'classes'");
   std::vector<MaterialClass> parsed;
@@ -169,8 +192,13 @@ Result<MaterialTable> MaterialTable::load(const std::string& path) {
 const MaterialTable& MaterialTable::paper_default() {
   static const MaterialTable table = [] {
     Result<MaterialTable> t = from_json(kDefaultMaterialTableJson, "embedded materials.json");
-    // The embedded table is checked by the test suite; an error here is a build defect.
-    return t.ok() ? std::move(*t) : MaterialTable();
+    if (!t.ok()) {
+      // The embedded table is checked by the test suite: failing here is a
+      // defect of the build, not of any input, and must not pass silently.
+      std::fprintf(stderr, "libg2p: the built-in material table is broken: %s\n", t.status().to_string().c_str());
+      std::abort();
+    }
+    return std::move(*t);
   }();
   return table;
 }

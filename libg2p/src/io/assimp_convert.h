@@ -10,9 +10,11 @@ struct aiScene;
 
 namespace g2p::detail {
 
-// Converts every material of the scene, in the scene's order (for glTF that is
-// the file's `materials` order), decoding textures when `load_textures`.
-// Problems that only lose appearance are appended to `warnings`.
+// Converts every material of the scene, in assimp's order, decoding textures
+// when `load_textures`. (For glTF, assimp's order is not the file's: see
+// gltf_layout.h.) An empty `model_dir` means the model came from memory and
+// external texture files cannot be resolved. Problems that only lose
+// appearance are appended to `warnings`.
 std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::string& model_dir, bool load_textures,
                                               std::vector<std::string>& warnings);
 

@@ -475,7 +475,9 @@ Result<Model> load_model(const std::string& path, const ImportOptions& options) 
     info.path = path;
     info.format = ext;
     const std::string gltf_bytes = is_gltf(ext) ? read_gltf_json_bytes(path) : std::string();
-    return convert_scene(*scene, ext, fs::path(path).parent_path().string(), gltf_bytes, options, std::move(info));
+    std::string dir = fs::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    return convert_scene(*scene, ext, dir, gltf_bytes, options, std::move(info));
   });
 }
 
@@ -493,7 +495,7 @@ Result<Model> load_model_from_memory(const void* data, std::size_t size, const s
     info.path = "<memory>";
     info.format = ext;
     const std::string gltf_bytes = is_gltf(ext) ? std::string(static_cast<const char*>(data), size) : std::string();
-    return convert_scene(*scene, ext, ".", gltf_bytes, options, std::move(info));
+    return convert_scene(*scene, ext, /*model_dir=*/"", gltf_bytes, options, std::move(info));
   });
 }
 
@@ -508,7 +510,7 @@ Result<double> parse_unit(const std::string& unit) {
   const std::string u = lower(unit);
   for (const auto& [name, scale] : kUnits)
     if (u == name) return scale;
-  return Status::InvalidArgument("unknown unit '" + unit + "' (use m, cm, mm, in or ft)");
+  return Status::InvalidArgument("unknown unit '" + unit + "' (use m, cm, mm, km, in or ft)");
 }
 
 }  // namespace g2p

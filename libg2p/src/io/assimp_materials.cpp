@@ -90,6 +90,7 @@ class TextureCache {
       return image;
     }
     if (!uri.empty() && uri[0] == '*') return Status::NotFound("embedded texture " + uri + " is missing");
+    if (dir_.empty()) return Status::NotFound("an external file cannot be resolved for a model read from memory");
     std::filesystem::path path(uri);
     if (path.is_relative()) path = std::filesystem::path(dir_) / path;
     return read_image_rgba(path.lexically_normal().string());

@@ -14,26 +14,21 @@ namespace g2p {
 namespace detail {
 namespace {
 
-// Converts any decoded cv::Mat (1-4 channels, 8 or 16 bit) to RGBA8.
+// Converts any decoded cv::Mat (1-4 channels, 8 or 16 bit) to RGBA8, writing
+// straight into the returned image's storage (no intermediate copy: decoded
+// textures are up to 4096^2 and fresh memory is costly on virtual machines).
 ImageU8 to_rgba8(const cv::Mat& decoded) {
   cv::Mat m = decoded;
-  if (m.depth() == CV_16U)
-    m.convertTo(m, CV_8U, 1.0 / 257.0);
-  else if (m.depth() != CV_8U)
-    m.convertTo(m, CV_8U, 255.0);
-  cv::Mat rgba;
+  if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
+  else if (m.depth() != CV_8U) m.convertTo(m, CV_8U, 255.0);
+  if (m.channels() > 4 || m.channels() == 2) cv::extractChannel(m, m, 0);
+  ImageU8 out(m.cols, m.rows, 4);
+  cv::Mat rgba(m.rows, m.cols, CV_8UC4, out.data());  // a view of `out`
   switch (m.channels()) {
     case 1: cv::cvtColor(m, rgba, cv::COLOR_GRAY2RGBA); break;
     case 3: cv::cvtColor(m, rgba, cv::COLOR_BGR2RGBA); break;
-    case 4: cv::cvtColor(m, rgba, cv::COLOR_BGRA2RGBA); break;
-    default: {
-      cv::Mat first;
-      cv::extractChannel(m, first, 0);
-      cv::cvtColor(first, rgba, cv::COLOR_GRAY2RGBA);
-    }
+    default: cv::cvtColor(m, rgba, cv::COLOR_BGRA2RGBA); break;
   }
-  ImageU8 out(rgba.cols, rgba.rows, 4);
-  for (int y = 0; y < rgba.rows; ++y) std::memcpy(out.pixel(0, y), rgba.ptr<std::uint8_t>(y), out.row_stride());
   return out;
 }
 

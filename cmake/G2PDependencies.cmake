@@ -19,6 +19,12 @@ g2p_require(assimp_FOUND libassimp-dev)
 find_package(OpenCV 4.6 QUIET COMPONENTS core imgproc imgcodecs)
 g2p_require(OpenCV_FOUND libopencv-dev)
 
+find_package(embree 3 QUIET)
+g2p_require(embree_FOUND libembree-dev)
+
+find_package(TBB QUIET)
+g2p_require(TBB_FOUND libtbb-dev)
+
 find_package(nlohmann_json 3.10 QUIET)
 g2p_require(nlohmann_json_FOUND nlohmann-json3-dev)
 

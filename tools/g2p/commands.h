@@ -17,5 +17,6 @@ enum ExitCode : int {
 // Adds a subcommand; the returned function runs it after parsing.
 using Command = std::function<int()>;
 void add_info_command(CLI::App& app, Command& run);
+void add_render_command(CLI::App& app, Command& run);
 
 }  // namespace g2p::cli

@@ -2,12 +2,12 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
-#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "commands.h"
+#include "common.h"
 #include "g2p/io.h"
 
 namespace g2p::cli {
@@ -15,10 +15,7 @@ namespace {
 
 struct InfoArgs {
   std::string path;
-  std::string unit;  // "" = from the format
-  std::string up = "auto";
-  bool keep_axes = false;
-  bool no_textures = false;
+  ImportArgs import;
   bool json = false;
 };
 
@@ -95,27 +92,9 @@ void print_text(const Model& model, const std::vector<int>& faces_per_material) 
 }
 
 int run_info(const InfoArgs& args) {
-  ImportOptions options;
-  if (!args.unit.empty()) {
-    Result<double> scale = parse_unit(args.unit);
-    if (!scale.ok()) {
-      std::cerr << "g2p info: " << scale.status().message() << "\n";
-      return kExitUsage;
-    }
-    options.unit_scale = *scale;
-  }
-  static const std::map<std::string, UpAxis> kAxes = {
-      {"auto", UpAxis::kAuto}, {"x", UpAxis::kX}, {"y", UpAxis::kY}, {"z", UpAxis::kZ}};
-  const auto axis = kAxes.find(args.up);
-  options.up_axis = axis != kAxes.end() ? axis->second : UpAxis::kAuto;
-  options.z_up = !args.keep_axes;
-  options.load_textures = !args.no_textures;
-
-  Result<Model> model = load_model(args.path, options);
-  if (!model.ok()) {
-    std::cerr << "g2p info: error: " << model.status().to_string() << "\n";
-    return kExitFailure;
-  }
+  int exit_code = kExitOk;
+  Result<Model> model = load_with_flags("info", args.path, args.import, exit_code);
+  if (!model.ok()) return exit_code;
   std::vector<int> faces_per_material(model->materials.size(), 0);
   for (const FaceSource& s : model->mesh.face_source)
     if (s.material >= 0 && s.material < static_cast<int>(faces_per_material.size())) ++faces_per_material[s.material];
@@ -132,11 +111,7 @@ void add_info_command(CLI::App& app, Command& run) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand("info", "Print the meshes, faces, materials and bounds libg2p reads from a model");
   cmd->add_option("model", args->path, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, DAE, 3MF, ...)")->required();
-  cmd->add_option("--unit", args->unit, "Unit of the file's coordinates: m, cm, mm, in, ft (default: from the format)");
-  cmd->add_option("--up", args->up, "Up axis of the file: auto, x, y, z")
-      ->transform(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
-  cmd->add_flag("--keep-axes", args->keep_axes, "Keep the file's axes (default: rotate its up axis to +Z)");
-  cmd->add_flag("--no-textures", args->no_textures, "Do not decode textures");
+  add_import_flags(cmd, args->import);
   cmd->add_flag("--json", args->json, "Print a JSON summary instead of text");
   cmd->callback([args, &run] { run = [args] { return run_info(*args); }; });
 }

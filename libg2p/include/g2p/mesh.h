@@ -28,7 +28,10 @@ enum FaceFlag : std::uint8_t {
 struct Mesh {
   std::vector<Eigen::Vector3f> positions;  // metres, in libg2p's frame (right-handed, +Z up by default)
   std::vector<Eigen::Vector3f> normals;    // per vertex, unit length; empty or positions.size()
-  std::vector<Eigen::Vector2f> uvs;        // per vertex, first UV set; empty or positions.size()
+  // Per vertex, first UV set; empty or positions.size(). Image convention, as
+  // glTF: (0, 0) is the top-left corner of a texture, v grows downwards (files
+  // with OpenGL-style v-up coordinates, such as OBJ, are flipped on import).
+  std::vector<Eigen::Vector2f> uvs;
   std::vector<Eigen::Vector3i> triangles;  // counter-clockwise seen from outside; indices into positions
   std::vector<FaceSource> face_source;     // per triangle; empty for meshes built without provenance
   std::vector<std::uint8_t> face_flags;    // per triangle, FaceFlag bits; empty = no flags

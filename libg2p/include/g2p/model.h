@@ -23,6 +23,9 @@ struct Texture {
   int uv_set = 0;                        // which UV set it reads (libg2p keeps set 0)
   WrapMode wrap_u = WrapMode::kRepeat;
   WrapMode wrap_v = WrapMode::kRepeat;
+  // Affine map applied to Mesh::uvs before sampling (glTF KHR_texture_transform:
+  // translation * rotation * scale); identity when the file has none.
+  Eigen::Matrix<float, 2, 3> uv_transform = (Eigen::Matrix<float, 2, 3>() << 1, 0, 0, 0, 1, 0).finished();
   bool empty() const { return image == nullptr; }
 };
 

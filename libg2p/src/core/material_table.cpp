@@ -4,11 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <iterator>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/file_util.h"
 #include "g2p/materials.h"
 
 namespace g2p {
@@ -220,21 +221,7 @@ std::string MaterialTable::to_json() const {
   return doc.dump(2) + "\n";
 }
 
-Status MaterialTable::save(const std::string& path) const {
-  // Write beside the target and rename, so a failure never leaves half a file.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status::IoError(path + ": cannot open for writing");
-    out << to_json();
-    if (!out.flush()) return Status::IoError(path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return Status::IoError(path + ": cannot replace the file");
-  }
-  return Status::Ok();
-}
+Status MaterialTable::save(const std::string& path) const { return detail::write_file_atomically(path, to_json()); }
 
 int MaterialTable::find(std::string_view name) const {
   for (std::size_t i = 0; i < classes_.size(); ++i)

@@ -232,7 +232,9 @@ class SceneFlattener {
       if (has_uvs) {
         const aiVector3D& t = src.mTextureCoords[0][v];
         const bool finite = std::isfinite(t.x) && std::isfinite(t.y);
-        mesh.uvs.emplace_back(finite ? t.x : 0.f, finite ? t.y : 0.f);
+        // assimp hands out OpenGL-style v-up coordinates (it flips glTF's);
+        // libg2p keeps the image convention, glTF's own.
+        mesh.uvs.emplace_back(finite ? t.x : 0.f, finite ? 1.f - t.y : 0.f);
         any_bad_uv_ |= !finite;
       } else {
         mesh.uvs.emplace_back(0.f, 0.f);
@@ -323,10 +325,16 @@ Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bo
     const int file_index = layout->primitives[k].material;
     const unsigned assimp_index = scene.mMeshes[k]->mMaterialIndex;
     if (file_index < 0 || assimp_index >= model.materials.size()) continue;
-    // Factors come from the file's JSON; decoded textures from assimp.
+    // Factors and texture transforms come from the file's JSON; decoded
+    // textures and samplers from assimp.
     SourceMaterial& m = materials[static_cast<std::size_t>(file_index)];
-    m.base_color_texture = model.materials[assimp_index].base_color_texture;
-    m.metallic_roughness_texture = model.materials[assimp_index].metallic_roughness_texture;
+    const SourceMaterial& decoded = model.materials[assimp_index];
+    for (auto [to, from] : {std::pair{&m.base_color_texture, &decoded.base_color_texture},
+                            std::pair{&m.metallic_roughness_texture, &decoded.metallic_roughness_texture}}) {
+      const Eigen::Matrix<float, 2, 3> transform = to->uv_transform;
+      *to = *from;
+      to->uv_transform = transform;
+    }
   }
   for (FaceSource& s : model.mesh.face_source)
     s.material = layout->primitives[static_cast<std::size_t>(s.mesh)].material;

@@ -4,6 +4,7 @@
 // tells them.
 #include "gltf_layout.h"
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -37,6 +38,30 @@ float number_or(const json& obj, const char* key, float fallback) {
   return it != obj.end() && it->is_number() ? it->get<float>() : fallback;
 }
 
+// KHR_texture_transform of a textureInfo object, as the affine map
+// translation * rotation * scale (the extension's specification).
+Eigen::Matrix<float, 2, 3> texture_transform(const json& info) {
+  Eigen::Matrix<float, 2, 3> t;
+  t << 1, 0, 0, 0, 1, 0;
+  if (!info.is_object()) return t;
+  auto ext = info.find("extensions");
+  if (ext == info.end() || !ext->is_object()) return t;
+  auto tt = ext->find("KHR_texture_transform");
+  if (tt == ext->end() || !tt->is_object()) return t;
+  float offset[2] = {0.f, 0.f}, scale[2] = {1.f, 1.f};
+  for (int k = 0; k < 2; ++k) {
+    if (auto o = tt->find("offset"); o != tt->end() && o->is_array() && o->size() == 2 && (*o)[k].is_number())
+      offset[k] = (*o)[k].get<float>();
+    if (auto s = tt->find("scale"); s != tt->end() && s->is_array() && s->size() == 2 && (*s)[k].is_number())
+      scale[k] = (*s)[k].get<float>();
+  }
+  const float r = number_or(*tt, "rotation", 0.f);
+  const float c = std::cos(r), s = std::sin(r);
+  // [[c, s], [-s, c]] * diag(scale), then the offset.
+  t << c * scale[0], s * scale[1], offset[0], -s * scale[0], c * scale[1], offset[1];
+  return t;
+}
+
 SourceMaterial parse_material(const json& m) {
   SourceMaterial out;
   if (!m.is_object()) return out;
@@ -49,6 +74,10 @@ SourceMaterial parse_material(const json& m) {
     }
     out.metallic = number_or(*pbr, "metallicFactor", 1.f);
     out.roughness = number_or(*pbr, "roughnessFactor", 1.f);
+    if (auto t = pbr->find("baseColorTexture"); t != pbr->end())
+      out.base_color_texture.uv_transform = texture_transform(*t);
+    if (auto t = pbr->find("metallicRoughnessTexture"); t != pbr->end())
+      out.metallic_roughness_texture.uv_transform = texture_transform(*t);
   }
   if (auto a = m.find("alphaMode"); a != m.end() && a->is_string()) {
     const std::string mode = a->get<std::string>();

@@ -1,0 +1,48 @@
+// Private: what a renderer needs to turn a surface hit into colour. Texture
+// sampling through a material's UV transform and wrap modes, colour-space
+// conversion, and the studio lighting with a metallic-roughness BRDF.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "g2p/model.h"
+
+namespace g2p::detail {
+
+// sRGB <-> linear (IEC 61966-2-1).
+float srgb_to_linear(float c);
+float linear_to_srgb(float c);
+std::uint8_t linear_to_srgb8(float c);  // clamps to [0, 1] first
+
+// Bilinear sample of a texture at mesh UV `uv` (image convention), after the
+// texture's uv_transform and wrap modes. `srgb` converts texels to linear
+// before filtering (colour textures). Returns RGBA; (1, 1, 1, 1) for an empty texture.
+Eigen::Vector4f sample(const Texture& texture, const Eigen::Vector2f& uv, bool srgb);
+
+// What a surface point looks like.
+struct SurfaceSample {
+  Eigen::Vector3f base_color{1.f, 1.f, 1.f};  // linear
+  float alpha = 1.f;                          // after alpha mode (MASK cut-outs never get here)
+  float metallic = 0.f;
+  float roughness = 1.f;
+  float transmission = 0.f;
+};
+
+// Evaluates a material at a point with UV `uv` (ignored without textures).
+SurfaceSample evaluate_material(const SourceMaterial& material, const Eigen::Vector2f& uv);
+
+// Alpha of a material at `uv` (factor times texture), for MASK cut-outs.
+float material_alpha(const SourceMaterial& material, const Eigen::Vector2f& uv);
+
+// Radiance leaving the surface towards the camera under libg2p's fixed studio
+// light set (see shading.cpp), split so callers can weight the specular part
+// of transparent surfaces separately. `n` and `v` are unit world vectors with
+// dot(n, v) >= 0; `camera_to_world` orients the camera-relative lights.
+struct ShadedColor {
+  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();
+  Eigen::Vector3f specular = Eigen::Vector3f::Zero();
+};
+ShadedColor shade(const SurfaceSample& s, const Eigen::Vector3f& n, const Eigen::Vector3f& v,
+                  const Eigen::Matrix3f& camera_to_world);
+
+}  // namespace g2p::detail

@@ -2,23 +2,34 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "g2p/io.h"
+#include "support/test_data.h"
+
 namespace g2p::test {
 
+int GltfBuilder::add_texture(const std::string& image_bytes, int wrap) {
+  textures_.push_back({image_bytes, wrap});
+  return static_cast<int>(textures_.size()) - 1;
+}
+
 int GltfBuilder::add_material(const std::string& name, const Eigen::Vector4f& base_color, float metallic,
-                              float roughness) {
-  materials_.push_back({name, base_color, metallic, roughness});
+                              float roughness, int base_color_texture, const std::string& texture_info_json,
+                              const std::string& material_json) {
+  materials_.push_back({name, base_color, metallic, roughness, base_color_texture, texture_info_json, material_json});
   return static_cast<int>(materials_.size()) - 1;
 }
 
 int GltfBuilder::add_mesh(const std::string& name, const std::vector<Eigen::Vector3f>& positions,
-                          const std::vector<std::array<unsigned, 3>>& triangles, int material) {
-  meshes_.push_back({name, positions, triangles, material});
+                          const std::vector<std::array<unsigned, 3>>& triangles, int material,
+                          const std::vector<Eigen::Vector2f>& uvs) {
+  meshes_.push_back({name, positions, triangles, material, uvs});
   return static_cast<int>(meshes_.size()) - 1;
 }
 
@@ -57,18 +68,37 @@ std::string GltfBuilder::glb() const {
                          {"type", "SCALAR"},
                          {"min", {0}},
                          {"max", {max_index}}});
-    json prim = {{"attributes", {{"POSITION", position_accessor}}},
-                 {"indices", static_cast<int>(accessors.size()) - 1},
-                 {"mode", 4}};
+    const int index_accessor = static_cast<int>(accessors.size()) - 1;
+    json attributes = {{"POSITION", position_accessor}};
+    if (!m.uvs.empty()) {
+      const int tv = append(m.uvs.data(), m.uvs.size() * sizeof(Eigen::Vector2f), 34962);
+      accessors.push_back({{"bufferView", tv}, {"componentType", 5126}, {"count", m.uvs.size()}, {"type", "VEC2"}});
+      attributes["TEXCOORD_0"] = static_cast<int>(accessors.size()) - 1;
+    }
+    json prim = {{"attributes", attributes}, {"indices", index_accessor}, {"mode", 4}};
     if (m.material >= 0) prim["material"] = m.material;
     meshes.push_back({{"name", m.name}, {"primitives", json::array({prim})}});
   }
   for (const Material& m : materials_) {
-    materials.push_back({{"name", m.name},
-                         {"pbrMetallicRoughness",
-                          {{"baseColorFactor", {m.color[0], m.color[1], m.color[2], m.color[3]}},
-                           {"metallicFactor", m.metallic},
-                           {"roughnessFactor", m.roughness}}}});
+    json pbr = {{"baseColorFactor", {m.color[0], m.color[1], m.color[2], m.color[3]}},
+                {"metallicFactor", m.metallic},
+                {"roughnessFactor", m.roughness}};
+    if (m.texture >= 0) {
+      json info = {{"index", m.texture}};
+      info.merge_patch(json::parse(m.texture_info_json));
+      pbr["baseColorTexture"] = info;
+    }
+    json material = {{"name", m.name}, {"pbrMetallicRoughness", pbr}};
+    material.merge_patch(json::parse(m.material_json));
+    materials.push_back(material);
+  }
+  json images = json::array(), samplers = json::array(), textures = json::array();
+  for (std::size_t i = 0; i < textures_.size(); ++i) {
+    const int view = append(textures_[i].bytes.data(), textures_[i].bytes.size(), 0);
+    buffer_views[static_cast<std::size_t>(view)].erase("target");
+    images.push_back({{"bufferView", view}, {"mimeType", "image/png"}});
+    samplers.push_back({{"wrapS", textures_[i].wrap}, {"wrapT", textures_[i].wrap}});
+    textures.push_back({{"source", i}, {"sampler", i}});
   }
   json scene_nodes = json::array();
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
@@ -87,6 +117,11 @@ std::string GltfBuilder::glb() const {
               {"bufferViews", buffer_views},
               {"buffers", {{{"byteLength", bin.size()}}}}};
   if (!materials.empty()) doc["materials"] = materials;
+  if (!textures.empty()) {
+    doc["images"] = images;
+    doc["samplers"] = samplers;
+    doc["textures"] = textures;
+  }
   std::string text = doc.dump();
   while (text.size() % 4) text.push_back(' ');
 
@@ -157,6 +192,27 @@ GltfBuilder make_hammer() {
   cylinder_geometry(0.015f, 0.f, 0.30f, 24, p, t);
   g.add_node(g.add_mesh("handle", p, t, oak));
   return g;
+}
+
+void quad_geometry(float x0, float y0, float x1, float y1, float z, std::vector<Eigen::Vector3f>& positions,
+                   std::vector<std::array<unsigned, 3>>& triangles, std::vector<Eigen::Vector2f>& uvs) {
+  const unsigned b = static_cast<unsigned>(positions.size());
+  positions.insert(positions.end(), {{x0, y1, z}, {x1, y1, z}, {x1, y0, z}, {x0, y0, z}});
+  uvs.insert(uvs.end(), {{0.f, 0.f}, {1.f, 0.f}, {1.f, 1.f}, {0.f, 1.f}});
+  triangles.push_back({b + 0, b + 3, b + 2});  // counter-clockwise seen from +Z
+  triangles.push_back({b + 0, b + 2, b + 1});
+}
+
+std::string png_bytes(int width, int height, const std::function<std::array<std::uint8_t, 4>(int, int)>& pixel) {
+  ImageU8 image(width, height, 4);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const auto p = pixel(x, y);
+      for (int c = 0; c < 4; ++c) image.at(x, y, c) = p[static_cast<std::size_t>(c)];
+    }
+  const std::string path = scratch_dir("png_bytes_" + std::to_string(::getpid())) + "/image.png";
+  EXPECT_TRUE(write_image(path, image).ok());
+  return read_file(path);
 }
 
 double signed_volume(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3i>& triangles) {

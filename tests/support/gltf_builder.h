@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -11,11 +13,21 @@ namespace g2p::test {
 
 class GltfBuilder {
  public:
-  // Returns the material index.
-  int add_material(const std::string& name, const Eigen::Vector4f& base_color, float metallic, float roughness);
-  // One mesh with one triangle-list primitive; returns the mesh index.
+  // An embedded image (PNG or JPEG bytes) with a sampler; returns the texture
+  // index. `wrap` is the glTF sampler code (10497 REPEAT, 33071 CLAMP_TO_EDGE).
+  int add_texture(const std::string& image_bytes, int wrap = 10497);
+  // Returns the material index. `base_color_texture` is a texture index or -1;
+  // `texture_info_json` is merged into its textureInfo (e.g. a
+  // KHR_texture_transform), `material_json` into the material (alphaMode,
+  // extensions, ...).
+  int add_material(const std::string& name, const Eigen::Vector4f& base_color, float metallic, float roughness,
+                   int base_color_texture = -1, const std::string& texture_info_json = "{}",
+                   const std::string& material_json = "{}");
+  // One mesh with one triangle-list primitive; returns the mesh index. `uvs`
+  // (TEXCOORD_0, glTF convention: (0, 0) = top-left of the image) may be empty.
   int add_mesh(const std::string& name, const std::vector<Eigen::Vector3f>& positions,
-               const std::vector<std::array<unsigned, 3>>& triangles, int material);
+               const std::vector<std::array<unsigned, 3>>& triangles, int material,
+               const std::vector<Eigen::Vector2f>& uvs = {});
   // A root node instancing `mesh`, with a translation and a scale.
   void add_node(int mesh, const Eigen::Vector3f& translation = Eigen::Vector3f::Zero(),
                 const Eigen::Vector3f& scale = Eigen::Vector3f::Ones());
@@ -30,6 +42,11 @@ class GltfBuilder {
     std::vector<Eigen::Vector3f> positions;
     std::vector<std::array<unsigned, 3>> triangles;
     int material;
+    std::vector<Eigen::Vector2f> uvs;
+  };
+  struct TextureData {
+    std::string bytes;
+    int wrap;
   };
   struct Node {
     int mesh;
@@ -39,8 +56,11 @@ class GltfBuilder {
     std::string name;
     Eigen::Vector4f color;
     float metallic, roughness;
+    int texture;
+    std::string texture_info_json, material_json;
   };
   std::vector<Material> materials_;
+  std::vector<TextureData> textures_;
   std::vector<MeshData> meshes_;
   std::vector<Node> nodes_;
 };
@@ -56,6 +76,15 @@ void cylinder_geometry(float radius, float y0, float y1, int segments, std::vect
 // The two-material "hammer": a metal box head on a wooden cylinder handle, in
 // glTF's Y-up metres. Material 0 "steel" (metallic), material 1 "oak".
 GltfBuilder make_hammer();
+
+// A flat rectangle with UVs covering the texture once: corners (x0, y0) and
+// (x1, y1) in the plane z = `z` (glTF axes), facing +Z; the top-left corner
+// (x0, y1) gets UV (0, 0).
+void quad_geometry(float x0, float y0, float x1, float y1, float z, std::vector<Eigen::Vector3f>& positions,
+                   std::vector<std::array<unsigned, 3>>& triangles, std::vector<Eigen::Vector2f>& uvs);
+
+// PNG bytes of an RGBA image made by `pixel(x, y)`.
+std::string png_bytes(int width, int height, const std::function<std::array<std::uint8_t, 4>(int, int)>& pixel);
 
 // Signed volume of a closed triangle mesh (divergence theorem); positive when
 // the triangles wind outward.

@@ -22,7 +22,7 @@ namespace g2p {
 // A pinhole or orthographic camera in OpenCV's convention: the camera looks
 // along its +z axis, x points right and y down in the image. Pixel (i, j)
 // covers [i, i+1) x [j, j+1); its centre is (i + 0.5, j + 0.5).
-struct Camera {
+struct G2P_API Camera {
   int width = 512;   // pixels
   int height = 512;  // pixels
   bool orthographic = false;

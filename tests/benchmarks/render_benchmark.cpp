@@ -1,0 +1,168 @@
+// Render throughput on a mesh of over a million triangles (SheenChair, each
+// triangle split into 4 three times: 2.56 M triangles), 11 default views at
+// 512x512, against a bare Embree primary-ray loop on the same scene and
+// cameras in the same run (one rtcIntersect1 per pixel, TBB tiles, no shading).
+// docs/performance.md records the figures and the command:
+//
+//   build/bin/g2p_render_benchmark --benchmark_min_time=2
+#include <benchmark/benchmark.h>
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <map>
+#include <memory>
+#include <unordered_map>
+
+#include "g2p/io.h"
+#include "g2p/render.h"
+
+namespace {
+
+// Splits every triangle into four at its edge midpoints (shared between neighbours).
+g2p::Mesh subdivide(const g2p::Mesh& in) {
+  g2p::Mesh out;
+  out.positions = in.positions;
+  out.uvs = in.uvs;
+  std::unordered_map<std::uint64_t, int> midpoints;
+  auto midpoint = [&](int a, int b) {
+    const std::uint64_t key =
+        (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+    auto [it, inserted] = midpoints.emplace(key, static_cast<int>(out.positions.size()));
+    if (inserted) {
+      out.positions.push_back(0.5f * (out.positions[a] + out.positions[b]));
+      if (!out.uvs.empty()) out.uvs.push_back(0.5f * (out.uvs[a] + out.uvs[b]));
+    }
+    return it->second;
+  };
+  for (std::size_t f = 0; f < in.triangles.size(); ++f) {
+    const Eigen::Vector3i& t = in.triangles[f];
+    const int ab = midpoint(t[0], t[1]), bc = midpoint(t[1], t[2]), ca = midpoint(t[2], t[0]);
+    for (const Eigen::Vector3i& s : {Eigen::Vector3i(t[0], ab, ca), Eigen::Vector3i(t[1], bc, ab),
+                                     Eigen::Vector3i(t[2], ca, bc), Eigen::Vector3i(ab, bc, ca)}) {
+      out.triangles.push_back(s);
+      if (!in.face_source.empty()) out.face_source.push_back(in.face_source[f]);
+    }
+  }
+  g2p::compute_vertex_normals(out);
+  return out;
+}
+
+struct Scene {
+  g2p::Model model;
+  std::vector<g2p::Camera> cameras;
+  double rays = 0;  // primary rays per pass over all cameras
+};
+
+const Scene& scene() {
+  static const Scene s = [] {
+    Scene sc;
+    g2p::Result<g2p::Model> m = g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/SheenChair/SheenChair.glb");
+    if (!m.ok()) throw std::runtime_error(m.status().to_string());
+    sc.model = std::move(*m);
+    for (int i = 0; i < 3; ++i) sc.model.mesh = subdivide(sc.model.mesh);
+    sc.cameras = *g2p::make_views(sc.model.mesh);
+    for (const g2p::Camera& c : sc.cameras) sc.rays += static_cast<double>(c.width) * c.height;
+    return sc;
+  }();
+  return s;
+}
+
+void report(benchmark::State& state) {
+  state.counters["Mrays/s"] =
+      benchmark::Counter(scene().rays * static_cast<double>(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
+  state.counters["triangles"] = static_cast<double>(scene().model.mesh.num_faces());
+}
+
+// The reference: Embree alone, same geometry, scene flags, tiles and rays.
+void BM_BareEmbreeLoop(benchmark::State& state) {
+  const Scene& s = scene();
+  RTCDevice device = rtcNewDevice(nullptr);
+  RTCScene rtc = rtcNewScene(device);
+  rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), s.model.mesh.positions.size()));
+  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(unsigned), s.model.mesh.triangles.size()));
+  for (std::size_t i = 0; i < s.model.mesh.positions.size(); ++i)
+    for (int k = 0; k < 3; ++k) v[3 * i + k] = s.model.mesh.positions[i][k];
+  for (std::size_t i = 0; i < s.model.mesh.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) idx[3 * i + k] = static_cast<unsigned>(s.model.mesh.triangles[i][k]);
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(rtc, g);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(rtc);
+
+  std::vector<int> ids;
+  for (auto _ : state) {
+    for (const g2p::Camera& cam : s.cameras) {
+      ids.assign(static_cast<std::size_t>(cam.width) * cam.height, -1);
+      tbb::parallel_for(tbb::blocked_range2d<int>(0, cam.height, 32, 0, cam.width, 32),
+                        [&](const tbb::blocked_range2d<int>& r) {
+                          RTCIntersectContext ctx;
+                          rtcInitIntersectContext(&ctx);
+                          ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                          for (int y = r.rows().begin(); y != r.rows().end(); ++y) {
+                            for (int x = r.cols().begin(); x != r.cols().end(); ++x) {
+                              Eigen::Vector3d o, d;
+                              cam.ray(x + 0.5, y + 0.5, o, d);
+                              alignas(16) RTCRayHit rh{};
+                              rh.ray.org_x = static_cast<float>(o.x());
+                              rh.ray.org_y = static_cast<float>(o.y());
+                              rh.ray.org_z = static_cast<float>(o.z());
+                              rh.ray.dir_x = static_cast<float>(d.x());
+                              rh.ray.dir_y = static_cast<float>(d.y());
+                              rh.ray.dir_z = static_cast<float>(d.z());
+                              rh.ray.tfar = std::numeric_limits<float>::infinity();
+                              rh.ray.mask = 0xFFFFFFFFu;
+                              rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                              rtcIntersect1(rtc, &ctx, &rh);
+                              ids[static_cast<std::size_t>(y) * cam.width + x] =
+                                  rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? -1 : static_cast<int>(rh.hit.primID);
+                            }
+                          }
+                        });
+      benchmark::DoNotOptimize(ids.data());
+    }
+  }
+  report(state);
+  rtcReleaseScene(rtc);
+  rtcReleaseDevice(device);
+}
+
+void run_pass(benchmark::State& state, const g2p::RenderOptions& options) {
+  const Scene& s = scene();
+  std::unique_ptr<g2p::Renderer> renderer = std::move(*g2p::renderer_registry().create("embree"));
+  if (g2p::Status st = renderer->set_model(s.model); !st.ok()) state.SkipWithError(st.message().c_str());
+  for (auto _ : state) {
+    for (const g2p::Camera& cam : s.cameras) {
+      g2p::Result<g2p::View> view = renderer->render(cam, options);
+      benchmark::DoNotOptimize(view);
+    }
+  }
+  report(state);
+}
+
+void BM_FaceIdPass(benchmark::State& state) {
+  g2p::RenderOptions o;
+  o.shade = o.material_buffers = o.geometry_buffers = false;
+  run_pass(state, o);
+}
+
+void BM_FullPass(benchmark::State& state) { run_pass(state, g2p::RenderOptions{}); }
+
+void BM_SceneBuild(benchmark::State& state) {
+  std::unique_ptr<g2p::Renderer> renderer = std::move(*g2p::renderer_registry().create("embree"));
+  for (auto _ : state) benchmark::DoNotOptimize(renderer->set_model(scene().model));
+  state.counters["triangles"] = static_cast<double>(scene().model.mesh.num_faces());
+}
+
+BENCHMARK(BM_BareEmbreeLoop)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FaceIdPass)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FullPass)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SceneBuild)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -299,6 +299,34 @@ TEST(EmbreeRenderer, DeterministicAndBuffersConsistent) {
   }
 }
 
+TEST(EmbreeRenderer, RenderIntoReusesAViewWithoutChangingTheResult) {
+  Result<Model> model = load_model(test::asset_path("SheenChair"));
+  ASSERT_TRUE(model.ok());
+  auto renderer = embree();
+  ASSERT_TRUE(renderer->set_model(*model).ok());
+  ViewOptions vo;
+  vo.width = 80;
+  vo.height = 64;
+  const std::vector<Camera> cams = *make_views(model->mesh, vo);
+  View reused;
+  for (const Camera& cam : {cams[3], cams[0]}) {
+    ASSERT_TRUE(renderer->render_into(cam, {}, reused).ok());
+    Result<View> fresh = renderer->render(cam);
+    ASSERT_TRUE(fresh.ok());
+    EXPECT_EQ(reused.rgb, fresh->rgb);
+    EXPECT_EQ(reused.face_id, fresh->face_id);
+    EXPECT_EQ(reused.base_color, fresh->base_color);
+    EXPECT_EQ(reused.depth, fresh->depth);
+  }
+  RenderOptions ids_only;
+  ids_only.shade = ids_only.material_buffers = ids_only.geometry_buffers = false;
+  ASSERT_TRUE(renderer->render_into(cams[1], ids_only, reused).ok());
+  EXPECT_TRUE(reused.rgb.empty());  // buffers not asked for are emptied, never stale
+  EXPECT_TRUE(reused.depth.empty());
+  EXPECT_TRUE(reused.base_color.empty());
+  EXPECT_EQ(reused.face_id.width(), 80);
+}
+
 TEST(EmbreeRenderer, ErrorsAreReported) {
   auto renderer = embree();
   EXPECT_EQ(renderer->render(Camera()).status().code(), StatusCode::kInvalidArgument);  // no model yet

@@ -25,6 +25,19 @@ class Image {
     assert(width >= 0 && height >= 0 && channels >= 1);
   }
 
+  // Gives the image a new shape, every value `fill`, reusing the storage it
+  // already has when large enough (no fresh memory for repeated renders).
+  void reset(int width, int height, int channels, T fill = T{}) {
+    assert(width >= 0 && height >= 0 && channels >= 1);
+    width_ = width, height_ = height, channels_ = channels;
+    data_.assign(static_cast<std::size_t>(width) * height * channels, fill);
+  }
+  // Empties the image (keeps the storage for a later reset).
+  void clear() {
+    width_ = height_ = channels_ = 0;
+    data_.clear();
+  }
+
   int width() const { return width_; }
   int height() const { return height_; }
   int channels() const { return channels_; }

@@ -96,14 +96,20 @@ struct View {
 };
 
 // The render stage's interface. set_model prepares a model (acceleration
-// structures); render draws one view of it. The model must stay alive and
-// unchanged while the renderer uses it. render() is const and may be called
-// from several threads at once.
+// structures); render_into draws one view of it. The model must stay alive and
+// unchanged while the renderer uses it. Rendering is const and may run on
+// several threads at once (each with its own View).
 class G2P_API Renderer {
  public:
   virtual ~Renderer();
   virtual Status set_model(const Model& model) = 0;
-  virtual Result<View> render(const Camera& camera, const RenderOptions& options = {}) const = 0;
+  // Renders into `view`, reusing the memory its buffers already hold: a loop
+  // over many cameras with one View allocates nothing after the first.
+  // Buffers the options do not ask for are emptied.
+  virtual Status render_into(const Camera& camera, const RenderOptions& options, View& view) const = 0;
+
+  // Convenience: renders into a new View.
+  Result<View> render(const Camera& camera, const RenderOptions& options = {}) const;
 };
 
 // Backends by name; libg2p registers "embree" (the default).

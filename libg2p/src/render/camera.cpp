@@ -52,6 +52,12 @@ std::vector<Eigen::Vector3d> layout_directions(const ViewOptions& o) {
 
 Renderer::~Renderer() = default;
 
+Result<View> Renderer::render(const Camera& camera, const RenderOptions& options) const {
+  View view;
+  G2P_RETURN_IF_ERROR(render_into(camera, options, view));
+  return view;
+}
+
 Camera Camera::look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up, int width,
                        int height, double fov_y_deg) {
   Camera c;

@@ -31,7 +31,7 @@ class EmbreeRenderer final : public Renderer {
   }
 
   Status set_model(const Model& model) override;
-  Result<View> render(const Camera& camera, const RenderOptions& options) const override;
+  Status render_into(const Camera& camera, const RenderOptions& options, View& view) const override;
 
  private:
   struct Hit {
@@ -186,26 +186,27 @@ Status EmbreeRenderer::set_model(const Model& model) {
   return Status::Ok();
 }
 
-Result<View> EmbreeRenderer::render(const Camera& camera, const RenderOptions& options) const {
+Status EmbreeRenderer::render_into(const Camera& camera, const RenderOptions& options, View& view) const {
   if (scene_ == nullptr) return Status::InvalidArgument("render: set_model() first");
   G2P_RETURN_IF_ERROR(camera.validate().with_context("render"));
   if (options.tile_size < 1 || options.max_layers < 1)
     return Status::InvalidArgument("render: tile_size and max_layers must be >= 1");
 
   const int w = camera.width, h = camera.height;
-  View view;
   view.camera = camera;
-  view.face_id = ImageI32(w, h, 1, -1);
-  if (options.shade) view.rgb = ImageU8(w, h, 3);
-  if (options.geometry_buffers) {
-    view.depth = ImageF(w, h, 1, kInfinity);
-    view.normal = ImageF(w, h, 3, 0.f);
-  }
-  if (options.material_buffers) {
-    view.base_color = ImageF(w, h, 4, 0.f);
-    view.metallic_roughness = ImageF(w, h, 2, 0.f);
-    view.transmission = ImageF(w, h, 1, 0.f);
-  }
+  view.face_id.reset(w, h, 1, -1);
+  auto prepare = [&](auto& image, bool wanted, int channels, auto fill) {
+    if (wanted)
+      image.reset(w, h, channels, fill);
+    else
+      image.clear();
+  };
+  prepare(view.rgb, options.shade, 3, std::uint8_t{0});
+  prepare(view.depth, options.geometry_buffers, 1, kInfinity);
+  prepare(view.normal, options.geometry_buffers, 3, 0.f);
+  prepare(view.base_color, options.material_buffers, 4, 0.f);
+  prepare(view.metallic_roughness, options.material_buffers, 2, 0.f);
+  prepare(view.transmission, options.material_buffers, 1, 0.f);
   const bool first_hit_details = options.geometry_buffers || options.material_buffers;
   const Eigen::Vector3f background(detail::srgb_to_linear(options.background[0] / 255.f),
                                    detail::srgb_to_linear(options.background[1] / 255.f),
@@ -267,7 +268,7 @@ Result<View> EmbreeRenderer::render(const Camera& camera, const RenderOptions& o
     }
   };
   tbb::parallel_for(tbb::blocked_range2d<int>(0, h, options.tile_size, 0, w, options.tile_size), render_tile);
-  return view;
+  return Status::Ok();
 }
 
 }  // namespace

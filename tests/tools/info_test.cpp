@@ -1,34 +1,20 @@
 // The g2p tool as a user runs it: exit codes, messages on stderr, JSON output.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "support/test_data.h"
+#include "support/tool_run.h"
 
 namespace g2p {
 namespace {
 
-struct ToolRun {
-  int exit_code;
-  std::string out, err;
-};
-
-// Runs the g2p tool with `args` (already shell-quoted), capturing both streams.
-ToolRun run_tool(const std::string& args) {
-  static int counter = 0;  // ctest runs tests in parallel processes: one folder per run
-  const std::string dir = test::scratch_dir("tool_run_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
-  const std::string cmd = std::string("'") + G2P_TEST_TOOL + "' " + args + " >'" + dir + "/out' 2>'" + dir + "/err'";
-  const int status = std::system(cmd.c_str());
-  ToolRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, test::read_file(dir + "/out"), test::read_file(dir + "/err")};
-  return r;
-}
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+using test::quote;
+using test::run_tool;
+using test::ToolRun;
 
 TEST(ToolInfo, PrintsMeshesFacesMaterialsAndBounds) {
   ToolRun r = run_tool("info " + quote(test::asset_path("SheenChair")));

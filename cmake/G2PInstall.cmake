@@ -24,7 +24,7 @@ if(BUILD_SHARED_LIBS)
   set(G2P_STATIC_DEPENDENCIES "")
 else()
   set(G2P_STATIC_DEPENDENCIES
-      "find_dependency(assimp)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(OpenCV COMPONENTS core imgproc imgcodecs)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)")
+      "find_dependency(assimp)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(OpenCV COMPONENTS core imgproc imgcodecs dnn)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)")
 endif()
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/g2pConfig.cmake.in

@@ -29,7 +29,7 @@ extra=(
   assimp-testmodels
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   liburdfdom-tools libcpp-httplib-dev
-  pybind11-dev python3-dev python3-numpy
+  pybind11-dev python3-dev python3-numpy python3-onnx
 )
 
 pkgs=("${core[@]}")

@@ -42,4 +42,85 @@ Result<Model> load_with_flags(const std::string& command, const std::string& pat
   return model;
 }
 
+void add_view_flags(CLI::App* cmd, ViewArgs& args) {
+  cmd->add_option("--views", args.views, "Number of views (default 11, as in the paper)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--resolution", args.resolution, "Image width and height in pixels (default 512)")
+      ->check(CLI::Range(16, 8192));
+  cmd->add_option("--layout", args.layout, "View layout: sphere (poles and two rings), fibonacci, turntable")
+      ->transform(CLI::IsMember({"sphere", "fibonacci", "turntable"}, CLI::ignore_case));
+  cmd->add_option("--fov", args.fov, "Vertical field of view in degrees (default 40)")->check(CLI::Range(5.0, 150.0));
+  cmd->add_flag("--ortho", args.ortho, "Orthographic projection");
+  cmd->add_option("--renderer", args.renderer, "Render backend (default embree)");
+}
+
+Result<ViewOptions> view_options(const ViewArgs& args) {
+  static const std::map<std::string, ViewLayout> kLayouts = {
+      {"sphere", ViewLayout::kSphere}, {"fibonacci", ViewLayout::kFibonacci}, {"turntable", ViewLayout::kTurntable}};
+  ViewOptions o;
+  o.num_views = args.views;
+  o.width = o.height = args.resolution;
+  const auto layout = kLayouts.find(args.layout);
+  if (layout == kLayouts.end()) return Status::InvalidArgument("unknown layout '" + args.layout + "'");
+  o.layout = layout->second;
+  o.fov_y_deg = args.fov;
+  o.orthographic = args.ortho;
+  return o;
+}
+
+Result<std::vector<View>> render_with_flags(const std::string& command, const Model& model, const ViewArgs& args,
+                                            int& exit_code) {
+  auto fail = [&](const Status& s, int code) -> Result<std::vector<View>> {
+    std::cerr << "g2p " << command << ": " << (code == kExitUsage ? s.message() : "error: " + s.to_string()) << "\n";
+    exit_code = code;
+    return s;
+  };
+  Result<ViewOptions> options = view_options(args);
+  if (!options.ok()) return fail(options.status(), kExitUsage);
+  Result<std::vector<Camera>> cameras = make_views(model.mesh, *options);
+  if (!cameras.ok()) return fail(cameras.status(), kExitUsage);
+  Result<std::unique_ptr<Renderer>> renderer = renderer_registry().create(args.renderer);
+  if (!renderer.ok()) return fail(renderer.status(), kExitUsage);
+  Result<std::vector<View>> views = render_views(**renderer, model, *cameras);
+  if (!views.ok()) return fail(views.status(), kExitFailure);
+  return views;
+}
+
+void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args) {
+  cmd->add_option("--segmenter", args.name, "Segmenter backend: pbr (default), onnx, oracle");
+  cmd->add_option("--set", args.settings,
+                  "Segmenter setting KEY=VALUE, repeatable (onnx: model_card=FILE; oracle: labels=FILE, key=NAME; "
+                  "pbr: names=on|off, temperature=T)");
+}
+
+Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,
+                                                       int& exit_code) {
+  BackendSettings settings;
+  for (const std::string& kv : args.settings) {
+    const std::size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      std::cerr << "g2p " << command << ": --set expects KEY=VALUE, got '" << kv << "'\n";
+      exit_code = kExitUsage;
+      return Status::InvalidArgument("bad --set");
+    }
+    settings[kv.substr(0, eq)] = kv.substr(eq + 1);
+  }
+  Result<std::unique_ptr<Segmenter>> s = make_segmenter(args.name, settings);
+  if (!s.ok()) {
+    const bool usage = s.status().code() == StatusCode::kInvalidArgument || s.status().code() == StatusCode::kNotFound;
+    std::cerr << "g2p " << command << ": " << (usage ? "" : "error: ") << s.status().message() << "\n";
+    exit_code = usage ? kExitUsage : kExitFailure;
+  }
+  return s;
+}
+
+Result<MaterialTable> load_table_flag(const std::string& command, const std::string& path, int& exit_code) {
+  if (path.empty()) return MaterialTable::paper_default();
+  Result<MaterialTable> t = MaterialTable::load(path);
+  if (!t.ok()) {
+    std::cerr << "g2p " << command << ": error: " << t.status().to_string() << "\n";
+    exit_code = kExitFailure;
+  }
+  return t;
+}
+
 }  // namespace g2p::cli

@@ -4,7 +4,13 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include <memory>
+#include <vector>
+
 #include "g2p/io.h"
+#include "g2p/materials.h"
+#include "g2p/render.h"
+#include "g2p/segment.h"
 
 namespace g2p::cli {
 
@@ -22,5 +28,35 @@ void add_import_flags(CLI::App* cmd, ImportArgs& args);
 // returns the exit code in `exit_code`.
 Result<Model> load_with_flags(const std::string& command, const std::string& path, const ImportArgs& args,
                               int& exit_code);
+
+// Which views to render: --views, --resolution, --layout, --fov, --ortho, --renderer.
+struct ViewArgs {
+  int views = 11;
+  int resolution = 512;
+  std::string layout = "sphere";
+  double fov = 40.0;
+  bool ortho = false;
+  std::string renderer = "embree";
+};
+
+void add_view_flags(CLI::App* cmd, ViewArgs& args);
+Result<ViewOptions> view_options(const ViewArgs& args);
+
+// Renders the model's views with the flags (full shading and buffers).
+Result<std::vector<View>> render_with_flags(const std::string& command, const Model& model, const ViewArgs& args,
+                                            int& exit_code);
+
+// Which segmenter: --segmenter NAME, --set KEY=VALUE (repeatable).
+struct SegmenterArgs {
+  std::string name = "pbr";
+  std::vector<std::string> settings;
+};
+
+void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args);
+Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,
+                                                       int& exit_code);
+
+// The material table of --materials ("" = the paper's default).
+Result<MaterialTable> load_table_flag(const std::string& command, const std::string& path, int& exit_code);
 
 }  // namespace g2p::cli

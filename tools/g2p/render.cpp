@@ -1,7 +1,6 @@
 // g2p render MODEL -o DIR: the render stage on its own.
 #include <chrono>
 #include <iostream>
-#include <map>
 #include <memory>
 
 #include "commands.h"
@@ -15,12 +14,7 @@ struct RenderArgs {
   std::string path;
   std::string out;
   ImportArgs import;
-  std::string renderer = "embree";
-  int views = 11;
-  int resolution = 512;
-  std::string layout = "sphere";
-  double fov = 40.0;
-  bool ortho = false;
+  ViewArgs views;
   bool buffers = false;
   bool benchmark = false;
 };
@@ -61,20 +55,17 @@ int run_render(const RenderArgs& args) {
   Result<Model> model = load_with_flags("render", args.path, args.import, exit_code);
   if (!model.ok()) return exit_code;
 
-  static const std::map<std::string, ViewLayout> kLayouts = {
-      {"sphere", ViewLayout::kSphere}, {"fibonacci", ViewLayout::kFibonacci}, {"turntable", ViewLayout::kTurntable}};
-  ViewOptions view_options;
-  view_options.num_views = args.views;
-  view_options.width = view_options.height = args.resolution;
-  view_options.layout = kLayouts.at(args.layout);
-  view_options.fov_y_deg = args.fov;
-  view_options.orthographic = args.ortho;
-  Result<std::vector<Camera>> cameras = make_views(model->mesh, view_options);
+  Result<ViewOptions> options = view_options(args.views);
+  if (!options.ok()) {
+    std::cerr << "g2p render: " << options.status().message() << "\n";
+    return kExitUsage;
+  }
+  Result<std::vector<Camera>> cameras = make_views(model->mesh, *options);
   if (!cameras.ok()) {
     std::cerr << "g2p render: " << cameras.status().message() << "\n";
     return kExitUsage;
   }
-  Result<std::unique_ptr<Renderer>> renderer = renderer_registry().create(args.renderer);
+  Result<std::unique_ptr<Renderer>> renderer = renderer_registry().create(args.views.renderer);
   if (!renderer.ok()) {
     std::cerr << "g2p render: " << renderer.status().message() << "\n";
     return kExitUsage;
@@ -105,8 +96,8 @@ int run_render(const RenderArgs& args) {
     return kExitFailure;
   }
   std::cout << "rendered " << views.size() << " views of " << model->mesh.num_faces() << " triangles at "
-            << args.resolution << "x" << args.resolution << " in " << seconds_since(start) << " s -> " << args.out
-            << "\n";
+            << args.views.resolution << "x" << args.views.resolution << " in " << seconds_since(start) << " s -> "
+            << args.out << "\n";
   return kExitOk;
 }
 
@@ -117,16 +108,9 @@ void add_render_command(CLI::App& app, Command& run) {
   CLI::App* cmd = app.add_subcommand("render", "Render a model from several views: RGB, face IDs, cameras, buffers");
   cmd->add_option("model", args->path, "Model file")->required();
   cmd->add_option("-o,--output", args->out, "Output folder (created if needed)");
-  cmd->add_option("--views", args->views, "Number of views (default 11, as in the paper)")->check(CLI::Range(1, 1000));
-  cmd->add_option("--resolution", args->resolution, "Image width and height in pixels (default 512)")
-      ->check(CLI::Range(16, 8192));
-  cmd->add_option("--layout", args->layout, "View layout: sphere (poles and two rings), fibonacci, turntable")
-      ->transform(CLI::IsMember({"sphere", "fibonacci", "turntable"}, CLI::ignore_case));
-  cmd->add_option("--fov", args->fov, "Vertical field of view in degrees (default 40)")->check(CLI::Range(5.0, 150.0));
-  cmd->add_flag("--ortho", args->ortho, "Orthographic projection");
+  add_view_flags(cmd, args->views);
   cmd->add_flag("--buffers", args->buffers,
                 "Also write depth (.npy), normal, base colour, metallic-roughness and transmission images");
-  cmd->add_option("--renderer", args->renderer, "Render backend (default embree)");
   cmd->add_flag("--benchmark", args->benchmark, "Time the face-ID and full passes instead of writing files");
   add_import_flags(cmd, args->import);
   cmd->callback([args, cmd, &run] {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "g2p/export.h"
 #include "g2p/image.h"
 #include "g2p/mesh.h"
 
@@ -83,5 +84,11 @@ struct Model {
     return m >= 0 && m < static_cast<int>(materials.size()) ? materials[static_cast<std::size_t>(m)].name : kNone;
   }
 };
+
+// Replaces every name the model carries (materials, meshes, nodes, external
+// texture file names) by a meaningless one ("material_3", "mesh_1"), as
+// image-to-3D generators emit them. For measuring what a segmenter does
+// without names; geometry, provenance indices and textures are unchanged.
+G2P_API void anonymize_names(Model& model);
 
 }  // namespace g2p

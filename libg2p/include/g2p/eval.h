@@ -1,0 +1,53 @@
+// eval: accuracy of material segmentation, as the paper measures it (after
+// Cityscapes and MMSegmentation): one confusion matrix aggregated over a whole
+// set, IoU per class = TP / (TP + FP + FN), mIoU = the unweighted mean over
+// the classes present in the ground truth. Void (kUnknownLabel) ground truth
+// is left out; an unknown prediction on a labelled pixel counts against the
+// true class (a false negative) and for no other.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "g2p/export.h"
+#include "g2p/image.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+class G2P_API ConfusionMatrix {
+ public:
+  explicit ConfusionMatrix(int num_classes = 0);
+
+  int num_classes() const { return num_classes_; }
+
+  // One sample (a pixel, or a face weighted by its area). Labels outside
+  // [0, num_classes) other than kUnknownLabel are ignored.
+  void add(int truth, int predicted, double weight = 1.0);
+  // Every pixel of two label images of one size (InvalidArgument otherwise).
+  Status add(const ImageI32& truth, const ImageI32& predicted);
+  // Every face, weighted by its area in m^2.
+  Status add_faces(const Mesh& mesh, const std::vector<int>& truth, const std::vector<int>& predicted);
+  void merge(const ConfusionMatrix& other);
+
+  // Weight with ground truth `truth` predicted as `predicted` (kUnknownLabel allowed).
+  double count(int truth, int predicted) const;
+  bool present(int c) const;  // the class occurs in the ground truth
+  double iou(int c) const;    // NaN when the class is neither true nor predicted anywhere
+  double mean_iou() const;    // over present classes; NaN when none
+  double accuracy() const;    // correct weight / labelled weight
+  double total() const;       // labelled (non-void) weight
+
+  // A table like the paper's Table 2: IoU % per class present, then mIoU.
+  std::string table(const MaterialTable& table) const;
+  // {"classes": [...], "iou": {...}, "miou": ..., "accuracy": ..., "matrix": [[...]]}.
+  std::string to_json(const MaterialTable& table) const;
+
+ private:
+  int num_classes_;
+  std::vector<double> counts_;  // num_classes x (num_classes + 1): the last column is "unknown"
+};
+
+}  // namespace g2p

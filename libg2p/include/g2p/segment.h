@@ -1,0 +1,84 @@
+// segment: stage 2 of Gen2Physics. Every rendered pixel gets one of the
+// vocabulary's material classes (the paper: a fine-tuned ViT, whose weights
+// are not public). libg2p ships a weight-free default (`pbr`), runs any ONNX
+// segmentation model (`onnx`) and reads ground truth (`oracle`); researchers
+// register their own through segmenter_registry().
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "g2p/export.h"
+#include "g2p/image.h"
+#include "g2p/materials.h"
+#include "g2p/model.h"
+#include "g2p/registry.h"
+#include "g2p/render.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// Per-pixel material classes of one view.
+struct LabelMap {
+  ImageI32 labels;       // class index per pixel; kUnknownLabel for background and unknown
+  ImageF probabilities;  // one channel per class, summing to 1 on labelled pixels, 0 elsewhere;
+                         // empty when the backend gives no probabilities
+};
+
+// Backend settings, key = value (keys are documented per backend in docs/segment.md).
+using BackendSettings = std::map<std::string, std::string>;
+
+// The segment stage's interface.
+class G2P_API Segmenter {
+ public:
+  virtual ~Segmenter();
+  // Applies backend settings; the default accepts none. Unknown keys are errors.
+  virtual Status configure(const BackendSettings& settings);
+  // Prepares for the views of one model: the vocabulary to predict, and the
+  // model itself (source materials, names) for backends that use it. Both must
+  // outlive the segmenter's use of them.
+  virtual Status set_model(const Model& model, const MaterialTable& table) = 0;
+  // Labels one rendered view of that model: its RGB and, when present, its
+  // face IDs and material buffers. Reuses `out`'s memory.
+  virtual Status segment_into(const View& view, LabelMap& out) const = 0;
+
+  // Convenience: a new LabelMap.
+  Result<LabelMap> segment(const View& view) const;
+};
+
+// Backends by name: "pbr" (the default), "onnx", "oracle".
+G2P_API Registry<Segmenter>& segmenter_registry();
+
+// Creates a backend and applies its settings.
+G2P_API Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& name,
+                                                          const BackendSettings& settings = {});
+
+// ---- Ground truth -----------------------------------------------------------
+
+// Class label of every source material of `model` from a labels.json-style
+// file (../shared/assets/labels.json): {"models": {KEY: {"labels": {"0":
+// "Wood", ...}}}} or a bare {"labels": {...}}. "ignore" (void) and materials
+// without an entry map to kUnknownLabel; a class name not in `table` is an error.
+G2P_API Result<std::vector<int>> material_labels_from_json(const std::string& json_text, const std::string& key,
+                                                           const MaterialTable& table, int num_materials);
+
+// ---- Output -----------------------------------------------------------------
+
+// Labels as colours of the table (background and unknown in `background`).
+G2P_API ImageU8 colorize_labels(const ImageI32& labels, const MaterialTable& table,
+                                const std::array<std::uint8_t, 3>& background = {0, 0, 0});
+
+// A legend strip: one swatch and name per class.
+G2P_API ImageU8 label_legend(const MaterialTable& table, int width = 220);
+
+// Writes per view: view_XX_labels.png (colour-coded, with the legend beside
+// it), view_XX_labels_index.png (8-bit class index, 255 = unknown) and
+// view_XX_probs.npy (float32, height x width x classes) when there are
+// probabilities; plus legend.png and classes.json (names and colours).
+G2P_API Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& maps, const MaterialTable& table);
+
+}  // namespace g2p

@@ -1,0 +1,19 @@
+#include "g2p/model.h"
+
+namespace g2p {
+
+void anonymize_names(Model& model) {
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    SourceMaterial& m = model.materials[i];
+    m.name = "material_" + std::to_string(i);
+    for (Texture* t : {&m.base_color_texture, &m.metallic_roughness_texture})
+      if (!t->uri.empty() && t->uri[0] != '*') t->uri = "texture_" + std::to_string(i) + ".png";
+  }
+  for (SourcePrimitive& p : model.primitives) {
+    p.mesh_name = "mesh_" + std::to_string(p.mesh);
+    p.node_name = "node";
+  }
+  model.info.path = "model";
+}
+
+}  // namespace g2p

@@ -1,0 +1,140 @@
+// ConfusionMatrix: segmentation accuracy aggregated over a set.
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "g2p/eval.h"
+
+namespace g2p {
+
+ConfusionMatrix::ConfusionMatrix(int num_classes)
+    : num_classes_(std::max(0, num_classes)),
+      counts_(static_cast<std::size_t>(num_classes_) * static_cast<std::size_t>(num_classes_ + 1), 0.0) {}
+
+void ConfusionMatrix::add(int truth, int predicted, double weight) {
+  if (truth < 0 || truth >= num_classes_ || !(weight > 0.0)) return;         // void ground truth
+  if (predicted < 0 || predicted >= num_classes_) predicted = num_classes_;  // unknown
+  counts_[static_cast<std::size_t>(truth) * (num_classes_ + 1) + predicted] += weight;
+}
+
+Status ConfusionMatrix::add(const ImageI32& truth, const ImageI32& predicted) {
+  if (truth.width() != predicted.width() || truth.height() != predicted.height() || truth.channels() != 1 ||
+      predicted.channels() != 1)
+    return Status::InvalidArgument("confusion matrix: label images differ in size (" + std::to_string(truth.width()) +
+                                   "x" + std::to_string(truth.height()) + " vs " + std::to_string(predicted.width()) +
+                                   "x" + std::to_string(predicted.height()) + ")");
+  for (std::size_t i = 0; i < truth.size(); ++i) add(truth.data()[i], predicted.data()[i]);
+  return Status::Ok();
+}
+
+Status ConfusionMatrix::add_faces(const Mesh& mesh, const std::vector<int>& truth, const std::vector<int>& predicted) {
+  const std::size_t n = mesh.triangles.size();
+  if (truth.size() != n || predicted.size() != n)
+    return Status::InvalidArgument("confusion matrix: " + std::to_string(truth.size()) + " true and " +
+                                   std::to_string(predicted.size()) + " predicted face labels for " +
+                                   std::to_string(n) + " faces");
+  for (std::size_t f = 0; f < n; ++f) add(truth[f], predicted[f], face_area(mesh, static_cast<int>(f)));
+  return Status::Ok();
+}
+
+void ConfusionMatrix::merge(const ConfusionMatrix& other) {
+  if (other.num_classes_ != num_classes_) return;
+  for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += other.counts_[i];
+}
+
+double ConfusionMatrix::count(int truth, int predicted) const {
+  if (truth < 0 || truth >= num_classes_) return 0.0;
+  if (predicted < 0 || predicted >= num_classes_) predicted = num_classes_;
+  return counts_[static_cast<std::size_t>(truth) * (num_classes_ + 1) + predicted];
+}
+
+bool ConfusionMatrix::present(int c) const {
+  double row = 0.0;
+  for (int p = 0; p <= num_classes_; ++p) row += count(c, p == num_classes_ ? kUnknownLabel : p);
+  return row > 0.0;
+}
+
+double ConfusionMatrix::iou(int c) const {
+  if (c < 0 || c >= num_classes_) return std::numeric_limits<double>::quiet_NaN();
+  const double tp = count(c, c);
+  double fn = 0.0, fp = 0.0;
+  for (int p = 0; p <= num_classes_; ++p)
+    if (p != c) fn += count(c, p == num_classes_ ? kUnknownLabel : p);
+  for (int t = 0; t < num_classes_; ++t)
+    if (t != c) fp += count(t, c);
+  const double denominator = tp + fp + fn;
+  return denominator > 0.0 ? tp / denominator : std::numeric_limits<double>::quiet_NaN();
+}
+
+double ConfusionMatrix::mean_iou() const {
+  double sum = 0.0;
+  int n = 0;
+  for (int c = 0; c < num_classes_; ++c) {
+    if (!present(c)) continue;
+    sum += iou(c);
+    ++n;
+  }
+  return n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
+}
+
+double ConfusionMatrix::total() const {
+  double t = 0.0;
+  for (double v : counts_) t += v;
+  return t;
+}
+
+double ConfusionMatrix::accuracy() const {
+  double correct = 0.0;
+  for (int c = 0; c < num_classes_; ++c) correct += count(c, c);
+  const double t = total();
+  return t > 0.0 ? correct / t : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string ConfusionMatrix::table(const MaterialTable& table) const {
+  std::ostringstream header, values;
+  header << "|";
+  values << "|";
+  for (int c = 0; c < num_classes_; ++c) {
+    if (!present(c)) continue;
+    const std::string name = table.valid_label(c) ? table[c].name : "class " + std::to_string(c);
+    char cell[32];
+    std::snprintf(cell, sizeof(cell), " %6.2f |", 100.0 * iou(c));
+    header << " " << name << " |";
+    values << cell;
+  }
+  char miou[32];
+  std::snprintf(miou, sizeof(miou), " %6.2f |", 100.0 * mean_iou());
+  header << " mIoU |";
+  values << miou;
+  std::ostringstream out;
+  out << header.str() << "\n";
+  for (int c = 0; c <= num_classes_; ++c)
+    if (c == num_classes_ || present(c)) out << "|---";
+  out << "|\n" << values.str() << "\n";
+  return out.str();
+}
+
+std::string ConfusionMatrix::to_json(const MaterialTable& table) const {
+  using nlohmann::json;
+  json classes = json::array(), iou_json = json::object(), matrix = json::array();
+  for (int c = 0; c < num_classes_; ++c) {
+    const std::string name = table.valid_label(c) ? table[c].name : "class " + std::to_string(c);
+    classes.push_back(name);
+    if (present(c)) iou_json[name] = iou(c);
+    json row = json::array();
+    for (int p = 0; p <= num_classes_; ++p) row.push_back(count(c, p == num_classes_ ? kUnknownLabel : p));
+    matrix.push_back(row);
+  }
+  const double m = mean_iou(), a = accuracy();
+  json doc = {{"classes", classes},
+              {"iou", iou_json},
+              {"miou", std::isnan(m) ? json(nullptr) : json(m)},
+              {"accuracy", std::isnan(a) ? json(nullptr) : json(a)},
+              {"total_weight", total()},
+              {"matrix_rows_truth_columns_predicted_then_unknown", matrix}};
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace g2p

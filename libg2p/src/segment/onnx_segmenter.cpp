@@ -1,0 +1,205 @@
+// The `onnx` segmenter: any semantic-segmentation network exported to ONNX,
+// run with OpenCV's dnn module (CPU). A JSON model card says how to feed it
+// and how its output classes map onto the vocabulary (docs/segment.md):
+//
+//   {"format": "g2p-onnx-model-card", "version": 1,
+//    "model": "net.onnx",                       // relative to the card
+//    "input": {"width": 512, "height": 512, "channel_order": "RGB",
+//              "scale": 0.00392156862745098, "mean": [0.485, 0.456, 0.406],
+//              "std": [0.229, 0.224, 0.225], "name": "pixel_values"},
+//    "output": {"kind": "logits", "name": "logits"},   // or "probabilities"
+//    "classes": ["background", "Wood", "Metal", ...]}  // per output channel
+//
+// The view's RGB is resized to the input size, each channel becomes
+// (value * scale - mean) / std, and the NCHW output is resized back to the
+// view (bilinear), turned into probabilities (softmax for logits) and summed
+// per vocabulary class. Channels named "background", "ignore" or with no
+// class in the table are dropped; on object pixels the rest are renormalised,
+// background pixels (face ID -1) stay unknown.
+//
+// Settings: model_card = path of the card (required).
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "g2p/segment.h"
+#include "segment/backends.h"
+
+namespace g2p {
+namespace {
+
+using nlohmann::json;
+
+struct ModelCard {
+  std::string model_path;
+  int width = 0, height = 0;
+  bool bgr = false;
+  float scale = 1.f / 255.f;
+  cv::Scalar mean{0, 0, 0}, std{1, 1, 1};
+  std::string input_name, output_name;
+  bool logits = true;
+  std::vector<std::string> classes;
+};
+
+Result<ModelCard> read_card(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path + ": cannot open the model card");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const json doc = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded() || !doc.is_object()) return Status::ParseError(path + ": not a JSON object");
+  ModelCard card;
+  try {
+    card.model_path = doc.at("model").get<std::string>();
+    if (std::filesystem::path(card.model_path).is_relative())
+      card.model_path = (std::filesystem::path(path).parent_path() / card.model_path).string();
+    const json& input = doc.at("input");
+    card.width = input.at("width").get<int>();
+    card.height = input.at("height").get<int>();
+    const std::string order = input.value("channel_order", "RGB");
+    if (order != "RGB" && order != "BGR") return Status::ParseError(path + ": input.channel_order must be RGB or BGR");
+    card.bgr = order == "BGR";
+    card.scale = input.value("scale", 1.f / 255.f);
+    if (input.contains("mean")) {
+      const auto m = input.at("mean").get<std::vector<double>>();
+      if (m.size() != 3) return Status::ParseError(path + ": input.mean needs 3 values");
+      card.mean = cv::Scalar(m[0], m[1], m[2]);
+    }
+    if (input.contains("std")) {
+      const auto s = input.at("std").get<std::vector<double>>();
+      if (s.size() != 3 || s[0] <= 0 || s[1] <= 0 || s[2] <= 0)
+        return Status::ParseError(path + ": input.std needs 3 positive values");
+      card.std = cv::Scalar(s[0], s[1], s[2]);
+    }
+    card.input_name = input.value("name", "");
+    if (doc.contains("output")) {
+      const json& output = doc.at("output");
+      const std::string kind = output.value("kind", "logits");
+      if (kind != "logits" && kind != "probabilities")
+        return Status::ParseError(path + ": output.kind must be logits or probabilities");
+      card.logits = kind == "logits";
+      card.output_name = output.value("name", "");
+    }
+    card.classes = doc.at("classes").get<std::vector<std::string>>();
+  } catch (const json::exception& e) {
+    return Status::ParseError(path + ": " + e.what());
+  }
+  if (card.width < 8 || card.height < 8 || card.width > 8192 || card.height > 8192)
+    return Status::ParseError(path + ": input size outside 8..8192");
+  if (card.classes.empty()) return Status::ParseError(path + ": 'classes' is empty");
+  return card;
+}
+
+class OnnxSegmenter final : public Segmenter {
+ public:
+  Status configure(const BackendSettings& settings) override {
+    for (const auto& [k, v] : settings) {
+      if (k != "model_card") return Status::InvalidArgument("onnx: unknown setting '" + k + "' (known: model_card)");
+      Result<ModelCard> card = read_card(v);
+      if (!card.ok()) return card.status();
+      try {
+        net_ = cv::dnn::readNetFromONNX(card->model_path);
+      } catch (const cv::Exception& e) {
+        return Status::ParseError(card->model_path + ": OpenCV cannot load the ONNX model: " + e.what());
+      }
+      if (net_.empty()) return Status::ParseError(card->model_path + ": OpenCV loaded an empty network");
+      net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+      net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+      card_ = std::move(*card);
+    }
+    return Status::Ok();
+  }
+
+  Status set_model(const Model&, const MaterialTable& table) override {
+    if (card_.classes.empty()) return Status::InvalidArgument("onnx: needs the setting model_card=CARD.json");
+    num_classes_ = table.size();
+    channel_class_.clear();
+    bool any = false;
+    for (const std::string& name : card_.classes) {
+      channel_class_.push_back(name == "background" || name == "ignore" ? kUnknownLabel : table.find(name));
+      any |= channel_class_.back() != kUnknownLabel;
+    }
+    if (!any) return Status::InvalidArgument("onnx: no output class of the model card is in the material table");
+    return Status::Ok();
+  }
+
+  Status segment_into(const View& view, LabelMap& out) const override {
+    if (channel_class_.empty()) return Status::InvalidArgument("onnx: set_model() first");
+    const int w = view.face_id.width(), h = view.face_id.height();
+    if (view.rgb.width() != w || view.rgb.height() != h || view.rgb.channels() != 3)
+      return Status::InvalidArgument("onnx: the view needs an RGB image (render with shading on)");
+
+    cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.data()));
+    cv::Mat input;
+    cv::resize(rgb, input, cv::Size(card_.width, card_.height), 0, 0, cv::INTER_AREA);
+    if (card_.bgr) cv::cvtColor(input, input, cv::COLOR_RGB2BGR);
+    input.convertTo(input, CV_32FC3, card_.scale);
+    input = (input - card_.mean) / card_.std;
+    cv::Mat output;
+    try {
+      const cv::Mat blob = cv::dnn::blobFromImage(input);  // NCHW, no further scaling
+      std::lock_guard<std::mutex> lock(mutex_);            // cv::dnn::Net::forward is not const
+      net_.setInput(blob, card_.input_name);
+      output = net_.forward(card_.output_name).clone();
+    } catch (const cv::Exception& e) {
+      return Status::Internal(std::string("onnx: inference failed: ") + e.what());
+    }
+    if (output.dims != 4 || output.size[0] != 1 || output.size[1] != static_cast<int>(channel_class_.size()))
+      return Status::InvalidArgument("onnx: the network's output is not 1 x " + std::to_string(channel_class_.size()) +
+                                     " x H x W as the model card's classes say");
+    const int channels = output.size[1], oh = output.size[2], ow = output.size[3];
+
+    // Per output channel, resized to the view.
+    std::vector<cv::Mat> planes(static_cast<std::size_t>(channels));
+    for (int c = 0; c < channels; ++c) {
+      const cv::Mat plane(oh, ow, CV_32F, output.ptr<float>(0, c));
+      cv::resize(plane, planes[static_cast<std::size_t>(c)], cv::Size(w, h), 0, 0, cv::INTER_LINEAR);
+    }
+    out.labels.reset(w, h, 1, kUnknownLabel);
+    out.probabilities.reset(w, h, num_classes_, 0.f);
+    std::vector<float> p(static_cast<std::size_t>(channels));
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (view.face_id.at(x, y) < 0) continue;
+        float mx = -1e30f;
+        for (int c = 0; c < channels; ++c) mx = std::max(mx, p[c] = planes[c].at<float>(y, x));
+        if (card_.logits) {
+          for (int c = 0; c < channels; ++c) p[c] = std::exp(p[c] - mx);
+        }
+        float* q = out.probabilities.pixel(x, y);
+        float sum = 0.f;
+        for (int c = 0; c < channels; ++c) {
+          if (channel_class_[c] == kUnknownLabel) continue;
+          q[channel_class_[c]] += std::max(p[c], 0.f);
+          sum += std::max(p[c], 0.f);
+        }
+        if (!(sum > 0.f)) continue;
+        int best = 0;
+        for (int c = 0; c < num_classes_; ++c) {
+          q[c] /= sum;
+          if (q[c] > q[best]) best = c;
+        }
+        out.labels.at(x, y) = best;
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  ModelCard card_;
+  mutable cv::dnn::Net net_;
+  mutable std::mutex mutex_;
+  int num_classes_ = 0;
+  std::vector<int> channel_class_;  // per output channel: table class or kUnknownLabel
+};
+
+}  // namespace
+
+std::unique_ptr<Segmenter> make_onnx_segmenter() { return std::make_unique<OnnxSegmenter>(); }
+
+}  // namespace g2p

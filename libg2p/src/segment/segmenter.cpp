@@ -1,0 +1,38 @@
+// The Segmenter base class and the backend registry.
+#include "g2p/segment.h"
+#include "segment/backends.h"
+
+namespace g2p {
+
+Segmenter::~Segmenter() = default;
+
+Status Segmenter::configure(const BackendSettings& settings) {
+  if (settings.empty()) return Status::Ok();
+  return Status::InvalidArgument("this segmenter takes no settings (got '" + settings.begin()->first + "')");
+}
+
+Result<LabelMap> Segmenter::segment(const View& view) const {
+  LabelMap out;
+  G2P_RETURN_IF_ERROR(segment_into(view, out));
+  return out;
+}
+
+Registry<Segmenter>& segmenter_registry() {
+  static Registry<Segmenter>* registry = [] {
+    auto* r = new Registry<Segmenter>();  // never destroyed: usable during static destruction
+    (void)r->add("pbr", &make_pbr_segmenter);
+    (void)r->add("onnx", &make_onnx_segmenter);
+    (void)r->add("oracle", &make_oracle_segmenter);
+    return r;
+  }();
+  return *registry;
+}
+
+Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& name, const BackendSettings& settings) {
+  Result<std::unique_ptr<Segmenter>> s = segmenter_registry().create(name);
+  if (!s.ok()) return s.status();
+  G2P_RETURN_IF_ERROR((*s)->configure(settings));
+  return s;
+}
+
+}  // namespace g2p

@@ -1,0 +1,130 @@
+// g2p eval seg: segmentation accuracy over a labelled set of models, as the
+// paper's Table 2 (one confusion matrix over the set, IoU per class, mIoU).
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.h"
+#include "common.h"
+#include "g2p/eval.h"
+#include "g2p/segment.h"
+
+namespace g2p::cli {
+namespace {
+
+struct EvalArgs {
+  std::string assets;  // folder with labels.json and NAME/NAME.glb
+  std::vector<std::string> models;
+  ViewArgs views;
+  SegmenterArgs segmenter;
+  std::string materials;
+  bool anonymize = false;
+  std::string json_out;
+};
+
+int run_eval_seg(const EvalArgs& args) {
+  namespace fs = std::filesystem;
+  const std::string labels_path = (fs::path(args.assets) / "labels.json").string();
+  std::ifstream in(labels_path, std::ios::binary);
+  if (!in) {
+    std::cerr << "g2p eval seg: error: " << labels_path << ": cannot open (use --assets DIR)\n";
+    return kExitFailure;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  const nlohmann::json labels = nlohmann::json::parse(text.str(), nullptr, false);
+  if (labels.is_discarded() || !labels.contains("models") || !labels["models"].is_object()) {
+    std::cerr << "g2p eval seg: error: " << labels_path << ": expected {\"models\": {...}}\n";
+    return kExitFailure;
+  }
+  std::vector<std::string> keys = args.models;
+  if (keys.empty())
+    for (const auto& item : labels["models"].items()) keys.push_back(item.key());
+
+  int exit_code = kExitOk;
+  Result<MaterialTable> table = load_table_flag("eval seg", args.materials, exit_code);
+  if (!table.ok()) return exit_code;
+  Result<std::unique_ptr<Segmenter>> predictor = make_segmenter_flag("eval seg", args.segmenter, exit_code);
+  if (!predictor.ok()) return exit_code;
+
+  ConfusionMatrix total(table->size());
+  nlohmann::json per_model = nlohmann::json::object();
+  for (const std::string& key : keys) {
+    const std::string path = (fs::path(args.assets) / key / (key + ".glb")).string();
+    Result<Model> model = load_model(path);
+    if (!model.ok()) {
+      std::cerr << "g2p eval seg: error: " << model.status().to_string() << "\n";
+      return kExitFailure;
+    }
+    Result<std::unique_ptr<Segmenter>> oracle = make_segmenter("oracle", {{"labels", labels_path}, {"key", key}});
+    Status s = oracle.ok() ? (*oracle)->set_model(*model, *table) : oracle.status();
+    if (!s.ok()) {
+      std::cerr << "g2p eval seg: error: " << s.to_string() << "\n";
+      return kExitFailure;
+    }
+    if (args.anonymize) anonymize_names(*model);  // after the oracle: it reads indices, not names
+    Result<std::vector<View>> views = render_with_flags("eval seg", *model, args.views, exit_code);
+    if (!views.ok()) return exit_code;
+    if (s = (*predictor)->set_model(*model, *table); !s.ok()) {
+      std::cerr << "g2p eval seg: error: " << key << ": " << s.to_string() << "\n";
+      return kExitFailure;
+    }
+    ConfusionMatrix matrix(table->size());
+    LabelMap truth, predicted;
+    for (const View& v : *views) {
+      s = (*oracle)->segment_into(v, truth);
+      if (s.ok()) s = (*predictor)->segment_into(v, predicted);
+      if (s.ok()) s = matrix.add(truth.labels, predicted.labels);
+      if (!s.ok()) {
+        std::cerr << "g2p eval seg: error: " << key << ": " << s.to_string() << "\n";
+        return kExitFailure;
+      }
+    }
+    total.merge(matrix);
+    std::printf("%-28s pixels %9.0f  accuracy %6.2f %%  mIoU %6.2f %%\n", key.c_str(), matrix.total(),
+                100.0 * matrix.accuracy(), 100.0 * matrix.mean_iou());
+    per_model[key] = nlohmann::json::parse(matrix.to_json(*table));
+  }
+  std::cout << "\nAll " << keys.size() << " models, one confusion matrix (" << total.total()
+            << " labelled pixels), IoU %:\n"
+            << total.table(*table);
+  if (!args.json_out.empty()) {
+    const nlohmann::json doc = {{"segmenter", args.segmenter.name},
+                                {"anonymized_names", args.anonymize},
+                                {"views", args.views.views},
+                                {"resolution", args.views.resolution},
+                                {"total", nlohmann::json::parse(total.to_json(*table))},
+                                {"models", per_model}};
+    std::ofstream out(args.json_out, std::ios::binary | std::ios::trunc);
+    out << doc.dump(2) << "\n";
+    if (!out) {
+      std::cerr << "g2p eval seg: error: " << args.json_out << ": cannot write\n";
+      return kExitFailure;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_eval_command(CLI::App& app, Command& run) {
+  CLI::App* eval = app.add_subcommand("eval", "Measure accuracy against ground truth");
+  eval->require_subcommand(1);
+  auto args = std::make_shared<EvalArgs>();
+  CLI::App* seg = eval->add_subcommand("seg", "2D material segmentation accuracy (per pixel) over a labelled set");
+  seg->add_option("--assets", args->assets, "Folder with labels.json and NAME/NAME.glb (default ../shared/assets)")
+      ->default_val("../shared/assets");
+  seg->add_option("--models", args->models, "Only these models (keys of labels.json)")->delimiter(',');
+  seg->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
+  seg->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one before segmenting");
+  seg->add_option("--json", args->json_out, "Also write the results as JSON to this file");
+  add_view_flags(seg, args->views);
+  add_segmenter_flags(seg, args->segmenter);
+  seg->callback([args, &run] { run = [args] { return run_eval_seg(*args); }; });
+}
+
+}  // namespace g2p::cli

@@ -83,7 +83,8 @@ struct RenderOptions {
 };
 
 // One rendered view. Every buffer has the camera's size; background pixels
-// have face_id -1, depth +infinity and zero in the other buffers.
+// have face_id -1, the background colour in rgb, depth +infinity and zero in
+// the other buffers.
 struct View {
   Camera camera;
   ImageI32 face_id;           // index into Mesh::triangles of the first surface seen

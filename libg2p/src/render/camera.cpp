@@ -150,8 +150,7 @@ Result<std::vector<Camera>> make_views(const Mesh& mesh, const ViewOptions& o) {
   std::vector<Camera> cameras;
   for (const Eigen::Vector3d& d : layout_directions(o)) {
     // Straight up or down, +Y (the object's back) is up in the image.
-    const Eigen::Vector3d up =
-        std::abs(d.z()) > 0.999 ? Eigen::Vector3d(0, d.z() > 0 ? 1 : -1, 0) : Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d up = std::abs(d.z()) > 0.999 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
     const double eye_distance = o.orthographic ? 3.0 * radius : distance;
     Camera c = Camera::look_at(centre + eye_distance * d, centre, up, o.width, o.height, o.fov_y_deg);
     if (o.orthographic) {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 
 #include "backends.h"
 #include "shading.h"
@@ -128,6 +129,7 @@ class EmbreeRenderer final : public Renderer {
     m.roughness = 0.6f;
     return m;
   }();
+  std::mutex error_mutex_;
   std::string device_error_;
 };
 
@@ -138,8 +140,13 @@ Status EmbreeRenderer::set_model(const Model& model) {
     device_ = rtcNewDevice(nullptr);
     if (device_ == nullptr) return Status::Unavailable("render: Embree could not create a device");
     rtcSetDeviceErrorFunction(
-        device_, [](void* user, RTCError, const char* message) { *static_cast<std::string*>(user) = message; },
-        &device_error_);
+        device_,
+        [](void* user, RTCError, const char* message) {
+          auto* self = static_cast<EmbreeRenderer*>(user);
+          std::lock_guard<std::mutex> lock(self->error_mutex_);  // Embree may report from any thread
+          self->device_error_ = message;
+        },
+        this);
   }
   release_scene();
   device_error_.clear();
@@ -255,7 +262,9 @@ Status EmbreeRenderer::render_into(const Camera& camera, const RenderOptions& op
           const detail::ShadedColor lit = detail::shade(s, facing_normal(hit, to_viewer), to_viewer, camera_to_world);
           // Transmission leaves a faint body colour, keeps the highlights and
           // tints what is seen through it: glass reads as glass.
-          const float opacity = s.alpha * (1.f - 0.85f * s.transmission);
+          // The last layer allowed is treated as opaque rather than dropped.
+          const bool last = layer + 1 == options.max_layers;
+          const float opacity = last ? 1.f : s.alpha * (1.f - 0.85f * s.transmission);
           color += throughput.cwiseProduct(opacity * lit.diffuse + std::max(opacity, s.transmission) * lit.specular);
           const Eigen::Vector3f tint = Eigen::Vector3f::Ones() * (1.f - s.transmission) + s.base_color * s.transmission;
           throughput = throughput.cwiseProduct(tint) * (1.f - opacity);

@@ -1,0 +1,81 @@
+// ConfusionMatrix against hand-computed values.
+#include "g2p/eval.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+namespace g2p {
+namespace {
+
+// Three classes. Truth/prediction pairs (count):
+//   0->0 (5), 0->1 (1), 1->1 (3), 1->0 (2), 1->unknown (1), void->2 (4, ignored), 2 never occurs.
+ConfusionMatrix fixture() {
+  ConfusionMatrix m(3);
+  for (int i = 0; i < 5; ++i) m.add(0, 0);
+  m.add(0, 1);
+  for (int i = 0; i < 3; ++i) m.add(1, 1);
+  m.add(1, 0, 2.0);
+  m.add(1, kUnknownLabel);
+  for (int i = 0; i < 4; ++i) m.add(kUnknownLabel, 2);
+  return m;
+}
+
+TEST(ConfusionMatrix, HandComputedIoU) {
+  const ConfusionMatrix m = fixture();
+  // Class 0: TP 5, FP 2 (true 1), FN 1 -> 5/8. Class 1: TP 3, FP 1, FN 3 (2 as 0, 1 unknown) -> 3/7.
+  EXPECT_DOUBLE_EQ(m.iou(0), 5.0 / 8.0);
+  EXPECT_DOUBLE_EQ(m.iou(1), 3.0 / 7.0);
+  EXPECT_TRUE(std::isnan(m.iou(2)));  // neither true nor predicted on labelled pixels
+  EXPECT_TRUE(m.present(0));
+  EXPECT_FALSE(m.present(2));
+  EXPECT_DOUBLE_EQ(m.mean_iou(), (5.0 / 8.0 + 3.0 / 7.0) / 2.0);
+  EXPECT_DOUBLE_EQ(m.total(), 12.0);
+  EXPECT_DOUBLE_EQ(m.accuracy(), 8.0 / 12.0);
+  EXPECT_DOUBLE_EQ(m.count(1, kUnknownLabel), 1.0);
+}
+
+TEST(ConfusionMatrix, ImagesFacesAndMerging) {
+  ImageI32 truth(3, 1, 1), predicted(3, 1, 1);
+  truth.at(0, 0) = 0, truth.at(1, 0) = 1, truth.at(2, 0) = kUnknownLabel;
+  predicted.at(0, 0) = 0, predicted.at(1, 0) = 0, predicted.at(2, 0) = 1;
+  ConfusionMatrix m(2);
+  ASSERT_TRUE(m.add(truth, predicted).ok());
+  EXPECT_DOUBLE_EQ(m.iou(0), 0.5);
+  EXPECT_EQ(m.add(truth, ImageI32(2, 2, 1)).code(), StatusCode::kInvalidArgument);
+
+  // Faces weigh by area: a 2 m^2 and a 0.5 m^2 triangle.
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
+  mesh.triangles = {{0, 1, 2}, {3, 4, 5}};
+  ConfusionMatrix faces(2);
+  ASSERT_TRUE(faces.add_faces(mesh, {0, 1}, {0, 0}).ok());
+  EXPECT_DOUBLE_EQ(faces.count(0, 0), 2.0);
+  EXPECT_DOUBLE_EQ(faces.count(1, 0), 0.5);
+  EXPECT_DOUBLE_EQ(faces.iou(0), 2.0 / 2.5);
+  EXPECT_EQ(faces.add_faces(mesh, {0}, {0, 0}).code(), StatusCode::kInvalidArgument);
+
+  ConfusionMatrix sum(2);
+  sum.merge(m);
+  sum.merge(faces);
+  EXPECT_DOUBLE_EQ(sum.count(0, 0), 3.0);
+}
+
+TEST(ConfusionMatrix, TableAndJson) {
+  const MaterialTable& t = MaterialTable::paper_default();
+  ConfusionMatrix m(t.size());
+  m.add(t.find("Wood"), t.find("Wood"), 3);
+  m.add(t.find("Metal"), t.find("Wood"), 1);
+  const std::string table = m.table(t);
+  EXPECT_NE(table.find("| Wood | Metal | mIoU |"), std::string::npos) << table;
+  EXPECT_NE(table.find("75.00"), std::string::npos) << table;
+  EXPECT_NE(table.find("37.50"), std::string::npos) << table;  // (0.75 + 0) / 2
+  const nlohmann::json j = nlohmann::json::parse(m.to_json(t));
+  EXPECT_DOUBLE_EQ(j["iou"]["Wood"].get<double>(), 0.75);
+  EXPECT_DOUBLE_EQ(j["miou"].get<double>(), 0.375);
+  EXPECT_FALSE(j["iou"].contains("Glass"));
+}
+
+}  // namespace
+}  // namespace g2p

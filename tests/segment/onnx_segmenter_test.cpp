@@ -1,0 +1,83 @@
+// The `onnx` backend on a tiny network the test writes with python3-onnx
+// (make_tiny_onnx.py): each pixel's class is its strongest colour channel.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "g2p/segment.h"
+#include "segment/segment_fixtures.h"
+#include "support/test_data.h"
+#include "support/tool_run.h"
+
+namespace g2p {
+namespace {
+
+std::string make_model_dir() {
+  const std::string dir = test::scratch_dir("OnnxSegmenter.model");
+  const std::string cmd =
+      "/usr/bin/python3 " + test::quote(test::source_path("tests/segment/make_tiny_onnx.py")) + " " + test::quote(dir);
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << "writing the ONNX model needs Debian's python3-onnx "
+                                            "(scripts/install-deps.sh installs it)";
+  return dir;
+}
+
+// Red, green and blue boxes, matte and dielectric.
+Model rgb_boxes() {
+  return test::boxes({{"a", {1, 0, 0, 1}, 0.f, 1.f}, {"b", {0, 1, 0, 1}, 0.f, 1.f}, {"c", {0, 0, 1, 1}, 0.f, 1.f}},
+                     "OnnxSegmenter.boxes");
+}
+
+TEST(OnnxSegmenter, RunsTheNetworkAndMapsItsClasses) {
+  const std::string dir = make_model_dir();
+  const Model model = rgb_boxes();
+  const std::vector<View> views = test::render(model, 2, 96);
+  const MaterialTable& table = MaterialTable::paper_default();
+  for (const char* order : {"rgb", "bgr"}) {
+    Result<std::unique_ptr<Segmenter>> s =
+        make_segmenter("onnx", {{"model_card", dir + "/card_" + std::string(order) + ".json"}});
+    ASSERT_TRUE(s.ok()) << s.status().to_string();
+    ASSERT_TRUE((*s)->set_model(model, table).ok());
+    std::vector<LabelMap> maps(views.size());
+    for (std::size_t i = 0; i < views.size(); ++i) ASSERT_TRUE((*s)->segment_into(views[i], maps[i]).ok());
+    const bool bgr = std::string(order) == "bgr";
+    // Channel 0 of the network's input is red (RGB card) or blue (BGR card); its class is Wood.
+    EXPECT_EQ(test::majority_label(model, views, maps, 0), table.find(bgr ? "Glass" : "Wood")) << order;
+    EXPECT_EQ(test::majority_label(model, views, maps, 1), table.find("Metal")) << order;
+    EXPECT_EQ(test::majority_label(model, views, maps, 2), table.find(bgr ? "Wood" : "Glass")) << order;
+    // Background stays unknown; probabilities cover the three mapped classes only.
+    for (std::size_t i = 0; i < views[0].face_id.size(); ++i) {
+      if (views[0].face_id.data()[i] < 0) {
+        ASSERT_EQ(maps[0].labels.data()[i], kUnknownLabel);
+      } else {
+        const float* p = maps[0].probabilities.data() + 12 * i;
+        ASSERT_NEAR(p[table.find("Wood")] + p[table.find("Metal")] + p[table.find("Glass")], 1.f, 1e-5f);
+      }
+    }
+  }
+}
+
+TEST(OnnxSegmenter, ModelCardErrors) {
+  const std::string dir = make_model_dir();
+  EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/none.json"}}).status().code(), StatusCode::kNotFound);
+  test::write_file(dir + "/bad.json", R"({"model": "tiny_seg.onnx", "input": {"width": 32}, "classes": ["Wood"]})");
+  EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/bad.json"}}).status().code(), StatusCode::kParseError);
+  test::write_file(dir + "/missing_model.json",
+                   R"({"model": "nope.onnx", "input": {"width": 32, "height": 32}, "classes": ["Wood"]})");
+  EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/missing_model.json"}}).status().code(),
+            StatusCode::kParseError);
+  // The card promises two classes, the network gives three channels.
+  test::write_file(dir + "/two.json", R"({"model": "tiny_seg.onnx", "input": {"width": 32, "height": 32},
+                                          "classes": ["Wood", "Metal"]})");
+  auto two = std::move(*make_segmenter("onnx", {{"model_card", dir + "/two.json"}}));
+  const Model model = rgb_boxes();
+  ASSERT_TRUE(two->set_model(model, MaterialTable::paper_default()).ok());
+  const std::vector<View> views = test::render(model, 1, 32);
+  EXPECT_EQ(two->segment(views[0]).status().code(), StatusCode::kInvalidArgument);
+  // No card at all.
+  auto bare = std::move(*make_segmenter("onnx"));
+  EXPECT_EQ(bare->set_model(model, MaterialTable::paper_default()).code(), StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace g2p

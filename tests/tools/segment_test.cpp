@@ -1,0 +1,114 @@
+// g2p segment and g2p eval seg as a user runs them.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "g2p/io.h"
+#include "g2p/render.h"
+#include "g2p/segment.h"
+#include "support/gltf_builder.h"
+#include "support/test_data.h"
+#include "support/tool_run.h"
+
+namespace g2p {
+namespace {
+
+using test::quote;
+using test::run_tool;
+
+TEST(ToolSegment, WritesLabelMapsForEachBackend) {
+  const std::string dir = test::scratch_dir("ToolSegment.Backends");
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  test::write_file(dir + "/labels.json", R"({"labels": {"0": "Wood", "1": "Metal"}})");
+  for (const std::string& backend : {"pbr", "oracle"}) {
+    const std::string out = dir + "/" + backend;
+    const std::string set = backend == "oracle" ? " --set labels=" + quote(dir + "/labels.json") : "";
+    test::ToolRun r =
+        run_tool("segment " + hammer + " -o " + quote(out) + " --views 2 --resolution 48 --segmenter " + backend + set);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* f : {"view_00_labels.png", "view_01_labels_index.png", "view_01_probs.npy", "view_00_rgb.png",
+                          "legend.png", "classes.json", "cameras.json"})
+      EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << backend << ": " << f;
+  }
+  // Seen from below (view 1), the oracle labels the handle Wood and the head Metal.
+  Result<ImageU8> index = read_image(dir + "/oracle/view_01_labels_index.png");
+  ASSERT_TRUE(index.ok());
+  int wood = 0, metal = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x) {
+      wood += index->at(x, y, 0) == 0;
+      metal += index->at(x, y, 0) == 5;
+    }
+  EXPECT_GT(wood, 10);
+  EXPECT_GT(metal, 10);
+}
+
+TEST(ToolSegment, BadSegmenterArguments) {
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  test::ToolRun r = run_tool("segment " + hammer + " -o /tmp/x --segmenter segformer");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("known: pbr, onnx, oracle"), std::string::npos) << r.err;
+  EXPECT_EQ(run_tool("segment " + hammer + " -o /tmp/x --set nonsense").exit_code, 2);
+  EXPECT_EQ(run_tool("segment " + hammer + " -o /tmp/x --segmenter onnx").exit_code, 2);  // no model card
+}
+
+// The eval tool's mIoU equals one computed here from independently counted pixels.
+TEST(ToolEval, ReproducesAHandComputedMeanIoU) {
+  const std::string assets = test::scratch_dir("ToolEval.Assets");
+  // Two boxes of two materials; truth: Wood and Metal; "prediction": Wood for both.
+  test::GltfBuilder g;
+  std::vector<Eigen::Vector3f> p;
+  std::vector<std::array<unsigned, 3>> t;
+  test::box_geometry({0, 0, 0}, {1, 1, 1}, p, t);
+  g.add_node(g.add_mesh("a", p, t, g.add_material("a", {0.5f, 0.5f, 0.5f, 1}, 0, 0.5f)));
+  p.clear(), t.clear();
+  test::box_geometry({1.5f, 0, 0}, {2.5f, 0.6f, 0.8f}, p, t);
+  g.add_node(g.add_mesh("b", p, t, g.add_material("b", {0.5f, 0.5f, 0.5f, 1}, 0, 0.5f)));
+  std::filesystem::create_directories(assets + "/Boxes");
+  g.write(assets + "/Boxes/Boxes.glb");
+  test::write_file(assets + "/labels.json", R"({"models": {"Boxes": {"labels": {"0": "Wood", "1": "Metal"}}}})");
+  test::write_file(assets + "/predicted.json", R"({"models": {"Boxes": {"labels": {"0": "Wood", "1": "Wood"}}}})");
+
+  test::ToolRun r = run_tool("eval seg --assets " + quote(assets) + " --views 3 --resolution 40 --segmenter oracle " +
+                             "--set labels=" + quote(assets + "/predicted.json") + " --set key=Boxes --json " +
+                             quote(assets + "/result.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| Wood | Metal | mIoU |"), std::string::npos) << r.out;
+
+  // Count each box's pixels in the same views.
+  Result<Model> model = load_model(assets + "/Boxes/Boxes.glb");
+  ASSERT_TRUE(model.ok());
+  ViewOptions vo;
+  vo.num_views = 3;
+  vo.width = vo.height = 40;
+  auto renderer = std::move(*renderer_registry().create("embree"));
+  Result<std::vector<View>> views = render_views(*renderer, *model, *make_views(model->mesh, vo));
+  ASSERT_TRUE(views.ok());
+  double n_a = 0, n_b = 0;
+  for (const View& v : *views)
+    for (std::size_t i = 0; i < v.face_id.size(); ++i)
+      if (v.face_id.data()[i] >= 0) (model->mesh.face_source[v.face_id.data()[i]].material == 0 ? n_a : n_b) += 1;
+  ASSERT_GT(n_a, 0);
+  ASSERT_GT(n_b, 0);
+  // Wood: TP n_a, FP n_b -> n_a / (n_a + n_b). Metal: TP 0 -> 0. mIoU: the mean of the two.
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(assets + "/result.json"));
+  EXPECT_DOUBLE_EQ(j["total"]["iou"]["Wood"].get<double>(), n_a / (n_a + n_b));
+  EXPECT_DOUBLE_EQ(j["total"]["iou"]["Metal"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(j["total"]["miou"].get<double>(), 0.5 * n_a / (n_a + n_b));
+  EXPECT_DOUBLE_EQ(j["total"]["total_weight"].get<double>(), n_a + n_b);
+}
+
+TEST(ToolEval, SharedAssetsWithAndWithoutNames) {
+  for (const char* flag : {"", " --anonymize-names"}) {
+    test::ToolRun r = run_tool(std::string("eval seg --assets ") + quote(test::source_path("../shared/assets")) +
+                               " --views 2 --resolution 48 --models Avocado,SheenChair" + flag);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("SheenChair"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("mIoU"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(run_tool("eval seg --assets /nonexistent").exit_code, 1);
+}
+
+}  // namespace
+}  // namespace g2p

@@ -77,5 +77,18 @@ TEST(ConfusionMatrix, TableAndJson) {
   EXPECT_FALSE(j["iou"].contains("Glass"));
 }
 
+TEST(CalibrationBins, HandComputedEce) {
+  CalibrationBins bins(10);
+  // Bin [0.9, 1): confidence 0.95 x 4, 3 correct -> |0.75 - 0.95| weight 4.
+  for (int i = 0; i < 4; ++i) bins.add(0.95f, i < 3);
+  // Bin [0.5, 0.6): confidence 0.55 x 2, 1 correct -> |0.5 - 0.55| weight 2.
+  bins.add(0.55f, true);
+  bins.add(0.55f, false);
+  EXPECT_NEAR(bins.expected_calibration_error(), (4 * 0.2 + 2 * 0.05) / 6.0, 1e-6);
+  EXPECT_NEAR(bins.accuracy(), 4.0 / 6.0, 1e-12);
+  EXPECT_NEAR(bins.mean_confidence(), (4 * 0.95 + 2 * 0.55) / 6.0, 1e-6);
+  EXPECT_TRUE(std::isnan(CalibrationBins().expected_calibration_error()));
+}
+
 }  // namespace
 }  // namespace g2p

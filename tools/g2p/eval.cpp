@@ -52,6 +52,7 @@ int run_eval_seg(const EvalArgs& args) {
   if (!predictor.ok()) return exit_code;
 
   ConfusionMatrix total(table->size());
+  CalibrationBins calibration;
   nlohmann::json per_model = nlohmann::json::object();
   for (const std::string& key : keys) {
     const std::string path = (fs::path(args.assets) / key / (key + ".glb")).string();
@@ -79,6 +80,8 @@ int run_eval_seg(const EvalArgs& args) {
       s = (*oracle)->segment_into(v, truth);
       if (s.ok()) s = (*predictor)->segment_into(v, predicted);
       if (s.ok()) s = matrix.add(truth.labels, predicted.labels);
+      if (s.ok() && !predicted.probabilities.empty())
+        s = calibration.add(truth.labels, predicted.labels, predicted.probabilities);
       if (!s.ok()) {
         std::cerr << "g2p eval seg: error: " << key << ": " << s.to_string() << "\n";
         return kExitFailure;
@@ -92,12 +95,19 @@ int run_eval_seg(const EvalArgs& args) {
   std::cout << "\nAll " << keys.size() << " models, one confusion matrix (" << total.total()
             << " labelled pixels), IoU %:\n"
             << total.table(*table);
+  if (calibration.accuracy() == calibration.accuracy())  // has probabilities
+    std::printf("calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n", calibration.mean_confidence(),
+                calibration.accuracy(), calibration.expected_calibration_error());
   if (!args.json_out.empty()) {
     const nlohmann::json doc = {{"segmenter", args.segmenter.name},
                                 {"anonymized_names", args.anonymize},
                                 {"views", args.views.views},
                                 {"resolution", args.views.resolution},
                                 {"total", nlohmann::json::parse(total.to_json(*table))},
+                                {"calibration",
+                                 {{"ece", calibration.expected_calibration_error()},
+                                  {"mean_confidence", calibration.mean_confidence()},
+                                  {"accuracy", calibration.accuracy()}}},
                                 {"models", per_model}};
     std::ofstream out(args.json_out, std::ios::binary | std::ios::trunc);
     out << doc.dump(2) << "\n";

@@ -50,4 +50,24 @@ class G2P_API ConfusionMatrix {
   std::vector<double> counts_;  // num_classes x (num_classes + 1): the last column is "unknown"
 };
 
+// Calibration of predicted probabilities: how far the confidence of the top
+// class is from the accuracy it achieves. Expected calibration error (Guo et
+// al. 2017, "On Calibration of Modern Neural Networks"): samples are binned by
+// confidence; ECE = sum over bins of (bin weight / total) x |accuracy - mean
+// confidence|. 0 is perfect.
+class G2P_API CalibrationBins {
+ public:
+  explicit CalibrationBins(int bins = 10);
+  void add(float confidence, bool correct, double weight = 1.0);
+  // Every labelled pixel (truth not void) of a label map with probabilities.
+  Status add(const ImageI32& truth, const ImageI32& predicted, const ImageF& probabilities);
+  void merge(const CalibrationBins& other);
+  double expected_calibration_error() const;  // NaN when empty
+  double mean_confidence() const;
+  double accuracy() const;
+
+ private:
+  std::vector<double> weight_, confidence_, correct_;
+};
+
 }  // namespace g2p

@@ -1,4 +1,5 @@
 // ConfusionMatrix: segmentation accuracy aggregated over a set.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -135,6 +136,68 @@ std::string ConfusionMatrix::to_json(const MaterialTable& table) const {
               {"total_weight", total()},
               {"matrix_rows_truth_columns_predicted_then_unknown", matrix}};
   return doc.dump(2) + "\n";
+}
+
+}  // namespace g2p
+
+namespace g2p {
+
+CalibrationBins::CalibrationBins(int bins)
+    : weight_(static_cast<std::size_t>(std::max(1, bins)), 0.0), confidence_(weight_.size(), 0.0),
+      correct_(weight_.size(), 0.0) {}
+
+void CalibrationBins::add(float confidence, bool correct, double weight) {
+  if (!(weight > 0.0) || !std::isfinite(confidence)) return;
+  const float c = std::clamp(confidence, 0.f, 1.f);
+  const std::size_t bin = std::min(weight_.size() - 1, static_cast<std::size_t>(c * weight_.size()));
+  weight_[bin] += weight;
+  confidence_[bin] += weight * c;
+  correct_[bin] += correct ? weight : 0.0;
+}
+
+Status CalibrationBins::add(const ImageI32& truth, const ImageI32& predicted, const ImageF& probabilities) {
+  if (truth.width() != predicted.width() || truth.height() != predicted.height() ||
+      probabilities.width() != truth.width() || probabilities.height() != truth.height())
+    return Status::InvalidArgument("calibration: label images and probabilities differ in size");
+  for (int y = 0; y < truth.height(); ++y) {
+    for (int x = 0; x < truth.width(); ++x) {
+      const int t = truth.at(x, y), p = predicted.at(x, y);
+      if (t < 0) continue;
+      const float confidence = p >= 0 && p < probabilities.channels() ? probabilities.at(x, y, p) : 0.f;
+      add(confidence, t == p);
+    }
+  }
+  return Status::Ok();
+}
+
+void CalibrationBins::merge(const CalibrationBins& other) {
+  if (other.weight_.size() != weight_.size()) return;
+  for (std::size_t b = 0; b < weight_.size(); ++b) {
+    weight_[b] += other.weight_[b];
+    confidence_[b] += other.confidence_[b];
+    correct_[b] += other.correct_[b];
+  }
+}
+
+double CalibrationBins::expected_calibration_error() const {
+  double total = 0.0, ece = 0.0;
+  for (double w : weight_) total += w;
+  if (!(total > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t b = 0; b < weight_.size(); ++b)
+    if (weight_[b] > 0.0) ece += std::abs(correct_[b] - confidence_[b]) / total;
+  return ece;
+}
+
+double CalibrationBins::mean_confidence() const {
+  double total = 0.0, c = 0.0;
+  for (std::size_t b = 0; b < weight_.size(); ++b) total += weight_[b], c += confidence_[b];
+  return total > 0.0 ? c / total : std::numeric_limits<double>::quiet_NaN();
+}
+
+double CalibrationBins::accuracy() const {
+  double total = 0.0, c = 0.0;
+  for (std::size_t b = 0; b < weight_.size(); ++b) total += weight_[b], c += correct_[b];
+  return total > 0.0 ? c / total : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace g2p

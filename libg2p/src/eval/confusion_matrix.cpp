@@ -143,7 +143,8 @@ std::string ConfusionMatrix::to_json(const MaterialTable& table) const {
 namespace g2p {
 
 CalibrationBins::CalibrationBins(int bins)
-    : weight_(static_cast<std::size_t>(std::max(1, bins)), 0.0), confidence_(weight_.size(), 0.0),
+    : weight_(static_cast<std::size_t>(std::max(1, bins)), 0.0),
+      confidence_(weight_.size(), 0.0),
       correct_(weight_.size(), 0.0) {}
 
 void CalibrationBins::add(float confidence, bool correct, double weight) {

@@ -5,7 +5,10 @@
 //             are common; organic, paper and "other" rare);
 //   names     4 x the lexicon evidence (material_lexicon.cpp) of the source
 //             material's name and external texture file name, and 0.7 of that
-//             for the source mesh and node names ("SheenChair_wood");
+//             for the source mesh and node names ("SheenChair_wood"). A prefix
+//             that all material (or all mesh) names of the model share names
+//             the object, not a material ("GlamVelvetSofa_feet" is not velvet),
+//             and is dropped first;
 //   metallic  metallic >= 0.5 pushes Metal up to +4 and the rest down; a
 //             dielectric pushes Metal down up to -2.5 (the glTF metallic channel
 //             is physically meaningful: metals have no diffuse colour);
@@ -115,6 +118,22 @@ void add_appearance(const Appearance& a, Scores& s) {
   if (h[0] >= 70.f && h[0] <= 160.f && h[1] > 0.3f) s[kOrganic] += 0.8f;
 }
 
+// The names without the prefix they all share (the object's name, when the
+// asset's author prefixed every name with it). Fewer than two names, or a
+// shared prefix of under 4 characters: unchanged.
+std::vector<std::string> strip_common_prefix(std::vector<std::string> names) {
+  if (names.size() < 2) return names;
+  std::size_t n = names[0].size();
+  for (const std::string& s : names) {
+    std::size_t k = 0;
+    while (k < n && k < s.size() && s[k] == names[0][k]) ++k;
+    n = k;
+  }
+  if (n < 4) return names;
+  for (std::string& s : names) s = s.substr(n);
+  return names;
+}
+
 // Luminance standard deviation of a texture on a coarse grid (grain).
 float texture_grain(const Texture& t) {
   if (t.empty()) return -1.f;
@@ -162,6 +181,9 @@ class PbrSegmenter final : public Segmenter {
 
     // Per source material: name evidence and texture statistics, once.
     material_scores_.assign(model.materials.size(), std::vector<float>(static_cast<std::size_t>(table.size()), 0.f));
+    std::vector<std::string> material_names;
+    for (const SourceMaterial& mat : model.materials) material_names.push_back(mat.name);
+    material_names = strip_common_prefix(std::move(material_names));
     for (std::size_t m = 0; m < model.materials.size(); ++m) {
       const SourceMaterial& mat = model.materials[m];
       Scores s{};
@@ -176,7 +198,7 @@ class PbrSegmenter final : public Segmenter {
       std::vector<float>& out = material_scores_[m];
       scatter(s, out);
       if (use_names_) {
-        std::string text = mat.name;
+        std::string text = material_names[m];
         for (const Texture* t : {&mat.base_color_texture, &mat.metallic_roughness_texture})
           if (!t->uri.empty() && t->uri[0] != '*') text += " " + std::filesystem::path(t->uri).stem().string();
         const std::vector<float> e = detail::name_evidence(text, table);
@@ -185,10 +207,18 @@ class PbrSegmenter final : public Segmenter {
     }
     mesh_scores_.clear();
     if (use_names_) {
+      std::vector<std::string> mesh_names, node_names;
       for (const SourcePrimitive& p : model.primitives) {
+        mesh_names.push_back(p.mesh_name);
+        node_names.push_back(p.node_name);
+      }
+      mesh_names = strip_common_prefix(std::move(mesh_names));
+      node_names = strip_common_prefix(std::move(node_names));
+      for (std::size_t i = 0; i < model.primitives.size(); ++i) {
+        const SourcePrimitive& p = model.primitives[i];
         if (p.mesh < 0) continue;
         if (static_cast<std::size_t>(p.mesh) >= mesh_scores_.size()) mesh_scores_.resize(p.mesh + 1);
-        const std::vector<float> e = detail::name_evidence(p.mesh_name + " " + p.node_name, table);
+        const std::vector<float> e = detail::name_evidence(mesh_names[i] + " " + node_names[i], table);
         std::vector<float>& out = mesh_scores_[static_cast<std::size_t>(p.mesh)];
         out.assign(e.size(), 0.f);
         for (std::size_t c = 0; c < e.size(); ++c) out[c] = kNameWeight * kMeshNameShare * e[c];

@@ -20,5 +20,6 @@ void add_info_command(CLI::App& app, Command& run);
 void add_render_command(CLI::App& app, Command& run);
 void add_segment_command(CLI::App& app, Command& run);
 void add_eval_command(CLI::App& app, Command& run);
+void add_project_command(CLI::App& app, Command& run);
 
 }  // namespace g2p::cli

@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/eval.h"
+#include "g2p/project.h"
 #include "g2p/segment.h"
 
 namespace g2p::cli {
@@ -51,7 +52,7 @@ int run_eval_seg(const EvalArgs& args) {
   Result<std::unique_ptr<Segmenter>> predictor = make_segmenter_flag("eval seg", args.segmenter, exit_code);
   if (!predictor.ok()) return exit_code;
 
-  ConfusionMatrix total(table->size());
+  ConfusionMatrix total(table->size()), total_3d(table->size());
   CalibrationBins calibration;
   nlohmann::json per_model = nlohmann::json::object();
   for (const std::string& key : keys) {
@@ -76,25 +77,55 @@ int run_eval_seg(const EvalArgs& args) {
     }
     ConfusionMatrix matrix(table->size());
     LabelMap truth, predicted;
+    std::vector<LabelMap> predictions;
     for (const View& v : *views) {
       s = (*oracle)->segment_into(v, truth);
       if (s.ok()) s = (*predictor)->segment_into(v, predicted);
       if (s.ok()) s = matrix.add(truth.labels, predicted.labels);
       if (s.ok() && !predicted.probabilities.empty())
         s = calibration.add(truth.labels, predicted.labels, predicted.probabilities);
+      predictions.push_back(predicted);
       if (!s.ok()) {
         std::cerr << "g2p eval seg: error: " << key << ": " << s.to_string() << "\n";
         return kExitFailure;
       }
     }
+    // 3D: the predictions voted onto the faces (the project stage), scored per
+    // face weighted by area; ground truth per face from its source material.
+    Result<Projection> projection = project(model->mesh, *views, predictions, table->size());
+    if (!projection.ok()) {
+      std::cerr << "g2p eval seg: error: " << key << ": " << projection.status().to_string() << "\n";
+      return kExitFailure;
+    }
+    Result<std::vector<int>> material_truth =
+        material_labels_from_json(text.str(), key, *table, static_cast<int>(model->materials.size()));
+    if (!material_truth.ok()) {
+      std::cerr << "g2p eval seg: error: " << material_truth.status().to_string() << "\n";
+      return kExitFailure;
+    }
+    std::vector<int> face_truth(model->mesh.triangles.size(), kUnknownLabel);
+    for (std::size_t f = 0; f < face_truth.size(); ++f) {
+      const int m = model->mesh.face_source[f].material;
+      if (m >= 0 && m < static_cast<int>(material_truth->size())) face_truth[f] = (*material_truth)[m];
+    }
+    ConfusionMatrix matrix_3d(table->size());
+    if (Status st = matrix_3d.add_faces(model->mesh, face_truth, projection->labels.label); !st.ok()) {
+      std::cerr << "g2p eval seg: error: " << st.to_string() << "\n";
+      return kExitFailure;
+    }
     total.merge(matrix);
-    std::printf("%-28s pixels %9.0f  accuracy %6.2f %%  mIoU %6.2f %%\n", key.c_str(), matrix.total(),
-                100.0 * matrix.accuracy(), 100.0 * matrix.mean_iou());
-    per_model[key] = nlohmann::json::parse(matrix.to_json(*table));
+    total_3d.merge(matrix_3d);
+    std::printf(
+        "%-28s 2D: %9.0f px, accuracy %6.2f %%, mIoU %6.2f %% | 3D: %8.4f m^2, accuracy %6.2f %%, mIoU %6.2f %%\n",
+        key.c_str(), matrix.total(), 100.0 * matrix.accuracy(), 100.0 * matrix.mean_iou(), matrix_3d.total(),
+        100.0 * matrix_3d.accuracy(), 100.0 * matrix_3d.mean_iou());
+    per_model[key] = {{"2d", nlohmann::json::parse(matrix.to_json(*table))},
+                      {"3d", nlohmann::json::parse(matrix_3d.to_json(*table))}};
   }
   std::cout << "\nAll " << keys.size() << " models, one confusion matrix (" << total.total()
             << " labelled pixels), IoU %:\n"
-            << total.table(*table);
+            << total.table(*table) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
+            << total_3d.table(*table);
   if (calibration.accuracy() == calibration.accuracy())  // has probabilities
     std::printf("calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n", calibration.mean_confidence(),
                 calibration.accuracy(), calibration.expected_calibration_error());
@@ -104,6 +135,7 @@ int run_eval_seg(const EvalArgs& args) {
                                 {"views", args.views.views},
                                 {"resolution", args.views.resolution},
                                 {"total", nlohmann::json::parse(total.to_json(*table))},
+                                {"total_3d", nlohmann::json::parse(total_3d.to_json(*table))},
                                 {"calibration",
                                  {{"ece", calibration.expected_calibration_error()},
                                   {"mean_confidence", calibration.mean_confidence()},
@@ -125,7 +157,8 @@ void add_eval_command(CLI::App& app, Command& run) {
   CLI::App* eval = app.add_subcommand("eval", "Measure accuracy against ground truth");
   eval->require_subcommand(1);
   auto args = std::make_shared<EvalArgs>();
-  CLI::App* seg = eval->add_subcommand("seg", "2D material segmentation accuracy (per pixel) over a labelled set");
+  CLI::App* seg = eval->add_subcommand(
+      "seg", "Material segmentation accuracy over a labelled set: per pixel (2D) and per face after voting (3D)");
   seg->add_option("--assets", args->assets, "Folder with labels.json and NAME/NAME.glb (default ../shared/assets)")
       ->default_val("../shared/assets");
   seg->add_option("--models", args->models, "Only these models (keys of labels.json)")->delimiter(',');

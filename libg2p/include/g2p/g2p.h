@@ -7,6 +7,7 @@
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/model.h"
+#include "g2p/project.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"

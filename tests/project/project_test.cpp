@@ -61,6 +61,8 @@ FaceVotes hand_votes(int faces, int classes, const std::vector<std::tuple<int, i
   v.num_classes = classes;
   v.histogram.assign(static_cast<std::size_t>(faces * classes), 0.f);
   v.total.assign(static_cast<std::size_t>(faces), 0.f);
+  v.row.assign(static_cast<std::size_t>(faces), -1);
+  for (const auto& e : entries) v.row[static_cast<std::size_t>(std::get<0>(e))] = std::get<0>(e);
   for (const auto& [f, c, w] : entries) {
     v.histogram[static_cast<std::size_t>(f * classes + c)] += w;
     v.total[static_cast<std::size_t>(f)] += w;

@@ -52,13 +52,20 @@ struct VoteOptions {
   bool weight_by_footprint = false;  // times the surface area the pixel covers (m^2), so votes measure area
 };
 
-// Per-face vote histograms over all views.
+// Per-face vote histograms over all views. Only faces some view saw have a
+// histogram row (large meshes are mostly hidden inside), so memory follows the
+// visible faces, not the mesh.
 struct FaceVotes {
   int num_classes = 0;
-  std::vector<float> histogram;  // num_faces x num_classes, row-major
-  std::vector<float> total;      // per face, the sum of its votes (0: no view saw it)
+  std::vector<int> row;          // per face: its row in `histogram`, or -1 if no view saw it
+  std::vector<float> histogram;  // rows x num_classes, row-major
+  std::vector<float> total;      // per face, the sum of its votes (0 for unseen faces)
 
-  const float* of(int face) const { return histogram.data() + static_cast<std::size_t>(face) * num_classes; }
+  // The face's votes per class, or nullptr if no view saw it.
+  const float* of(int face) const {
+    const int r = row[static_cast<std::size_t>(face)];
+    return r < 0 ? nullptr : histogram.data() + static_cast<std::size_t>(r) * num_classes;
+  }
 };
 
 G2P_API Result<FaceVotes> vote(const Mesh& mesh, const std::vector<View>& views, const std::vector<LabelMap>& maps,

@@ -74,8 +74,8 @@ FaceLabels assign_labels(const Mesh& mesh, const FaceGraph& graph, const FaceVot
   out.seen.assign(static_cast<std::size_t>(nf), 0);
   for (int f = 0; f < nf; ++f) {
     const float total = votes.total[static_cast<std::size_t>(f)];
-    if (!(total > 0.f)) continue;
     const float* h = votes.of(f);
+    if (h == nullptr || !(total > 0.f)) continue;
     int best = 0;
     for (int c = 1; c < k; ++c)
       if (h[c] > h[best]) best = c;  // strict: ties keep the lower index

@@ -18,7 +18,8 @@ Result<Projection> project(const Mesh& mesh, const std::vector<View>& views, con
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const float total = p.votes.total[static_cast<std::size_t>(f)];
     const int l = p.labels.label[static_cast<std::size_t>(f)];
-    p.labels.confidence[static_cast<std::size_t>(f)] = total > 0.f && l >= 0 ? p.votes.of(f)[l] / total : 0.f;
+    const float* h = p.votes.of(f);
+    p.labels.confidence[static_cast<std::size_t>(f)] = h != nullptr && total > 0.f && l >= 0 ? h[l] / total : 0.f;
   }
   return p;
 }

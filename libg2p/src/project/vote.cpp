@@ -14,21 +14,37 @@ Result<FaceVotes> vote(const Mesh& mesh, const std::vector<View>& views, const s
   const int nf = mesh.num_faces();
   FaceVotes votes;
   votes.num_classes = num_classes;
-  votes.histogram.assign(static_cast<std::size_t>(nf) * num_classes, 0.f);
   votes.total.assign(static_cast<std::size_t>(nf), 0.f);
+  votes.row.assign(static_cast<std::size_t>(nf), -1);
 
   std::vector<Eigen::Vector3f> normals;
   if (options.weight_by_angle || options.weight_by_footprint) {
     normals.resize(static_cast<std::size_t>(nf));
     for (int f = 0; f < nf; ++f) normals[static_cast<std::size_t>(f)] = face_normal(mesh, f).cast<float>();
   }
+  // First pass: checks, and a histogram row for every face some pixel sees.
+  int rows = 0;
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    const View& view = views[v];
+    const LabelMap& map = maps[v];
+    const std::string where = "vote: view " + std::to_string(v);
+    if (map.labels.width() != view.face_id.width() || map.labels.height() != view.face_id.height())
+      return Status::InvalidArgument(where + ": label map and face-ID buffer differ in size");
+    for (std::size_t i = 0; i < view.face_id.size(); ++i) {
+      const int f = view.face_id.data()[i];
+      if (f < 0) continue;
+      if (f >= nf) return Status::InvalidArgument(where + ": face ID " + std::to_string(f) + " out of range");
+      int& r = votes.row[static_cast<std::size_t>(f)];
+      if (r < 0) r = rows++;
+    }
+  }
+  votes.histogram.assign(static_cast<std::size_t>(rows) * num_classes, 0.f);
+
   for (std::size_t v = 0; v < views.size(); ++v) {
     const View& view = views[v];
     const LabelMap& map = maps[v];
     const int w = view.face_id.width(), h = view.face_id.height();
     const std::string where = "vote: view " + std::to_string(v);
-    if (map.labels.width() != w || map.labels.height() != h)
-      return Status::InvalidArgument(where + ": label map and face-ID buffer differ in size");
     const bool soft = options.mode == VoteMode::kSoft;
     if (soft && (map.probabilities.width() != w || map.probabilities.channels() != num_classes))
       return Status::InvalidArgument(where + ": soft votes need probabilities with " + std::to_string(num_classes) +
@@ -44,7 +60,6 @@ Result<FaceVotes> vote(const Mesh& mesh, const std::vector<View>& views, const s
       for (int x = 0; x < w; ++x) {
         const int f = view.face_id.at(x, y);
         if (f < 0) continue;
-        if (f >= nf) return Status::InvalidArgument(where + ": face ID " + std::to_string(f) + " out of range");
         const int label = map.labels.at(x, y);
         if (!soft && (label < 0 || label >= num_classes)) continue;
         float weight = 1.f;
@@ -62,7 +77,8 @@ Result<FaceVotes> vote(const Mesh& mesh, const std::vector<View>& views, const s
             weight *= pixel_area * z * z / cosine;
           }
         }
-        float* hist = votes.histogram.data() + static_cast<std::size_t>(f) * num_classes;
+        float* hist =
+            votes.histogram.data() + static_cast<std::size_t>(votes.row[static_cast<std::size_t>(f)]) * num_classes;
         if (soft) {
           const float* p = map.probabilities.pixel(x, y);
           float sum = 0.f;

@@ -122,9 +122,8 @@ int run_eval_seg(const EvalArgs& args) {
     per_model[key] = {{"2d", nlohmann::json::parse(matrix.to_json(*table))},
                       {"3d", nlohmann::json::parse(matrix_3d.to_json(*table))}};
   }
-  std::cout << "\nAll " << keys.size() << " models, one confusion matrix (" << total.total()
-            << " labelled pixels), IoU %:\n"
-            << total.table(*table) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
+  std::printf("\nAll %zu models, one confusion matrix (%.0f labelled pixels), IoU %%:\n", keys.size(), total.total());
+  std::cout << total.table(*table) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
             << total_3d.table(*table);
   if (calibration.accuracy() == calibration.accuracy())  // has probabilities
     std::printf("calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n", calibration.mean_confidence(),

@@ -88,7 +88,8 @@ struct Model {
 // Replaces every name the model carries (materials, meshes, nodes, external
 // texture file names) by a meaningless one ("material_3", "mesh_1"), as
 // image-to-3D generators emit them. For measuring what a segmenter does
-// without names; geometry, provenance indices and textures are unchanged.
+// without names; geometry, provenance indices, textures and the file path
+// (the oracle's default key) are unchanged.
 G2P_API void anonymize_names(Model& model);
 
 }  // namespace g2p

@@ -13,7 +13,6 @@ void anonymize_names(Model& model) {
     p.mesh_name = "mesh_" + std::to_string(p.mesh);
     p.node_name = "node";
   }
-  model.info.path = "model";
 }
 
 }  // namespace g2p

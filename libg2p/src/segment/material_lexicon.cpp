@@ -84,7 +84,7 @@ const Entry kLexicon[] = {
   // Rubber
   {"rubber", "Rubber", 1}, {"latex", "Rubber", 1}, {"silicone", "Rubber", 0.9f}, {"neoprene", "Rubber", 1},
   {"tire", "Rubber", 0.8f}, {"tyre", "Rubber", 0.8f}, {"gummi", "Rubber", 1}, {"caoutchouc", "Rubber", 1},
-  {"goma", "Rubber", 1}, {"gomma", "Rubber", 1}, {"borracha", "Rubber", 1}, {"rubber", "Rubber", 1},
+  {"goma", "Rubber", 1}, {"gomma", "Rubber", 1}, {"borracha", "Rubber", 1},
   // Paper
   {"paper", "Paper", 1}, {"cardboard", "Paper", 1}, {"carton", "Paper", 0.9f}, {"paperboard", "Paper", 1},
   {"label", "Paper", 0.6f}, {"sticker", "Paper", 0.7f}, {"book", "Paper", 0.6f}, {"papier", "Paper", 1},
@@ -108,6 +108,11 @@ std::string fold(std::string_view text) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     if (c == 0xC3 && i + 1 < text.size()) {
+      if (static_cast<unsigned char>(text[i + 1]) == 0x9F) {  // sharp s
+        out += "ss";
+        ++i;
+        continue;
+      }
       const auto d = static_cast<unsigned char>(text[++i]) | 0x20;  // lower case
       const char* map = "aaaaaaaceeeeiiiidnooooo/ouuuuyty";         // U+00E0..U+00FF
       if (d >= 0xA0) out.push_back(map[d - 0xA0]);

@@ -53,6 +53,10 @@ Result<ModelCard> read_card(const std::string& path) {
   text << in.rdbuf();
   const json doc = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) return Status::ParseError(path + ": not a JSON object");
+  if (doc.contains("format") && doc["format"] != "g2p-onnx-model-card")
+    return Status::ParseError(path + ": 'format' must be \"g2p-onnx-model-card\"");
+  if (doc.contains("version") && (!doc["version"].is_number_integer() || doc["version"].get<int>() > 1))
+    return Status::Unsupported(path + ": model card version " + doc["version"].dump() + " is newer than 1");
   ModelCard card;
   try {
     card.model_path = doc.at("model").get<std::string>();

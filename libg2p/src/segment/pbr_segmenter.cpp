@@ -6,15 +6,16 @@
 //   names     4 x the lexicon evidence (material_lexicon.cpp) of the source
 //             material's name and external texture file name, and 0.7 of that
 //             for the source mesh and node names ("SheenChair_wood"). A prefix
-//             that all material (or all mesh) names of the model share names
-//             the object, not a material ("GlamVelvetSofa_feet" is not velvet),
-//             and is dropped first;
+//             that all material (or all mesh, or all node) names share names
+//             the object, not a material ("GlamVelvetSofa_feet" is not
+//             velvet): its words count a quarter, the rest of each name fully;
 //   metallic  metallic >= 0.5 pushes Metal up to +4 and the rest down; a
 //             dielectric pushes Metal down up to -2.5 (the glTF metallic channel
 //             is physically meaningful: metals have no diffuse colour);
-//   glass     transmission pushes Glass up to +5 and Plastic +1.5; an alpha
-//             below 1 (BLEND) pushes Glass up to +3 (see-through solids are glass
-//             far more often than anything else);
+//   glass     transmission t pushes every class down by t, then Glass up by
+//             6t and Plastic by 2.5t (net +5t and +1.5t); an opacity a below 1
+//             (BLEND) adds 3(1 - a) to Glass and (1 - a) to Plastic
+//             (see-through solids are glass far more often than anything else);
 //   roughness smooth dielectrics (roughness < 0.35) lean to Plastic, Ceramic
 //             and Glass and away from Fabric and Paper; rough ones (> 0.6) to
 //             Fabric, Stone, Paper and Rubber and away from Glass and Ceramic;
@@ -32,6 +33,7 @@
 // hand-set from the physics of the channels and the glTF conventions, not
 // fitted to the shared assets (docs/accuracy.md measures them there).
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 
@@ -49,6 +51,7 @@ using Scores = std::array<float, kPaperClasses>;
 constexpr Scores kPrior = {0.4f, -0.6f, 0.3f, -0.6f, -0.4f, 0.3f, -0.6f, 0.4f, -0.3f, -0.3f, -0.5f, -1.0f};
 constexpr float kNameWeight = 4.f;
 constexpr float kMeshNameShare = 0.7f;
+constexpr float kSharedPrefixShare = 0.25f;
 
 struct Appearance {
   Eigen::Vector3f color = Eigen::Vector3f::Constant(0.5f);  // linear
@@ -118,20 +121,23 @@ void add_appearance(const Appearance& a, Scores& s) {
   if (h[0] >= 70.f && h[0] <= 160.f && h[1] > 0.3f) s[kOrganic] += 0.8f;
 }
 
-// The names without the prefix they all share (the object's name, when the
-// asset's author prefixed every name with it). Fewer than two names, or a
-// shared prefix of under 4 characters: unchanged.
-std::vector<std::string> strip_common_prefix(std::vector<std::string> names) {
-  if (names.size() < 2) return names;
+// Splits names into the prefix they all share (the object's name when the
+// author prefixed every name with it: "GlamVelvetSofa_feet") and the rest.
+// The prefix ends at a separator (not inside a word); fewer than two names,
+// or no shared prefix of at least 4 characters up to a separator: no prefix.
+std::string split_common_prefix(std::vector<std::string>& names) {
+  if (names.size() < 2) return {};
   std::size_t n = names[0].size();
   for (const std::string& s : names) {
     std::size_t k = 0;
     while (k < n && k < s.size() && s[k] == names[0][k]) ++k;
     n = k;
   }
-  if (n < 4) return names;
+  while (n > 0 && std::isalnum(static_cast<unsigned char>(names[0][n - 1]))) --n;  // back to a separator
+  if (n < 4) return {};
+  std::string prefix = names[0].substr(0, n);
   for (std::string& s : names) s = s.substr(n);
-  return names;
+  return prefix;
 }
 
 // Luminance standard deviation of a texture on a coarse grid (grain).
@@ -162,7 +168,7 @@ class PbrSegmenter final : public Segmenter {
       } else if (key == "temperature") {
         char* end = nullptr;
         temperature_ = std::strtof(value.c_str(), &end);
-        if (end == value.c_str() || !(temperature_ > 0.f))
+        if (end == value.c_str() || *end != '\0' || !std::isfinite(temperature_) || !(temperature_ > 0.f))
           return Status::InvalidArgument("pbr: temperature must be a number > 0, got '" + value + "'");
       } else {
         return Status::InvalidArgument("pbr: unknown setting '" + key + "' (known: names, temperature)");
@@ -183,7 +189,7 @@ class PbrSegmenter final : public Segmenter {
     material_scores_.assign(model.materials.size(), std::vector<float>(static_cast<std::size_t>(table.size()), 0.f));
     std::vector<std::string> material_names;
     for (const SourceMaterial& mat : model.materials) material_names.push_back(mat.name);
-    material_names = strip_common_prefix(std::move(material_names));
+    const std::string material_prefix = split_common_prefix(material_names);
     for (std::size_t m = 0; m < model.materials.size(); ++m) {
       const SourceMaterial& mat = model.materials[m];
       Scores s{};
@@ -202,7 +208,9 @@ class PbrSegmenter final : public Segmenter {
         for (const Texture* t : {&mat.base_color_texture, &mat.metallic_roughness_texture})
           if (!t->uri.empty() && t->uri[0] != '*') text += " " + std::filesystem::path(t->uri).stem().string();
         const std::vector<float> e = detail::name_evidence(text, table);
-        for (std::size_t c = 0; c < out.size(); ++c) out[c] += kNameWeight * e[c];
+        const std::vector<float> shared = detail::name_evidence(material_prefix, table);
+        for (std::size_t c = 0; c < out.size(); ++c)
+          out[c] += kNameWeight * std::max(e[c], kSharedPrefixShare * shared[c]);
       }
     }
     mesh_scores_.clear();
@@ -212,8 +220,9 @@ class PbrSegmenter final : public Segmenter {
         mesh_names.push_back(p.mesh_name);
         node_names.push_back(p.node_name);
       }
-      mesh_names = strip_common_prefix(std::move(mesh_names));
-      node_names = strip_common_prefix(std::move(node_names));
+      const std::string mesh_prefix = split_common_prefix(mesh_names);
+      const std::string node_prefix = split_common_prefix(node_names);
+      const std::vector<float> shared = detail::name_evidence(mesh_prefix + " " + node_prefix, table);
       for (std::size_t i = 0; i < model.primitives.size(); ++i) {
         const SourcePrimitive& p = model.primitives[i];
         if (p.mesh < 0) continue;
@@ -221,7 +230,8 @@ class PbrSegmenter final : public Segmenter {
         const std::vector<float> e = detail::name_evidence(mesh_names[i] + " " + node_names[i], table);
         std::vector<float>& out = mesh_scores_[static_cast<std::size_t>(p.mesh)];
         out.assign(e.size(), 0.f);
-        for (std::size_t c = 0; c < e.size(); ++c) out[c] = kNameWeight * kMeshNameShare * e[c];
+        for (std::size_t c = 0; c < e.size(); ++c)
+          out[c] = kNameWeight * kMeshNameShare * std::max(e[c], kSharedPrefixShare * shared[c]);
       }
     }
     return Status::Ok();

@@ -1,6 +1,7 @@
 // g2p segment and g2p eval seg as a user runs them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -108,6 +109,24 @@ TEST(ToolEval, SharedAssetsWithAndWithoutNames) {
     EXPECT_NE(r.out.find("mIoU"), std::string::npos) << r.out;
   }
   EXPECT_EQ(run_tool("eval seg --assets /nonexistent").exit_code, 1);
+}
+
+TEST(ToolProject, WritesFacesPartsAndRefines) {
+  const std::string out = test::scratch_dir("ToolProject") + "/out";
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  test::ToolRun r = run_tool("project " + hammer + " -o " + quote(out) +
+                             " --views 6 --resolution 64 --refiner smooth --refine-set lambda=0.5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("smooth: "), std::string::npos) << r.out;
+  for (const char* f : {"faces.csv", "labelled.ply", "parts.json", "refine.json", "projected/view_00_labels.png",
+                        "segmented/view_00_labels_index.png", "view_00_rgb.png"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
+  const std::string csv = test::read_file(out + "/faces.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 105);  // header + 104 faces
+  const nlohmann::json parts = nlohmann::json::parse(test::read_file(out + "/parts.json"));
+  EXPECT_GE(parts["parts"].size(), 1u);
+  EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner oracle-vlm").exit_code, 2);
+  EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner smooth --refine-set x").exit_code, 2);
 }
 
 }  // namespace

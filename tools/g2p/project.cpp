@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/project.h"
+#include "g2p/refine.h"
 
 namespace g2p::cli {
 namespace {
@@ -21,6 +22,8 @@ struct ProjectArgs {
   bool anonymize = false;
   bool soft = false, weight_angle = false, weight_footprint = false;
   double min_part_area = 0.001;
+  std::string refiner = "none";
+  std::vector<std::string> refiner_settings;
   double weld = 1e-6;
 };
 
@@ -54,6 +57,52 @@ int run_project(const ProjectArgs& args) {
   Result<Projection> projection = project(model->mesh, *views, maps, table->size(), options);
   if (!projection.ok()) return fail(projection.status());
 
+  // Stage 4 (optional): refine the labels, then re-partition with the refined labels.
+  nlohmann::json refine_report = {{"refiner", args.refiner}};
+  if (args.refiner != "none") {
+    BackendSettings settings;
+    for (const std::string& kv : args.refiner_settings) {
+      const std::size_t eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        std::cerr << "g2p project: --refine-set expects KEY=VALUE, got '" << kv << "'\n";
+        return kExitUsage;
+      }
+      settings[kv.substr(0, eq)] = kv.substr(eq + 1);
+    }
+    Result<std::unique_ptr<Refiner>> refiner = make_refiner(args.refiner, settings);
+    if (!refiner.ok()) {
+      std::cerr << "g2p project: " << refiner.status().message() << "\n";
+      return kExitUsage;
+    }
+    RefineInput in{&model->mesh, &projection->graph, &projection->votes, &projection->labels, &*views, &*table};
+    Result<RefineResult> refined = (*refiner)->refine(in);
+    if (!refined.ok()) {
+      // An optional stage: its failure loses nothing, the projected labels stand.
+      std::cerr << "g2p project: warning: refine failed, keeping the projected labels: " << refined.status().to_string()
+                << "\n";
+      refine_report["error"] = refined.status().to_string();
+    } else {
+      projection->labels.label = refined->labels;
+      projection->parts =
+          partition(model->mesh, projection->graph, projection->labels.label, projection->face_part, options.partition);
+      for (int f = 0; f < model->mesh.num_faces(); ++f) {
+        const float* h = projection->votes.of(f);
+        const int l = projection->labels.label[static_cast<std::size_t>(f)];
+        const float t = projection->votes.total[static_cast<std::size_t>(f)];
+        projection->labels.confidence[static_cast<std::size_t>(f)] = h != nullptr && t > 0.f && l >= 0 ? h[l] / t : 0.f;
+      }
+      refine_report["notes"] = refined->notes;
+      refine_report["changed_faces"] = refined->changes.size();
+      nlohmann::json changes = nlohmann::json::array();
+      for (std::size_t i = 0; i < refined->changes.size() && i < 1000; ++i) {
+        const LabelChange& c = refined->changes[i];
+        changes.push_back({{"face", c.face}, {"from", c.from}, {"to", c.to}, {"reason", c.reason}});
+      }
+      refine_report["changes_first_1000"] = changes;
+      for (const std::string& n : refined->notes) std::cout << n << "\n";
+    }
+  }
+
   // The labels seen through every view: what the refine stage (and a person) looks at.
   std::vector<LabelMap> projected;
   for (const View& v : *views) projected.push_back(render_face_labels(v, projection->labels.label));
@@ -69,6 +118,11 @@ int run_project(const ProjectArgs& args) {
                      {"label", table->valid_label(p.label) ? (*table)[p.label].name : std::string()},
                      {"faces", p.faces.size()},
                      {"area_m2", p.area_m2}});
+  }
+  if (s.ok()) {
+    std::ofstream report(args.out + "/refine.json");
+    report << refine_report.dump(2) << "\n";
+    if (!report) s = Status::IoError(args.out + "/refine.json: cannot write");
   }
   if (s.ok()) {
     std::ofstream out(args.out + "/parts.json");
@@ -104,6 +158,9 @@ void add_project_command(CLI::App& app, Command& run) {
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--weld", args->weld, "Weld tolerance relative to the object's size (default 1e-6)")
       ->check(CLI::Range(0.0, 0.1));
+  cmd->add_option("--refiner", args->refiner, "Refine the labels: none (default), smooth");
+  cmd->add_option("--refine-set", args->refiner_settings,
+                  "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps)");
   add_import_flags(cmd, args->import);
   add_view_flags(cmd, args->views);
   add_segmenter_flags(cmd, args->segmenter);

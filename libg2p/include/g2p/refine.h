@@ -1,0 +1,60 @@
+// refine: stage 4 of Gen2Physics, contextual correction of face labels that
+// are consistent across views but wrong. The paper asks a vision-language
+// model; libg2p's offline default (`smooth`) minimises a labelling energy on
+// the welded face graph. Backends are swappable through refiner_registry().
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "g2p/export.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/project.h"
+#include "g2p/registry.h"
+#include "g2p/render.h"
+#include "g2p/segment.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// What a refiner may look at: the mesh and its face graph, the votes and the
+// labels the project stage produced, and the rendered views (for backends that
+// show them to a model). All must outlive the call.
+struct RefineInput {
+  const Mesh* mesh = nullptr;
+  const FaceGraph* graph = nullptr;
+  const FaceVotes* votes = nullptr;
+  const FaceLabels* labels = nullptr;
+  const std::vector<View>* views = nullptr;  // may be null for backends that do not need them
+  const MaterialTable* table = nullptr;
+};
+
+// One face whose label the refiner changed, and why.
+struct LabelChange {
+  int face = -1;
+  int from = kUnknownLabel;
+  int to = kUnknownLabel;
+  std::string reason;
+};
+
+struct RefineResult {
+  std::vector<int> labels;           // per face
+  std::vector<LabelChange> changes;  // every face whose label differs from the input
+  std::vector<std::string> notes;    // what the refiner did or could not do, for the report
+};
+
+class G2P_API Refiner {
+ public:
+  virtual ~Refiner();
+  // Backend settings, key = value; unknown keys are errors.
+  virtual Status configure(const BackendSettings& settings);
+  virtual Result<RefineResult> refine(const RefineInput& input) const = 0;
+};
+
+// Backends by name; libg2p registers "smooth" (the offline default) and
+// "none" (labels unchanged, for ablations).
+G2P_API Registry<Refiner>& refiner_registry();
+G2P_API Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings = {});
+
+}  // namespace g2p

@@ -1,0 +1,12 @@
+// Private: factories of the built-in refiners, registered in refiner_registry().
+#pragma once
+
+#include <memory>
+
+#include "g2p/refine.h"
+
+namespace g2p {
+
+std::unique_ptr<Refiner> make_smooth_refiner();
+
+}  // namespace g2p

@@ -41,6 +41,9 @@ TEST(LabelMaps, ColoursLegendAndFiles) {
   const nlohmann::json classes = nlohmann::json::parse(test::read_file(dir + "/classes.json"));
   EXPECT_EQ(classes["classes"][5]["name"], "Metal");
   EXPECT_TRUE(std::filesystem::exists(dir + "/legend.png"));
+  Result<ImageU8> contact = read_image(dir + "/contact_sheet.png");
+  ASSERT_TRUE(contact.ok());
+  EXPECT_EQ(contact->width(), 3 * (256 + 4) + 4);  // two views and the legend
   EXPECT_EQ(write_label_maps(dir, {}, t).code(), StatusCode::kInvalidArgument);
 }
 

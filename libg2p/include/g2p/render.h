@@ -142,7 +142,8 @@ G2P_API Result<std::vector<Camera>> cameras_from_json(const std::string& json_te
 G2P_API Result<ImageU8> encode_face_ids(const ImageI32& face_id);
 G2P_API Result<ImageI32> decode_face_ids(const ImageU8& encoded);
 
-// A grid of images scaled to `tile` pixels, `columns` wide, each labelled with its index.
-G2P_API ImageU8 contact_sheet(const std::vector<const ImageU8*>& images, int columns, int tile);
+// A grid of images scaled to `tile` pixels, `columns` wide; the first
+// `numbered` of them (all when -1) carry their index in a corner.
+G2P_API ImageU8 contact_sheet(const std::vector<const ImageU8*>& images, int columns, int tile, int numbered = -1);
 
 }  // namespace g2p

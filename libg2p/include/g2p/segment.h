@@ -78,7 +78,8 @@ G2P_API ImageU8 label_legend(const MaterialTable& table, int width = 220);
 // Writes per view: view_XX_labels.png (colour-coded, with the legend beside
 // it), view_XX_labels_index.png (8-bit class index, 255 = unknown) and
 // view_XX_probs.npy (float32, height x width x classes) when there are
-// probabilities; plus legend.png and classes.json (names and colours).
+// probabilities; plus legend.png, contact_sheet.png (every view's colours
+// and the legend) and classes.json (names and colours).
 G2P_API Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& maps, const MaterialTable& table);
 
 }  // namespace g2p

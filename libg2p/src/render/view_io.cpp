@@ -146,7 +146,7 @@ Result<std::vector<Camera>> cameras_from_json(const std::string& json_text) {
   return cameras;
 }
 
-ImageU8 contact_sheet(const std::vector<const ImageU8*>& images, int columns, int tile) {
+ImageU8 contact_sheet(const std::vector<const ImageU8*>& images, int columns, int tile, int numbered) {
   columns = std::max(1, std::min<int>(columns, static_cast<int>(images.size())));
   tile = std::max(16, tile);
   const int rows = (static_cast<int>(images.size()) + columns - 1) / columns;
@@ -162,6 +162,7 @@ ImageU8 contact_sheet(const std::vector<const ImageU8*>& images, int columns, in
     const int col = static_cast<int>(i) % columns, row = static_cast<int>(i) / columns;
     cv::Mat cell = sheet(cv::Rect(gap + col * (tile + gap), gap + row * (tile + gap), size.width, size.height));
     cv::resize(src, cell, size, 0, 0, cv::INTER_AREA);
+    if (numbered >= 0 && static_cast<int>(i) >= numbered) continue;
     cv::putText(cell, std::to_string(i), cv::Point(6, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 3);
     cv::putText(cell, std::to_string(i), cv::Point(6, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1);
   }

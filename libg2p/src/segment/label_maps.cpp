@@ -8,6 +8,7 @@
 
 #include "core/file_util.h"
 #include "g2p/io.h"
+#include "g2p/render.h"
 #include "g2p/segment.h"
 
 namespace g2p {
@@ -69,10 +70,13 @@ Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& map
   G2P_RETURN_IF_ERROR(detail::ensure_directory(dir));
   const std::string base = dir + "/";
   ImageU8 legend = label_legend(table);
+  std::vector<ImageU8> coloured;
+  coloured.reserve(maps.size());
   for (std::size_t i = 0; i < maps.size(); ++i) {
     const LabelMap& map = maps[i];
     // Colour-coded labels with the legend on the right.
-    ImageU8 colours = colorize_labels(map.labels, table);
+    coloured.push_back(colorize_labels(map.labels, table));
+    ImageU8& colours = coloured.back();
     ImageU8 sheet(colours.width() + legend.width(), std::max(colours.height(), legend.height()), 3);
     cv::Mat s = as_mat(sheet);
     s.setTo(cv::Scalar(255, 255, 255));
@@ -90,6 +94,13 @@ Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& map
       G2P_RETURN_IF_ERROR(detail::write_file_atomically(base + view_name(i, "probs", "npy"), npy(map.probabilities)));
   }
   G2P_RETURN_IF_ERROR(write_image(base + "legend.png", legend));
+  // All views at a glance, the legend as the last tile.
+  std::vector<const ImageU8*> tiles;
+  for (const ImageU8& c : coloured) tiles.push_back(&c);
+  ImageU8 legend_tile = legend;
+  tiles.push_back(&legend_tile);
+  G2P_RETURN_IF_ERROR(
+      write_image(base + "contact_sheet.png", contact_sheet(tiles, 4, 256, static_cast<int>(coloured.size()))));
   nlohmann::json classes = nlohmann::json::array();
   for (int c = 0; c < table.size(); ++c)
     classes.push_back({{"index", c}, {"name", table[c].name}, {"color", table[c].color}});

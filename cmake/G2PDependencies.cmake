@@ -25,6 +25,9 @@ g2p_require(embree_FOUND libembree-dev)
 find_package(TBB QUIET)
 g2p_require(TBB_FOUND libtbb-dev)
 
+find_package(CURL QUIET)
+g2p_require(CURL_FOUND libcurl4-openssl-dev)
+
 find_package(nlohmann_json 3.10 QUIET)
 g2p_require(nlohmann_json_FOUND nlohmann-json3-dev)
 

@@ -8,7 +8,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/libg2p/include/g2p
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h")
 install(FILES ${PROJECT_BINARY_DIR}/libg2p/generated/include/g2p/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/g2p)
-install(FILES ${PROJECT_SOURCE_DIR}/libg2p/data/materials.json
+install(FILES ${PROJECT_SOURCE_DIR}/libg2p/data/materials.json ${PROJECT_SOURCE_DIR}/libg2p/data/refine_prompt.txt
         DESTINATION ${CMAKE_INSTALL_DATADIR}/g2p)
 
 install(TARGETS g2p EXPORT g2pTargets
@@ -24,7 +24,7 @@ if(BUILD_SHARED_LIBS)
   set(G2P_STATIC_DEPENDENCIES "")
 else()
   set(G2P_STATIC_DEPENDENCIES
-      "find_dependency(assimp)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(OpenCV COMPONENTS core imgproc imgcodecs dnn)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)")
+      "find_dependency(assimp)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(CURL)\nfind_dependency(OpenCV COMPONENTS core imgproc imgcodecs dnn)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)")
 endif()
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/g2pConfig.cmake.in

@@ -158,9 +158,11 @@ void add_project_command(CLI::App& app, Command& run) {
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--weld", args->weld, "Weld tolerance relative to the object's size (default 1e-6)")
       ->check(CLI::Range(0.0, 0.1));
-  cmd->add_option("--refiner", args->refiner, "Refine the labels: none (default), smooth");
+  cmd->add_option("--refiner", args->refiner,
+                  "Refine the labels: none (default), smooth, vlm (needs --refine-set model=NAME url=URL)");
   cmd->add_option("--refine-set", args->refiner_settings,
-                  "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps)");
+                  "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps; vlm: url, model, "
+                  "api_key_env, timeout, retries, prompt_file, max_views)");
   add_import_flags(cmd, args->import);
   add_view_flags(cmd, args->views);
   add_segmenter_flags(cmd, args->segmenter);

@@ -14,3 +14,4 @@
 #include "g2p/segment.h"
 #include "g2p/status.h"
 #include "g2p/version.h"
+#include "g2p/vlm.h"

@@ -15,6 +15,7 @@
 #include "g2p/render.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/vlm.h"
 
 namespace g2p {
 
@@ -52,9 +53,13 @@ class G2P_API Refiner {
   virtual Result<RefineResult> refine(const RefineInput& input) const = 0;
 };
 
-// Backends by name; libg2p registers "smooth" (the offline default) and
+// Backends by name; libg2p registers "smooth" (the offline default), "vlm"
+// (a vision-language model over an OpenAI-compatible API, docs/vlm.md) and
 // "none" (labels unchanged, for ablations).
 G2P_API Registry<Refiner>& refiner_registry();
 G2P_API Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings = {});
+
+// The `vlm` refiner with a client of the caller's (any VlmClient subclass).
+G2P_API std::unique_ptr<Refiner> make_vlm_refiner(std::shared_ptr<const VlmClient> client);
 
 }  // namespace g2p

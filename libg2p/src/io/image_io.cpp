@@ -19,8 +19,10 @@ namespace {
 // textures are up to 4096^2 and fresh memory is costly on virtual machines).
 ImageU8 to_rgba8(const cv::Mat& decoded) {
   cv::Mat m = decoded;
-  if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
-  else if (m.depth() != CV_8U) m.convertTo(m, CV_8U, 255.0);
+  if (m.depth() == CV_16U)
+    m.convertTo(m, CV_8U, 1.0 / 257.0);
+  else if (m.depth() != CV_8U)
+    m.convertTo(m, CV_8U, 255.0);
   if (m.channels() > 4 || m.channels() == 2) cv::extractChannel(m, m, 0);
   ImageU8 out(m.cols, m.rows, 4);
   cv::Mat rgba(m.rows, m.cols, CV_8UC4, out.data());  // a view of `out`
@@ -44,6 +46,24 @@ Result<ImageU8> decode_image_rgba(const void* bytes, std::size_t size) {
     return to_rgba8(decoded);
   } catch (const cv::Exception& e) {
     return Status::ParseError(std::string("image decoder: ") + e.what());
+  }
+}
+
+Result<std::string> encode_png(const ImageU8& image) {
+  const int c = image.channels();
+  if (image.empty() || (c != 1 && c != 3 && c != 4)) return Status::InvalidArgument("encode_png: bad image");
+  try {
+    const cv::Mat src(image.height(), image.width(), CV_8UC(c), const_cast<std::uint8_t*>(image.data()));
+    cv::Mat bgr = src;
+    if (c == 3)
+      cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
+    else if (c == 4)
+      cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGRA);
+    std::vector<std::uint8_t> bytes;
+    if (!cv::imencode(".png", bgr, bytes)) return Status::Internal("encode_png: the PNG encoder failed");
+    return std::string(bytes.begin(), bytes.end());
+  } catch (const cv::Exception& e) {
+    return Status::Internal(std::string("encode_png: ") + e.what());
   }
 }
 

@@ -12,6 +12,9 @@ namespace g2p::detail {
 // Decodes PNG/JPEG/... bytes to 8-bit RGBA.
 Result<ImageU8> decode_image_rgba(const void* bytes, std::size_t size);
 
+// PNG bytes of an 8-bit image with 1, 3 (RGB) or 4 (RGBA) channels.
+Result<std::string> encode_png(const ImageU8& image);
+
 // Reads an image file to 8-bit RGBA.
 Result<ImageU8> read_image_rgba(const std::string& path);
 

@@ -8,5 +8,6 @@
 namespace g2p {
 
 std::unique_ptr<Refiner> make_smooth_refiner();
+std::unique_ptr<Refiner> make_vlm_refiner();
 
 }  // namespace g2p

@@ -1,0 +1,253 @@
+// The `vlm` refiner against a real HTTP server on 127.0.0.1 (cpp-httplib)
+// that checks each request and answers with scripted replies.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "g2p/refine.h"
+#include "g2p/vlm.h"
+#include "segment/segment_fixtures.h"
+#include "support/test_data.h"
+
+// After Eigen: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
+
+namespace g2p {
+namespace {
+
+using nlohmann::json;
+
+// A chat-completions server whose reply is scripted per test.
+class FakeVlmServer {
+ public:
+  using Reply = std::function<void(int attempt, const json& request, httplib::Response& res)>;
+
+  explicit FakeVlmServer(Reply reply) : reply_(std::move(reply)) {
+    server_.Post("/v1/chat/completions", [this](const httplib::Request& req, httplib::Response& res) {
+      const int attempt = attempts_++;
+      authorization_ = req.get_header_value("Authorization");
+      last_request_ = json::parse(req.body, nullptr, false);
+      reply_(attempt, last_request_, res);
+    });
+    port_ = server_.bind_to_any_port("127.0.0.1");
+    thread_ = std::thread([this] { server_.listen_after_bind(); });
+    while (!server_.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ~FakeVlmServer() {
+    server_.stop();
+    thread_.join();
+  }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_) + "/v1"; }
+  int attempts() const { return attempts_; }
+  const json& last_request() const { return last_request_; }
+  const std::string& authorization() const { return authorization_; }
+
+  static void answer(httplib::Response& res, const std::string& content) {
+    res.set_content(json{{"choices", {{{"message", {{"role", "assistant"}, {"content", content}}}}}}}.dump(),
+                    "application/json");
+  }
+
+ private:
+  httplib::Server server_;
+  Reply reply_;
+  int port_ = 0;
+  std::thread thread_;
+  std::atomic<int> attempts_{0};
+  json last_request_;
+  std::string authorization_;
+};
+
+// The hammer with its head mislabelled Plastic (handle Wood), seen from 2 views.
+struct Scene {
+  Model model;
+  std::vector<View> views;
+  FaceLabels labels;
+};
+
+Scene hammer() {
+  Scene s;
+  s.model = *load_model(test::source_path("examples/data/hammer.obj"));
+  s.views = test::render(s.model, 2, 64);
+  const MaterialTable& t = MaterialTable::paper_default();
+  for (const FaceSource& f : s.model.mesh.face_source)
+    s.labels.label.push_back(f.material == 0 ? t.find("Wood") : t.find("Plastic"));
+  s.labels.confidence.assign(s.labels.label.size(), 1.f);
+  s.labels.seen.assign(s.labels.label.size(), 1);
+  return s;
+}
+
+Result<RefineResult> run(const Scene& s, const std::string& url, BackendSettings extra = {}) {
+  BackendSettings settings = {{"url", url},        {"model", "test-vlm"}, {"timeout", "5"},
+                              {"backoff", "0.01"}, {"retries", "2"},      {"api_key_env", "G2P_TEST_VLM_KEY"}};
+  for (const auto& [k, v] : extra) settings[k] = v;
+  Result<std::unique_ptr<Refiner>> r = make_refiner("vlm", settings);
+  if (!r.ok()) return r.status();
+  RefineInput in;
+  in.mesh = &s.model.mesh;
+  in.labels = &s.labels;
+  in.views = &s.views;
+  in.table = &MaterialTable::paper_default();
+  return (*r)->refine(in);
+}
+
+std::string notes(const RefineResult& r) {
+  std::string all;
+  for (const std::string& n : r.notes) all += n + "\n";
+  return all;
+}
+
+const char* kValid =
+    "This is a hammer: a wooden handle and a steel head.\n```json\n"
+    R"({"object": "hammer", "corrections": [{"from": "Plastic", "to": "Metal", "reason": "steel head"}]})"
+    "\n```";
+
+TEST(VlmRefiner, AppliesAValidCorrectionAndSendsAWellFormedRequest) {
+  const Scene s = hammer();
+  FakeVlmServer server([](int, const json&, httplib::Response& res) { FakeVlmServer::answer(res, kValid); });
+  ::setenv("G2P_TEST_VLM_KEY", "sekret-key-123", 1);
+  Result<RefineResult> r = run(s, server.url());
+  ::unsetenv("G2P_TEST_VLM_KEY");
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  const MaterialTable& t = MaterialTable::paper_default();
+  int metal = 0;
+  for (std::size_t f = 0; f < r->labels.size(); ++f) {
+    EXPECT_EQ(r->labels[f], s.model.mesh.face_source[f].material == 0 ? t.find("Wood") : t.find("Metal"));
+    metal += r->labels[f] == t.find("Metal");
+  }
+  EXPECT_EQ(metal, 12);
+  ASSERT_EQ(r->changes.size(), 12u);
+  EXPECT_NE(r->changes[0].reason.find("steel head"), std::string::npos);
+  // The request: model, temperature 0, the prompt, two images per view as PNG data URLs.
+  const json& req = server.last_request();
+  EXPECT_EQ(req["model"], "test-vlm");
+  EXPECT_EQ(req["temperature"].get<double>(), 0.0);
+  int images = 0;
+  std::string text;
+  for (const json& part : req["messages"].back()["content"]) {
+    if (part["type"] == "image_url") {
+      EXPECT_EQ(part["image_url"]["url"].get<std::string>().rfind("data:image/png;base64,iVBOR", 0), 0u);
+      ++images;
+    } else {
+      text += part["text"].get<std::string>();
+    }
+  }
+  EXPECT_EQ(images, 4);
+  EXPECT_NE(text.find("\"corrections\""), std::string::npos);
+  EXPECT_NE(text.find("Wood, Rubber, Fabric"), std::string::npos);  // the vocabulary
+  EXPECT_NE(text.find("Plastic: "), std::string::npos);             // the current summary
+  // The key goes in the header and nowhere else.
+  EXPECT_EQ(server.authorization(), "Bearer sekret-key-123");
+  EXPECT_EQ(notes(*r).find("sekret"), std::string::npos);
+}
+
+TEST(VlmRefiner, RetriesAfter429) {
+  const Scene s = hammer();
+  FakeVlmServer server([](int attempt, const json&, httplib::Response& res) {
+    if (attempt == 0) {
+      res.status = 429;
+      res.set_header("Retry-After", "0");
+      res.set_content("slow down", "text/plain");
+    } else {
+      FakeVlmServer::answer(res, kValid);
+    }
+  });
+  Result<RefineResult> r = run(s, server.url());
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(server.attempts(), 2);
+  EXPECT_EQ(r->changes.size(), 12u);
+}
+
+// Each failure leaves the labels as they were and says what happened.
+struct FailureCase {
+  const char* name;
+  FakeVlmServer::Reply reply;
+  BackendSettings extra;
+  const char* note;
+};
+
+class VlmFailures : public testing::TestWithParam<FailureCase> {};
+
+TEST_P(VlmFailures, LoseNothingAndReport) {
+  const Scene s = hammer();
+  FakeVlmServer server(GetParam().reply);
+  Result<RefineResult> r = run(s, server.url(), GetParam().extra);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->labels, s.labels.label);
+  EXPECT_TRUE(r->changes.empty());
+  EXPECT_NE(notes(*r).find(GetParam().note), std::string::npos) << notes(*r);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scripted, VlmFailures,
+                         testing::Values(FailureCase{"malformed_json",
+                                                     [](int, const json&, httplib::Response& res) {
+                                                       FakeVlmServer::answer(
+                                                           res, "Looks fine to me {\"corrections\": [ {\"from\": ");
+                                                     },
+                                                     {},
+                                                     "rejected the answer"},
+                                         FailureCase{"server_error",
+                                                     [](int, const json&, httplib::Response& res) {
+                                                       res.status = 500;
+                                                       res.set_content("boom", "text/plain");
+                                                     },
+                                                     {},
+                                                     "HTTP 500 (gave up after 3 attempts)"},
+                                         FailureCase{"timeout",
+                                                     [](int, const json&, httplib::Response& res) {
+                                                       std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+                                                       FakeVlmServer::answer(res, kValid);
+                                                     },
+                                                     {{"timeout", "0.3"}},
+                                                     "no answer from"},
+                                         FailureCase{"ten_megabytes",
+                                                     [](int, const json&, httplib::Response& res) {
+                                                       FakeVlmServer::answer(res, std::string(10u << 20, 'x'));
+                                                     },
+                                                     {},
+                                                     "exceeds 4194304 bytes"},
+                                         FailureCase{
+                                             "unknown_class",
+                                             [](int, const json&, httplib::Response& res) {
+                                               FakeVlmServer::answer(
+                                                   res, R"({"corrections": [{"from": "Plastic", "to": "Vibranium"}]})");
+                                             },
+                                             {},
+                                             "outside the vocabulary"},
+                                         FailureCase{"refusal",
+                                                     [](int, const json&, httplib::Response& res) {
+                                                       FakeVlmServer::answer(res, "I cannot help with that.");
+                                                     },
+                                                     {},
+                                                     "rejected the answer"}),
+                         [](const testing::TestParamInfo<FailureCase>& info) { return std::string(info.param.name); });
+
+TEST(VlmRefiner, UnreachableServerAndBadSettings) {
+  const Scene s = hammer();
+  Result<RefineResult> r = run(s, "http://127.0.0.1:9/v1", {{"retries", "0"}});  // discard port: refused
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->labels, s.labels.label);
+  EXPECT_NE(notes(*r).find("labels stand"), std::string::npos) << notes(*r);
+  EXPECT_EQ(make_refiner("vlm", {{"model", "m"}, {"url", "ftp://x"}}).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(make_refiner("vlm", {{"temperature", "2"}}).status().code(), StatusCode::kInvalidArgument);
+  auto unconfigured = std::move(*make_refiner("vlm"));
+  RefineInput in{&s.model.mesh, nullptr, nullptr, &s.labels, &s.views, &MaterialTable::paper_default()};
+  EXPECT_EQ(unconfigured->refine(in).status().code(), StatusCode::kInvalidArgument);  // no model named
+}
+
+TEST(VlmHelpers, JsonExtractionAndBase64) {
+  EXPECT_EQ(*extract_json_object("reasoning...\n```json\n{\"a\": 1}\n```\n"), "\n{\"a\": 1}\n");
+  EXPECT_EQ(*extract_json_object("first {\"x\": {\"y\": 2}} then {\"z\": 3} done"), "{\"z\": 3}");
+  EXPECT_EQ(*extract_json_object("nested {\"x\": {\"y\": 2}}"), "{\"x\": {\"y\": 2}}");
+  EXPECT_FALSE(extract_json_object("no json here").ok());
+  EXPECT_EQ(base64_encode(""), "");
+  EXPECT_EQ(base64_encode("f"), "Zg==");
+  EXPECT_EQ(base64_encode("fo"), "Zm8=");
+  EXPECT_EQ(base64_encode("foobar"), "Zm9vYmFy");
+}
+
+}  // namespace
+}  // namespace g2p

@@ -61,7 +61,8 @@ const Fixture& fixture() {
     g2p::RenderOptions ids_only;
     ids_only.shade = ids_only.material_buffers = ids_only.geometry_buffers = false;
     (void)renderer->set_model(x.model);
-    for (const g2p::Camera& c : *g2p::make_views(x.model.mesh, vo)) x.views.push_back(*renderer->render(c, ids_only));
+    const std::vector<g2p::Camera> cameras = *g2p::make_views(x.model.mesh, vo);
+    for (const g2p::Camera& c : cameras) x.views.push_back(*renderer->render(c, ids_only));
     auto oracle =
         std::move(*g2p::make_segmenter("oracle", {{"labels", assets + "/labels.json"}, {"key", "SheenChair"}}));
     (void)oracle->set_model(x.model, g2p::MaterialTable::paper_default());

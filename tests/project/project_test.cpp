@@ -136,6 +136,15 @@ TEST(Partition, ConnectedComponentsAndFragmentMerging) {
   EXPECT_EQ(labels[4], 0);
   EXPECT_EQ(parts[0].faces.size(), 8u);
   EXPECT_EQ(face_part[9], 1);
+
+  // A confidently voted fragment is a real small part and stays; a doubtful one merges.
+  for (const float c : {0.9f, 0.3f}) {
+    std::vector<int> l = {0, 0, 0, 0, 1, 0, 0, 0, 2, 2};
+    std::vector<float> confidence(10, 1.f);
+    confidence[4] = c;
+    partition(m, g, l, face_part, {0.15}, &confidence);
+    EXPECT_EQ(l[4], c > 0.6f ? 1 : 0) << "confidence " << c;
+  }
 }
 
 // With the oracle as segmenter every shared asset keeps its ground truth on

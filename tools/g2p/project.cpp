@@ -82,9 +82,10 @@ int run_project(const ProjectArgs& args) {
                 << "\n";
       refine_report["error"] = refined.status().to_string();
     } else {
+      const std::vector<float> voted_confidence = projection->labels.confidence;
       projection->labels.label = refined->labels;
-      projection->parts =
-          partition(model->mesh, projection->graph, projection->labels.label, projection->face_part, options.partition);
+      projection->parts = partition(model->mesh, projection->graph, projection->labels.label, projection->face_part,
+                                    options.partition, &voted_confidence);
       for (int f = 0; f < model->mesh.num_faces(); ++f) {
         const float* h = projection->votes.of(f);
         const int l = projection->labels.label[static_cast<std::size_t>(f)];

@@ -96,14 +96,22 @@ struct Part {
 
 struct PartitionOptions {
   // Parts smaller than this fraction of the total area merge into the
-  // neighbouring part they share the longest border with (0 = keep all).
+  // neighbouring part they share the longest border with (0 = keep all)...
   double min_part_area_fraction = 0.001;
+  // ...unless their votes were confident: a fragment whose area-weighted mean
+  // confidence exceeds this is a real small part (metal feet, screws) and
+  // stays. Only used when partition() is given the confidences.
+  double merge_max_confidence = 0.6;
 };
 
 // Connected components of same-label faces over the face graph; `labels` is
 // updated where small fragments were merged. face_part gets each face's part.
+// `confidence` (per face, e.g. FaceLabels::confidence; 0 for filled faces)
+// protects confidently voted fragments from merging; null merges every small
+// fragment.
 G2P_API std::vector<Part> partition(const Mesh& mesh, const FaceGraph& graph, std::vector<int>& labels,
-                                    std::vector<int>& face_part, const PartitionOptions& options = {});
+                                    std::vector<int>& face_part, const PartitionOptions& options = {},
+                                    const std::vector<float>* confidence = nullptr);
 
 // ---- The whole stage ----------------------------------------------------------
 

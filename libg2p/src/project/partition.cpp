@@ -37,7 +37,9 @@ int components(const FaceGraph& graph, const std::vector<int>& labels, std::vect
 }  // namespace
 
 std::vector<Part> partition(const Mesh& mesh, const FaceGraph& graph, std::vector<int>& labels,
-                            std::vector<int>& face_part, const PartitionOptions& options) {
+                            std::vector<int>& face_part, const PartitionOptions& options,
+                            const std::vector<float>* confidence) {
+  if (confidence != nullptr && confidence->size() != static_cast<std::size_t>(mesh.num_faces())) confidence = nullptr;
   const int nf = mesh.num_faces();
   std::vector<double> area(static_cast<std::size_t>(nf));
   double total = 0.0;
@@ -46,11 +48,20 @@ std::vector<Part> partition(const Mesh& mesh, const FaceGraph& graph, std::vecto
 
   int parts = components(graph, labels, face_part);
   for (int pass = 0; pass < 16 && threshold > 0.0; ++pass) {
-    std::vector<double> part_area(static_cast<std::size_t>(parts), 0.0);
-    for (int f = 0; f < nf; ++f) part_area[static_cast<std::size_t>(face_part[f])] += area[static_cast<std::size_t>(f)];
+    std::vector<double> part_area(static_cast<std::size_t>(parts), 0.0), part_confidence(part_area.size(), 0.0);
+    for (int f = 0; f < nf; ++f) {
+      part_area[static_cast<std::size_t>(face_part[f])] += area[static_cast<std::size_t>(f)];
+      if (confidence != nullptr)
+        part_confidence[static_cast<std::size_t>(face_part[f])] +=
+            area[static_cast<std::size_t>(f)] * (*confidence)[static_cast<std::size_t>(f)];
+    }
     std::vector<int> small;
-    for (int p = 0; p < parts; ++p)
-      if (part_area[static_cast<std::size_t>(p)] < threshold) small.push_back(p);
+    for (int p = 0; p < parts; ++p) {
+      const double a = part_area[static_cast<std::size_t>(p)];
+      const bool confident = confidence != nullptr && a > 0.0 &&
+                             part_confidence[static_cast<std::size_t>(p)] / a > options.merge_max_confidence;
+      if (a < threshold && !confident) small.push_back(p);
+    }
     if (small.empty()) break;
     // Smallest first; a fragment merges into its neighbour as that is now.
     std::stable_sort(small.begin(), small.end(), [&](int a, int b) { return part_area[a] < part_area[b]; });

@@ -13,7 +13,8 @@ Result<Projection> project(const Mesh& mesh, const std::vector<View>& views, con
   if (!votes.ok()) return votes.status();
   p.votes = std::move(*votes);
   p.labels = assign_labels(mesh, p.graph, p.votes);
-  p.parts = partition(mesh, p.graph, p.labels.label, p.face_part, options.partition);
+  const std::vector<float> voted_confidence = p.labels.confidence;
+  p.parts = partition(mesh, p.graph, p.labels.label, p.face_part, options.partition, &voted_confidence);
   // Fragment merging may have changed labels: confidence is the new label's vote share.
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const float total = p.votes.total[static_cast<std::size_t>(f)];

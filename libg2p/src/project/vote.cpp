@@ -46,10 +46,11 @@ Result<FaceVotes> vote(const Mesh& mesh, const std::vector<View>& views, const s
     const int w = view.face_id.width(), h = view.face_id.height();
     const std::string where = "vote: view " + std::to_string(v);
     const bool soft = options.mode == VoteMode::kSoft;
-    if (soft && (map.probabilities.width() != w || map.probabilities.channels() != num_classes))
+    if (soft && (map.probabilities.width() != w || map.probabilities.height() != h ||
+                 map.probabilities.channels() != num_classes))
       return Status::InvalidArgument(where + ": soft votes need probabilities with " + std::to_string(num_classes) +
                                      " classes");
-    if (options.weight_by_footprint && view.depth.width() != w)
+    if (options.weight_by_footprint && (view.depth.width() != w || view.depth.height() != h))
       return Status::InvalidArgument(where + ": footprint weights need the depth buffer");
     const Camera& cam = view.camera;
     const Eigen::Matrix3f rotation = cam.rotation.cast<float>();

@@ -18,8 +18,10 @@
 // Rule afterwards: an island (connected same-class region) smaller than
 // `island` (default 0.2%) of the object's area takes the class of the
 // neighbouring region it shares the longest border with (a speck of metal
-// inside a wooden panel is a highlight, not a screw, at that size); islands
-// with no neighbour (separate pieces) keep their class.
+// inside a wooden panel is a highlight, not a screw, at that size), unless
+// its faces were voted confidently (mean vote share above 0.6: the views
+// agree it is a real small part, such as metal feet); islands with no
+// neighbour (separate pieces) keep their class.
 //
 // Settings: lambda (default 1), island (area fraction, default 0.002), sweeps (default 50).
 #include <cmath>
@@ -130,7 +132,9 @@ class SmoothRefiner final : public Refiner {
     if (island_ > 0.0) {
       std::vector<int> face_part;
       std::vector<int> before = label;
-      partition(mesh, graph, label, face_part, PartitionOptions{island_});
+      PartitionOptions islands_only;
+      islands_only.min_part_area_fraction = island_;
+      partition(mesh, graph, label, face_part, islands_only, &in.labels->confidence);
       for (int f = 0; f < nf; ++f) islands += label[static_cast<std::size_t>(f)] != before[static_cast<std::size_t>(f)];
     }
     const MaterialTable* table = in.table;

@@ -55,7 +55,9 @@ Result<ModelCard> read_card(const std::string& path) {
   if (doc.is_discarded() || !doc.is_object()) return Status::ParseError(path + ": not a JSON object");
   if (doc.contains("format") && doc["format"] != "g2p-onnx-model-card")
     return Status::ParseError(path + ": 'format' must be \"g2p-onnx-model-card\"");
-  if (doc.contains("version") && (!doc["version"].is_number_integer() || doc["version"].get<int>() > 1))
+  if (doc.contains("version") && (!doc["version"].is_number_integer() || doc["version"].get<int>() < 1))
+    return Status::ParseError(path + ": 'version' must be a positive integer");
+  if (doc.contains("version") && doc["version"].get<int>() > 1)
     return Status::Unsupported(path + ": model card version " + doc["version"].dump() + " is newer than 1");
   ModelCard card;
   try {

@@ -8,35 +8,13 @@
 
 #include <unordered_map>
 
+#include "benchmarks/bench_support.h"
 #include "g2p/io.h"
 #include "g2p/project.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
 
 namespace {
-
-g2p::Mesh subdivide(const g2p::Mesh& in) {
-  g2p::Mesh out;
-  out.positions = in.positions;
-  std::unordered_map<std::uint64_t, int> midpoints;
-  auto midpoint = [&](int a, int b) {
-    const std::uint64_t key =
-        (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
-    auto [it, inserted] = midpoints.emplace(key, static_cast<int>(out.positions.size()));
-    if (inserted) out.positions.push_back(0.5f * (out.positions[a] + out.positions[b]));
-    return it->second;
-  };
-  for (std::size_t f = 0; f < in.triangles.size(); ++f) {
-    const Eigen::Vector3i& t = in.triangles[f];
-    const int ab = midpoint(t[0], t[1]), bc = midpoint(t[1], t[2]), ca = midpoint(t[2], t[0]);
-    for (const Eigen::Vector3i& s : {Eigen::Vector3i(t[0], ab, ca), Eigen::Vector3i(t[1], bc, ab),
-                                     Eigen::Vector3i(t[2], ca, bc), Eigen::Vector3i(ab, bc, ca)}) {
-      out.triangles.push_back(s);
-      out.face_source.push_back(in.face_source[f]);
-    }
-  }
-  return out;
-}
 
 struct Fixture {
   g2p::Model model;
@@ -54,7 +32,7 @@ const Fixture& fixture() {
     g2p::ImportOptions io;
     io.load_textures = false;
     x.model = *g2p::load_model(assets + "/SheenChair/SheenChair.glb", io);
-    for (int i = 0; i < 3; ++i) x.model.mesh = subdivide(x.model.mesh);
+    for (int i = 0; i < 3; ++i) x.model.mesh = g2p::bench::subdivide(x.model.mesh);
     g2p::ViewOptions vo;
     vo.width = vo.height = 1024;
     auto renderer = std::move(*g2p::renderer_registry().create("embree"));

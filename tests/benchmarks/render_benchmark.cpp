@@ -14,39 +14,11 @@
 #include <memory>
 #include <unordered_map>
 
+#include "benchmarks/bench_support.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
 
 namespace {
-
-// Splits every triangle into four at its edge midpoints (shared between neighbours).
-g2p::Mesh subdivide(const g2p::Mesh& in) {
-  g2p::Mesh out;
-  out.positions = in.positions;
-  out.uvs = in.uvs;
-  std::unordered_map<std::uint64_t, int> midpoints;
-  auto midpoint = [&](int a, int b) {
-    const std::uint64_t key =
-        (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
-    auto [it, inserted] = midpoints.emplace(key, static_cast<int>(out.positions.size()));
-    if (inserted) {
-      out.positions.push_back(0.5f * (out.positions[a] + out.positions[b]));
-      if (!out.uvs.empty()) out.uvs.push_back(0.5f * (out.uvs[a] + out.uvs[b]));
-    }
-    return it->second;
-  };
-  for (std::size_t f = 0; f < in.triangles.size(); ++f) {
-    const Eigen::Vector3i& t = in.triangles[f];
-    const int ab = midpoint(t[0], t[1]), bc = midpoint(t[1], t[2]), ca = midpoint(t[2], t[0]);
-    for (const Eigen::Vector3i& s : {Eigen::Vector3i(t[0], ab, ca), Eigen::Vector3i(t[1], bc, ab),
-                                     Eigen::Vector3i(t[2], ca, bc), Eigen::Vector3i(ab, bc, ca)}) {
-      out.triangles.push_back(s);
-      if (!in.face_source.empty()) out.face_source.push_back(in.face_source[f]);
-    }
-  }
-  g2p::compute_vertex_normals(out);
-  return out;
-}
 
 struct Scene {
   g2p::Model model;
@@ -60,7 +32,7 @@ const Scene& scene() {
     g2p::Result<g2p::Model> m = g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/SheenChair/SheenChair.glb");
     if (!m.ok()) throw std::runtime_error(m.status().to_string());
     sc.model = std::move(*m);
-    for (int i = 0; i < 3; ++i) sc.model.mesh = subdivide(sc.model.mesh);
+    for (int i = 0; i < 3; ++i) sc.model.mesh = g2p::bench::subdivide(sc.model.mesh);
     sc.cameras = *g2p::make_views(sc.model.mesh);
     for (const g2p::Camera& c : sc.cameras) sc.rays += static_cast<double>(c.width) * c.height;
     return sc;

@@ -30,6 +30,20 @@ Status write_file_atomically(const std::string& path, const std::string& bytes) 
   return Status::Ok();
 }
 
+std::string npy_float32(const ImageF& image) {
+  std::string shape = "(" + std::to_string(image.height()) + ", " + std::to_string(image.width()) +
+                      (image.channels() > 1 ? ", " + std::to_string(image.channels()) + ")" : ")");
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape + ", }";
+  while ((10 + header.size() + 1) % 64 != 0) header.push_back(' ');  // data aligned to 64 bytes
+  header.push_back('\n');
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out.push_back(static_cast<char>(header.size() & 0xFF));
+  out.push_back(static_cast<char>(header.size() >> 8));
+  out += header;
+  out.append(reinterpret_cast<const char*>(image.data()), image.size() * sizeof(float));
+  return out;
+}
+
 Status ensure_directory(const std::string& dir) {
   std::error_code ec;
   if (fs::is_directory(dir, ec)) return Status::Ok();

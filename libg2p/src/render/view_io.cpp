@@ -31,22 +31,6 @@ std::string view_name(std::size_t index, const char* what, const char* ext) {
   return name;
 }
 
-// A float32 array as a NumPy .npy file (format version 1.0), shape (h, w[, c]).
-std::string npy(const ImageF& image) {
-  std::string shape = "(" + std::to_string(image.height()) + ", " + std::to_string(image.width()) +
-                      (image.channels() > 1 ? ", " + std::to_string(image.channels()) + ")" : ")");
-  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape + ", }";
-  while ((10 + header.size() + 1) % 64 != 0) header.push_back(' ');
-  header.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  const auto len = static_cast<std::uint16_t>(header.size());
-  out.push_back(static_cast<char>(len & 0xFF));
-  out.push_back(static_cast<char>(len >> 8));
-  out += header;
-  out.append(reinterpret_cast<const char*>(image.data()), image.size() * sizeof(float));
-  return out;
-}
-
 // Linear float channels to 8-bit, sRGB-encoded or not.
 ImageU8 to_u8(const ImageF& image, int channels, bool srgb, float scale = 1.f, float offset = 0.f) {
   ImageU8 out(image.width(), image.height(), channels);
@@ -189,7 +173,8 @@ Status write_views(const std::string& dir, const std::vector<View>& views, const
     G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "faceid", "png"), *ids));
     if (!options.buffers) continue;
     if (!v.depth.empty())
-      G2P_RETURN_IF_ERROR(detail::write_file_atomically(base + view_name(i, "depth", "npy"), npy(v.depth)));
+      G2P_RETURN_IF_ERROR(
+          detail::write_file_atomically(base + view_name(i, "depth", "npy"), detail::npy_float32(v.depth)));
     if (!v.normal.empty())  // n in [-1, 1] shown as (n + 1) / 2
       G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "normal", "png"), to_u8(v.normal, 3, false, 0.5f, 0.5f)));
     if (!v.base_color.empty())

@@ -20,20 +20,6 @@ std::string view_name(std::size_t index, const char* what, const char* ext) {
   return name;
 }
 
-// float32 (h, w, c) as NumPy .npy (format 1.0).
-std::string npy(const ImageF& image) {
-  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(image.height()) + ", " +
-                       std::to_string(image.width()) + ", " + std::to_string(image.channels()) + "), }";
-  while ((10 + header.size() + 1) % 64 != 0) header.push_back(' ');
-  header.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  out.push_back(static_cast<char>(header.size() & 0xFF));
-  out.push_back(static_cast<char>(header.size() >> 8));
-  out += header;
-  out.append(reinterpret_cast<const char*>(image.data()), image.size() * sizeof(float));
-  return out;
-}
-
 cv::Mat as_mat(ImageU8& image) { return cv::Mat(image.height(), image.width(), CV_8UC3, image.data()); }
 
 }  // namespace
@@ -91,7 +77,8 @@ Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& map
     }
     G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "labels_index", "png"), index));
     if (!map.probabilities.empty())
-      G2P_RETURN_IF_ERROR(detail::write_file_atomically(base + view_name(i, "probs", "npy"), npy(map.probabilities)));
+      G2P_RETURN_IF_ERROR(
+          detail::write_file_atomically(base + view_name(i, "probs", "npy"), detail::npy_float32(map.probabilities)));
   }
   G2P_RETURN_IF_ERROR(write_image(base + "legend.png", legend));
   // All views at a glance, the legend as the last tile.

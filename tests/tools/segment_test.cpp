@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "g2p/io.h"
 #include "g2p/render.h"
@@ -127,6 +128,43 @@ TEST(ToolProject, WritesFacesPartsAndRefines) {
   EXPECT_GE(parts["parts"].size(), 1u);
   EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner oracle-vlm").exit_code, 2);
   EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner smooth --refine-set x").exit_code, 2);
+}
+
+// The label columns of a faces.csv (label onwards).
+std::string label_columns(const std::string& csv) {
+  std::string out;
+  std::istringstream in(csv);
+  for (std::string line; std::getline(in, line);) {
+    std::size_t comma = 0;
+    for (int k = 0; k < 4 && comma != std::string::npos; ++k) comma = line.find(',', comma + 1);
+    out += line.substr(comma == std::string::npos ? 0 : comma) + "\n";
+  }
+  return out;
+}
+
+TEST(ToolRefine, RefinesAProjectFolderLikeProjectDoes) {
+  const std::string dir = test::scratch_dir("ToolRefine");
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  const std::string flags = " --views 4 --resolution 64 --segmenter pbr --set names=off";
+  ASSERT_EQ(run_tool("project " + hammer + " -o " + quote(dir + "/a") + flags).exit_code, 0);
+  ASSERT_EQ(run_tool("project " + hammer + " -o " + quote(dir + "/b") + flags + " --refiner smooth").exit_code, 0);
+  test::ToolRun r = run_tool("refine " + quote(dir + "/a"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("refined with 'smooth'"), std::string::npos) << r.out;
+  // Rebuilt from the folder, the refinement equals the one done inside g2p project.
+  EXPECT_EQ(label_columns(test::read_file(dir + "/a/refined/faces.csv")),
+            label_columns(test::read_file(dir + "/b/faces.csv")));
+  // An unreachable VLM loses nothing: the labels stand and the report says why.
+  r = run_tool("refine " + quote(dir + "/a") + " -o " + quote(dir + "/vlm") +
+               " --refiner vlm --refine-set model=m --refine-set url=http://127.0.0.1:9/v1 --refine-set retries=0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(label_columns(test::read_file(dir + "/vlm/faces.csv")),
+            label_columns(test::read_file(dir + "/a/faces.csv")));
+  EXPECT_NE(test::read_file(dir + "/vlm/refine.json").find("labels stand"), std::string::npos);
+  // Not a project folder.
+  r = run_tool("refine " + quote(dir));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("project.json"), std::string::npos) << r.err;
 }
 
 }  // namespace

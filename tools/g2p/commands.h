@@ -21,5 +21,6 @@ void add_render_command(CLI::App& app, Command& run);
 void add_segment_command(CLI::App& app, Command& run);
 void add_eval_command(CLI::App& app, Command& run);
 void add_project_command(CLI::App& app, Command& run);
+void add_refine_command(CLI::App& app, Command& run);
 
 }  // namespace g2p::cli

@@ -1,6 +1,6 @@
 // g2p project MODEL -o DIR: render, segment and lift the labels onto the
 // mesh; faces.csv, a labelled PLY, parts.json and the labels seen per view.
-#include <fstream>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -9,6 +9,7 @@
 #include "common.h"
 #include "g2p/project.h"
 #include "g2p/refine.h"
+#include "stage_outputs.h"
 
 namespace g2p::cli {
 namespace {
@@ -22,8 +23,7 @@ struct ProjectArgs {
   bool anonymize = false;
   bool soft = false, weight_angle = false, weight_footprint = false;
   double min_part_area = 0.001;
-  std::string refiner = "none";
-  std::vector<std::string> refiner_settings;
+  RefineArgs refine;
   double weld = 1e-6;
 };
 
@@ -58,87 +58,41 @@ int run_project(const ProjectArgs& args) {
   if (!projection.ok()) return fail(projection.status());
 
   // Stage 4 (optional): refine the labels, then re-partition with the refined labels.
-  nlohmann::json refine_report = {{"refiner", args.refiner}};
-  if (args.refiner != "none") {
-    BackendSettings settings;
-    for (const std::string& kv : args.refiner_settings) {
-      const std::size_t eq = kv.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        std::cerr << "g2p project: --refine-set expects KEY=VALUE, got '" << kv << "'\n";
-        return kExitUsage;
-      }
-      settings[kv.substr(0, eq)] = kv.substr(eq + 1);
-    }
-    Result<std::unique_ptr<Refiner>> refiner = make_refiner(args.refiner, settings);
-    if (!refiner.ok()) {
-      std::cerr << "g2p project: " << refiner.status().message() << "\n";
-      return kExitUsage;
-    }
-    RefineInput in{&model->mesh, &projection->graph, &projection->votes, &projection->labels, &*views, &*table};
-    Result<RefineResult> refined = (*refiner)->refine(in);
-    if (!refined.ok()) {
-      // An optional stage: its failure loses nothing, the projected labels stand.
-      std::cerr << "g2p project: warning: refine failed, keeping the projected labels: " << refined.status().to_string()
-                << "\n";
-      refine_report["error"] = refined.status().to_string();
-    } else {
-      const std::vector<float> voted_confidence = projection->labels.confidence;
-      projection->labels.label = refined->labels;
-      projection->parts = partition(model->mesh, projection->graph, projection->labels.label, projection->face_part,
-                                    options.partition, &voted_confidence);
-      for (int f = 0; f < model->mesh.num_faces(); ++f) {
-        const float* h = projection->votes.of(f);
-        const int l = projection->labels.label[static_cast<std::size_t>(f)];
-        const float t = projection->votes.total[static_cast<std::size_t>(f)];
-        projection->labels.confidence[static_cast<std::size_t>(f)] = h != nullptr && t > 0.f && l >= 0 ? h[l] / t : 0.f;
-      }
-      refine_report["notes"] = refined->notes;
-      refine_report["changed_faces"] = refined->changes.size();
-      nlohmann::json changes = nlohmann::json::array();
-      for (std::size_t i = 0; i < refined->changes.size() && i < 1000; ++i) {
-        const LabelChange& c = refined->changes[i];
-        changes.push_back({{"face", c.face}, {"from", c.from}, {"to", c.to}, {"reason", c.reason}});
-      }
-      refine_report["changes_first_1000"] = changes;
-      for (const std::string& n : refined->notes) std::cout << n << "\n";
-    }
-  }
+  nlohmann::json refine_report;
+  if (int code = refine_projection("project", args.refine, *model, *views, *table, options.partition, *projection,
+                                   refine_report);
+      code != kExitOk)
+    return code;
 
-  // The labels seen through every view: what the refine stage (and a person) looks at.
-  std::vector<LabelMap> projected;
-  for (const View& v : *views) projected.push_back(render_face_labels(v, projection->labels.label));
+  // What `g2p refine DIR` needs to rebuild this projection.
+  const nlohmann::json manifest = {
+      {"format", "g2p-project"},
+      {"version", 1},
+      {"model", std::filesystem::absolute(args.path).string()},
+      {"import",
+       {{"unit", args.import.unit},
+        {"up", args.import.up},
+        {"keep_axes", args.import.keep_axes},
+        {"no_textures", args.import.no_textures}}},
+      {"materials", args.materials.empty() ? "" : std::filesystem::absolute(args.materials).string()},
+      {"anonymize_names", args.anonymize},
+      {"views", views->size()},
+      {"vote", args.soft ? "soft" : "hard"},
+      {"weight_angle", args.weight_angle},
+      {"weight_footprint", args.weight_footprint},
+      {"weld", args.weld},
+      {"min_part_area", args.min_part_area}};
   Status s = write_views(args.out, *views);
   if (s.ok()) s = write_label_maps(args.out + "/segmented", maps, *table);
-  if (s.ok()) s = write_label_maps(args.out + "/projected", projected, *table);
-  if (s.ok()) s = write_faces_csv(args.out + "/faces.csv", *model, *projection, *table);
-  if (s.ok()) s = write_labelled_ply(args.out + "/labelled.ply", model->mesh, projection->labels.label, *table);
-  nlohmann::json parts = nlohmann::json::array();
-  for (std::size_t i = 0; i < projection->parts.size(); ++i) {
-    const Part& p = projection->parts[i];
-    parts.push_back({{"part", i},
-                     {"label", table->valid_label(p.label) ? (*table)[p.label].name : std::string()},
-                     {"faces", p.faces.size()},
-                     {"area_m2", p.area_m2}});
-  }
-  if (s.ok()) {
-    std::ofstream report(args.out + "/refine.json");
-    report << refine_report.dump(2) << "\n";
-    if (!report) s = Status::IoError(args.out + "/refine.json: cannot write");
-  }
-  if (s.ok()) {
-    std::ofstream out(args.out + "/parts.json");
-    out << nlohmann::json{{"parts", parts}}.dump(2) << "\n";
-    if (!out) s = Status::IoError(args.out + "/parts.json: cannot write");
-  }
+  if (s.ok()) s = write_projection(args.out, *model, *views, *projection, *table, refine_report);
+  if (s.ok()) s = write_text_file(args.out + "/project.json", manifest.dump(2) + "\n");
   if (!s.ok()) return fail(s);
   int seen = 0;
   for (std::uint8_t v : projection->labels.seen) seen += v;
   std::cout << "projected " << views->size() << " views onto " << model->mesh.num_faces() << " faces (" << seen
             << " seen, " << model->mesh.num_faces() - seen << " filled): " << projection->parts.size() << " parts -> "
             << args.out << "\n";
-  for (std::size_t i = 0; i < projection->parts.size(); ++i)
-    std::cout << "  part " << i << ": " << parts[i]["label"].get<std::string>() << ", " << parts[i]["faces"]
-              << " faces, " << parts[i]["area_m2"] << " m^2\n";
+  print_parts(*projection, *table);
   return kExitOk;
 }
 
@@ -159,11 +113,7 @@ void add_project_command(CLI::App& app, Command& run) {
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--weld", args->weld, "Weld tolerance relative to the object's size (default 1e-6)")
       ->check(CLI::Range(0.0, 0.1));
-  cmd->add_option("--refiner", args->refiner,
-                  "Refine the labels: none (default), smooth, vlm (needs --refine-set model=NAME url=URL)");
-  cmd->add_option("--refine-set", args->refiner_settings,
-                  "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps; vlm: url, model, "
-                  "api_key_env, timeout, retries, prompt_file, max_views)");
+  add_refiner_flags(cmd, args->refine, "none");
   add_import_flags(cmd, args->import);
   add_view_flags(cmd, args->views);
   add_segmenter_flags(cmd, args->segmenter);

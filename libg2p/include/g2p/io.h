@@ -57,6 +57,10 @@ G2P_API Result<ImageU8> read_image(const std::string& path);
 // existing file is never left half-overwritten.
 G2P_API Status write_image(const std::string& path, const ImageU8& image);
 
+// Writes a text (or any byte) file under a temporary name and renames it, so
+// an existing file is never left half-overwritten.
+G2P_API Status write_text_file(const std::string& path, const std::string& text);
+
 // Whether assimp can read files with this extension (with or without the dot).
 G2P_API bool is_supported_extension(const std::string& extension);
 

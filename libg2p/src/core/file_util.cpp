@@ -1,4 +1,5 @@
 #include "core/file_util.h"
+#include "g2p/io.h"
 
 #include <filesystem>
 #include <fstream>
@@ -54,3 +55,11 @@ Status ensure_directory(const std::string& dir) {
 }
 
 }  // namespace g2p::detail
+
+namespace g2p {
+
+Status write_text_file(const std::string& path, const std::string& text) {
+  return detail::write_file_atomically(path, text);
+}
+
+}  // namespace g2p

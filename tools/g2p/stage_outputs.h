@@ -1,0 +1,37 @@
+// The project and refine stages' shared steps: applying a refiner to a
+// projection and writing the labelled results. Used by `g2p project` and
+// `g2p refine`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "g2p/project.h"
+#include "g2p/refine.h"
+
+namespace g2p::cli {
+
+// --refiner NAME and --refine-set KEY=VALUE.
+struct RefineArgs {
+  std::string name = "none";
+  std::vector<std::string> settings;
+};
+void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& default_name);
+
+// Runs the refiner on the projection and re-partitions with its labels. A
+// refiner failure keeps the projected labels (a warning; the report says
+// why). Returns an exit code: kExitOk, or kExitUsage for bad flags.
+int refine_projection(const std::string& command, const RefineArgs& args, const Model& model,
+                      const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition,
+                      Projection& projection, nlohmann::json& report);
+
+// faces.csv, labelled.ply, parts.json, refine.json and projected/ label maps.
+Status write_projection(const std::string& out, const Model& model, const std::vector<View>& views,
+                        const Projection& projection, const MaterialTable& table, const nlohmann::json& report);
+
+// One line per part on stdout.
+void print_parts(const Projection& projection, const MaterialTable& table);
+
+}  // namespace g2p::cli

@@ -233,6 +233,14 @@ TEST(VlmRefiner, UnreachableServerAndBadSettings) {
   EXPECT_NE(notes(*r).find("labels stand"), std::string::npos) << notes(*r);
   EXPECT_EQ(make_refiner("vlm", {{"model", "m"}, {"url", "ftp://x"}}).status().code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(make_refiner("vlm", {{"temperature", "2"}}).status().code(), StatusCode::kInvalidArgument);
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{{"timeout", "inf"},
+                                                                                   {"timeout", "0.00001"},
+                                                                                   {"retries", "1.5"},
+                                                                                   {"max_response_bytes", "-1"},
+                                                                                   {"backoff", "-2"},
+                                                                                   {"max_views", "0"}})
+    EXPECT_EQ(make_refiner("vlm", {{"model", "m"}, {key, value}}).status().code(), StatusCode::kInvalidArgument)
+        << key << "=" << value;
   auto unconfigured = std::move(*make_refiner("vlm"));
   RefineInput in{&s.model.mesh, nullptr, nullptr, &s.labels, &s.views, &MaterialTable::paper_default()};
   EXPECT_EQ(unconfigured->refine(in).status().code(), StatusCode::kInvalidArgument);  // no model named

@@ -161,6 +161,8 @@ TEST(ToolRefine, RefinesAProjectFolderLikeProjectDoes) {
   EXPECT_EQ(label_columns(test::read_file(dir + "/vlm/faces.csv")),
             label_columns(test::read_file(dir + "/a/faces.csv")));
   EXPECT_NE(test::read_file(dir + "/vlm/refine.json").find("labels stand"), std::string::npos);
+  // A vlm without a model name is a usage error.
+  EXPECT_EQ(run_tool("refine " + quote(dir + "/a") + " -o " + quote(dir + "/x") + " --refiner vlm").exit_code, 2);
   // Not a project folder.
   r = run_tool("refine " + quote(dir));
   EXPECT_EQ(r.exit_code, 1);

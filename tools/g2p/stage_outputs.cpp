@@ -14,14 +14,20 @@ void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& defau
       "Refiner: none, smooth, vlm (vlm needs --refine-set model=NAME --refine-set url=URL); default " + default_name);
   cmd->add_option("--refine-set", args.settings,
                   "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps; vlm: url, model, "
-                  "api_key_env, timeout, retries, backoff, prompt_file, max_views)");
+                  "api_key_env, timeout, retries, backoff, max_response_bytes, prompt_file, max_views)");
 }
 
 int refine_projection(const std::string& command, const RefineArgs& args, const Model& model,
                       const std::vector<View>& views, const MaterialTable& table,
                       const PartitionOptions& partition_options, Projection& projection, nlohmann::json& report) {
   report = {{"refiner", args.name}};
-  if (args.name == "none") return kExitOk;
+  if (args.name == "none") {
+    if (!args.settings.empty()) {
+      std::cerr << "g2p " << command << ": --refine-set needs a --refiner other than none\n";
+      return kExitUsage;
+    }
+    return kExitOk;
+  }
   BackendSettings settings;
   for (const std::string& kv : args.settings) {
     const std::size_t eq = kv.find('=');
@@ -38,6 +44,12 @@ int refine_projection(const std::string& command, const RefineArgs& args, const 
   }
   RefineInput in{&model.mesh, &projection.graph, &projection.votes, &projection.labels, &views, &table};
   Result<RefineResult> refined = (*refiner)->refine(in);
+  if (!refined.ok() &&
+      (refined.status().code() == StatusCode::kInvalidArgument || refined.status().code() == StatusCode::kNotFound)) {
+    // Missing settings (no model name, an unreadable prompt file): the command line is wrong.
+    std::cerr << "g2p " << command << ": " << refined.status().message() << "\n";
+    return kExitUsage;
+  }
   if (!refined.ok()) {
     // An optional stage: its failure loses nothing, the projected labels stand.
     std::cerr << "g2p " << command

@@ -110,10 +110,11 @@ class OpenAiClient final : public VlmClient {
     const std::string url =
         o_.base_url + (o_.base_url.empty() || o_.base_url.back() != '/' ? "/" : "") + "chat/completions";
 
-    double wait_s = o_.backoff_s;
+    double wait_s = o_.backoff_s;  // before the next attempt: backoff, 2 backoff, 4 backoff... or Retry-After
     std::string last_error;
     for (int attempt = 0; attempt <= o_.retries; ++attempt) {
       if (attempt > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
+      const double next_wait = o_.backoff_s * static_cast<double>(1 << std::min(attempt + 1, 20));
       CURL* curl = curl_easy_init();
       if (curl == nullptr) return Status::Internal("vlm: libcurl could not start");
       Body body{{}, o_.max_response_bytes};
@@ -150,7 +151,6 @@ class OpenAiClient final : public VlmClient {
         if (code == CURLE_COULDNT_CONNECT || code == CURLE_COULDNT_RESOLVE_HOST) return Status::Unavailable(last_error);
       } else if (status == 429 || status >= 500) {
         last_error = "vlm: " + url + " answered HTTP " + std::to_string(status);
-        if (retry_after > 0.0) wait_s = std::min(retry_after, 60.0);
       } else if (status != 200) {
         return Status::Unavailable("vlm: " + url + " answered HTTP " + std::to_string(status) + ": " +
                                    body.data.substr(0, 300));
@@ -163,7 +163,7 @@ class OpenAiClient final : public VlmClient {
           return Status::ParseError("vlm: the chat completion has no text content");
         return message["content"].get<std::string>();
       }
-      wait_s *= 2.0;
+      wait_s = retry_after > 0.0 ? std::min(retry_after, 60.0) : next_wait;
     }
     return Status::Unavailable(last_error + " (gave up after " + std::to_string(o_.retries + 1) + " attempts)");
   }
@@ -178,8 +178,10 @@ Result<std::unique_ptr<VlmClient>> make_openai_client(const OpenAiClientOptions&
   if (options.model.empty()) return Status::InvalidArgument("vlm: a model name is needed");
   if (options.base_url.rfind("http://", 0) != 0 && options.base_url.rfind("https://", 0) != 0)
     return Status::InvalidArgument("vlm: base URL must start with http:// or https://, got '" + options.base_url + "'");
-  if (!(options.timeout_s > 0.0) || options.retries < 0 || options.retries > 10 || options.max_response_bytes == 0)
-    return Status::InvalidArgument("vlm: timeout must be > 0 s, retries in 0..10, max response > 0 bytes");
+  if (!(options.timeout_s >= 0.001 && options.timeout_s <= 86400.0) || options.retries < 0 || options.retries > 10 ||
+      options.max_response_bytes == 0 || !(options.backoff_s >= 0.0 && options.backoff_s <= 3600.0))
+    return Status::InvalidArgument(
+        "vlm: need 0.001 <= timeout <= 86400 s, retries in 0..10, backoff in [0, 3600] s, max response > 0 bytes");
   init_curl_once();
   return std::unique_ptr<VlmClient>(std::make_unique<OpenAiClient>(options));
 }

@@ -24,7 +24,9 @@
 // neighbour (separate pieces) keep their class.
 //
 // Settings: lambda (default 1), island (area fraction, default 0.002), sweeps (default 50).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "refine/backends.h"
@@ -102,6 +104,10 @@ class SmoothRefiner final : public Refiner {
     RefineResult result;
     std::vector<int>& label = result.labels;
     label = in.labels->label;
+    if (std::all_of(label.begin(), label.end(), [](int l) { return l == kUnknownLabel; })) {
+      result.notes.push_back("smooth: no face has a label (no view saw the object?); nothing to smooth");
+      return result;
+    }
     std::vector<float> cost(static_cast<std::size_t>(k));
     int sweeps_done = 0, moved_total = 0;
     for (int sweep = 0; sweep < sweeps_; ++sweep) {
@@ -138,6 +144,11 @@ class SmoothRefiner final : public Refiner {
       for (int f = 0; f < nf; ++f) islands += label[static_cast<std::size_t>(f)] != before[static_cast<std::size_t>(f)];
     }
     const MaterialTable* table = in.table;
+    auto percent = [](double fraction) {
+      char text[32];
+      std::snprintf(text, sizeof(text), "%g%%", 100.0 * fraction);
+      return std::string(text);
+    };
     auto name = [table](int l) {
       return table != nullptr && table->valid_label(l) ? table->operator[](l).name : std::to_string(l);
     };
@@ -146,8 +157,8 @@ class SmoothRefiner final : public Refiner {
       if (from == to) continue;
       const bool by_island = after_smoothing[static_cast<std::size_t>(f)] != to;
       result.changes.push_back({f, from, to,
-                                by_island ? "island smaller than " + std::to_string(island_ * 100) +
-                                                "% of the area, surrounded by " + name(to)
+                                by_island ? "island smaller than " + percent(island_) +
+                                                " of the area, merged into the neighbouring " + name(to)
                                           : "label smoothing: " + name(to) + " lowers the energy (neighbours agree)"});
     }
     result.notes.push_back("smooth: " + std::to_string(sweeps_done) + " ICM sweeps moved " +

@@ -44,7 +44,8 @@ class VlmRefiner final : public Refiner {
     for (const auto& [key, value] : settings) {
       char* end = nullptr;
       const double number = std::strtod(value.c_str(), &end);
-      const bool is_number = end != value.c_str() && *end == '\0';
+      const bool is_number = end != value.c_str() && *end == '\0' && std::isfinite(number);
+      const bool is_count = is_number && number >= 0.0 && number == std::floor(number);
       if (key == "url")
         options_.base_url = value;
       else if (key == "model")
@@ -55,13 +56,13 @@ class VlmRefiner final : public Refiner {
         prompt_file_ = value;
       else if (key == "timeout" && is_number)
         options_.timeout_s = number;
-      else if (key == "retries" && is_number)
+      else if (key == "retries" && is_count && number <= 10)
         options_.retries = static_cast<int>(number);
       else if (key == "backoff" && is_number)
         options_.backoff_s = number;
-      else if (key == "max_response_bytes" && is_number)
+      else if (key == "max_response_bytes" && is_count && number >= 1 && number <= 1e9)
         options_.max_response_bytes = static_cast<std::size_t>(number);
-      else if (key == "max_views" && is_number && number >= 1)
+      else if (key == "max_views" && is_count && number >= 1 && number <= 100)
         max_views_ = static_cast<int>(number);
       else
         return Status::InvalidArgument("vlm: bad setting " + key + "=" + value +

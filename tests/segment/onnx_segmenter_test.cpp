@@ -66,6 +66,12 @@ TEST(OnnxSegmenter, ModelCardErrors) {
                    R"({"model": "nope.onnx", "input": {"width": 32, "height": 32}, "classes": ["Wood"]})");
   EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/missing_model.json"}}).status().code(),
             StatusCode::kParseError);
+  test::write_file(dir + "/format.json", R"({"format": "something-else", "model": "tiny_seg.onnx",
+                                             "input": {"width": 32, "height": 32}, "classes": ["Wood"]})");
+  EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/format.json"}}).status().code(), StatusCode::kParseError);
+  test::write_file(dir + "/v2.json", R"({"version": 2, "model": "tiny_seg.onnx",
+                                         "input": {"width": 32, "height": 32}, "classes": ["Wood"]})");
+  EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/v2.json"}}).status().code(), StatusCode::kUnsupported);
   // The card promises two classes, the network gives three channels.
   test::write_file(dir + "/two.json", R"({"model": "tiny_seg.onnx", "input": {"width": 32, "height": 32},
                                           "classes": ["Wood", "Metal"]})");

@@ -30,6 +30,15 @@ TEST(OracleSegmenter, LabelsEveryPixelWithItsMaterialsGroundTruth) {
   EXPECT_GT(labelled, 1000);
 }
 
+TEST(OracleSegmenter, AnonymizedNamesKeepTheDefaultKey) {
+  Result<Model> model = load_model(test::asset_path("Avocado"));
+  ASSERT_TRUE(model.ok());
+  anonymize_names(*model);
+  EXPECT_EQ(model->materials[0].name, "material_0");
+  auto oracle = std::move(*make_segmenter("oracle", {{"labels", test::labels_json_path()}}));
+  EXPECT_TRUE(oracle->set_model(*model, MaterialTable::paper_default()).ok());  // key "Avocado" from the path
+}
+
 TEST(OracleSegmenter, LabelFileErrors) {
   const MaterialTable& table = MaterialTable::paper_default();
   EXPECT_EQ(material_labels_from_json(R"({"models": {"A": {"labels": {}}}})", "B", table, 1).status().code(),

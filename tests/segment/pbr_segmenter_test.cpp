@@ -110,12 +110,53 @@ TEST(PbrSegmenter, SettingsAndErrors) {
       }
 
   EXPECT_EQ(make_segmenter("pbr", {{"colour", "on"}}).status().code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(make_segmenter("pbr", {{"temperature", "-1"}}).status().code(), StatusCode::kInvalidArgument);
+  for (const char* t : {"-1", "2x", "inf", "nan", ""})
+    EXPECT_EQ(make_segmenter("pbr", {{"temperature", t}}).status().code(), StatusCode::kInvalidArgument) << t;
   EXPECT_EQ(make_segmenter("deeplab").status().code(), StatusCode::kNotFound);
   auto fresh = std::move(*make_segmenter("pbr"));
   EXPECT_EQ(fresh->segment(views[0]).status().code(), StatusCode::kInvalidArgument);  // no set_model
   ASSERT_TRUE(fresh->set_model(model, table()).ok());
   EXPECT_EQ(fresh->segment(View{}).status().code(), StatusCode::kInvalidArgument);  // no face IDs
+}
+
+TEST(PbrSegmenter, ObjectNamePrefixSharedByAllNamesCountsLess) {
+  // "GlamVelvetSofa_feet": the shared prefix names the object (velvet), the rest the part.
+  // The metallic channel then decides; without the prefix rule "velvet" would outvote it.
+  const Eigen::Vector4f gold(1.f, 0.8f, 0.7f, 1.f), navy(0.01f, 0.01f, 0.05f, 1.f);
+  Model model =
+      test::boxes({{"Chesterfield_Velvet_feet", gold, 0.8f, 0.4f}, {"Chesterfield_Velvet_cushion", navy, 0.f, 0.8f}},
+                  "PbrSegmenter.Prefix");
+  const std::vector<View> views = test::render(model, 3, 48);
+  auto s = std::move(*make_segmenter("pbr"));
+  ASSERT_TRUE(s->set_model(model, table()).ok());
+  const std::vector<LabelMap> maps = segment_all(*s, views);
+  EXPECT_EQ(test::majority_label(model, views, maps, 0), label("Metal"));
+  EXPECT_EQ(test::majority_label(model, views, maps, 1), label("Fabric"));  // cushion: a Fabric word of its own
+  // A prefix that is the material word itself still counts (a quarter), e.g. "Fabric_red"/"Fabric_blue".
+  const Eigen::Vector4f grey(0.5f, 0.5f, 0.5f, 1.f);
+  Model fabrics =
+      test::boxes({{"Stoff_rot", grey, 0.f, 0.5f}, {"Stoff_blau", grey, 0.f, 0.5f}}, "PbrSegmenter.Prefix2");
+  const std::vector<View> v2 = test::render(fabrics, 2, 32);
+  ASSERT_TRUE(s->set_model(fabrics, table()).ok());
+  EXPECT_EQ(test::majority_label(fabrics, v2, segment_all(*s, v2), 0), label("Fabric"));
+}
+
+TEST(PbrSegmenter, AccentsAndSharpS) {
+  const Eigen::Vector4f grey(0.45f, 0.45f, 0.45f, 1.f);
+  // "chêne" (oak), "mármol" (marble) and "Gußeisen" (cast iron, with a sharp s).
+  Model model = test::boxes({{"ch\xC3\xAAne_clair", grey, 0.f, 0.5f},
+                             {"m\xC3\xA1rmol_blanco", grey, 0.f, 0.5f},
+                             {"Gu\xC3\x9F"
+                              "eisen",
+                              grey, 0.f, 0.5f}},
+                            "PbrSegmenter.Accents");
+  const std::vector<View> views = test::render(model, 3, 48);
+  auto s = std::move(*make_segmenter("pbr"));
+  ASSERT_TRUE(s->set_model(model, table()).ok());
+  const std::vector<LabelMap> maps = segment_all(*s, views);
+  EXPECT_EQ(test::majority_label(model, views, maps, 0), label("Wood"));
+  EXPECT_EQ(test::majority_label(model, views, maps, 1), label("Stone"));
+  EXPECT_EQ(test::majority_label(model, views, maps, 2), label("Metal"));  // "gusseisen" holds "eisen"
 }
 
 TEST(PbrSegmenter, CustomVocabularyByClassName) {

@@ -9,18 +9,8 @@
 namespace g2p {
 namespace {
 
-Mesh unit_cube() {
-  std::vector<Eigen::Vector3f> p;
-  std::vector<std::array<unsigned, 3>> t;
-  test::box_geometry({0.f, 0.f, 0.f}, {1.f, 1.f, 1.f}, p, t);
-  Mesh m;
-  m.positions = p;
-  for (const auto& tri : t) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
-  return m;
-}
-
 TEST(Mesh, BoundsAndArea) {
-  const Mesh cube = unit_cube();
+  const Mesh cube = test::box_mesh({0.f, 0.f, 0.f}, {1.f, 1.f, 1.f});
   const Eigen::AlignedBox3d box = bounds(cube);
   EXPECT_TRUE(box.min().isApprox(Eigen::Vector3d::Zero()));
   EXPECT_TRUE(box.max().isApprox(Eigen::Vector3d::Ones()));
@@ -30,7 +20,7 @@ TEST(Mesh, BoundsAndArea) {
 }
 
 TEST(Mesh, FaceNormalsPointOutward) {
-  const Mesh cube = unit_cube();
+  const Mesh cube = test::box_mesh({0.f, 0.f, 0.f}, {1.f, 1.f, 1.f});
   const Eigen::Vector3d centre(0.5, 0.5, 0.5);
   for (int f = 0; f < cube.num_faces(); ++f) {
     const Eigen::Vector3i& t = cube.triangles[f];
@@ -42,7 +32,7 @@ TEST(Mesh, FaceNormalsPointOutward) {
 }
 
 TEST(Mesh, VertexNormalsOfACubeCornerAreDiagonal) {
-  Mesh cube = unit_cube();
+  Mesh cube = test::box_mesh({0.f, 0.f, 0.f}, {1.f, 1.f, 1.f});
   compute_vertex_normals(cube);
   ASSERT_EQ(cube.normals.size(), cube.positions.size());
   for (int v = 0; v < cube.num_vertices(); ++v) {
@@ -53,7 +43,7 @@ TEST(Mesh, VertexNormalsOfACubeCornerAreDiagonal) {
 }
 
 TEST(Mesh, FlagsRepeatedAndCollinearFacesAsDegenerate) {
-  Mesh m = unit_cube();
+  Mesh m = test::box_mesh({0.f, 0.f, 0.f}, {1.f, 1.f, 1.f});
   m.positions.push_back({2.f, 0.f, 0.f});
   m.positions.push_back({3.f, 0.f, 0.f});
   m.triangles.emplace_back(1, 8, 9);  // collinear along x
@@ -67,7 +57,7 @@ TEST(Mesh, FlagsRepeatedAndCollinearFacesAsDegenerate) {
 }
 
 TEST(Mesh, ValidateNamesTheOffendingElement) {
-  Mesh m = unit_cube();
+  Mesh m = test::box_mesh({0.f, 0.f, 0.f}, {1.f, 1.f, 1.f});
   EXPECT_TRUE(validate(m).ok());
 
   Mesh bad_index = m;

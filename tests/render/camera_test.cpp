@@ -10,16 +10,6 @@
 namespace g2p {
 namespace {
 
-Mesh box_mesh(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
-  std::vector<Eigen::Vector3f> p;
-  std::vector<std::array<unsigned, 3>> t;
-  test::box_geometry(lo, hi, p, t);
-  Mesh m;
-  m.positions = p;
-  for (const auto& tri : t) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
-  return m;
-}
-
 TEST(Camera, LookAtIsARightHandedOpenCvFrame) {
   const Camera c = Camera::look_at({0, -5, 0}, {0, 0, 0}, {0, 0, 1}, 640, 480, 40);
   EXPECT_TRUE(c.validate().ok());
@@ -66,7 +56,7 @@ class Layouts : public testing::TestWithParam<std::tuple<ViewLayout, bool, int>>
 
 TEST_P(Layouts, FrameTheWholeObjectAndLookAtItsCentre) {
   const auto [layout, ortho, count] = GetParam();
-  const Mesh mesh = box_mesh({-0.3f, -0.1f, 0.f}, {0.5f, 0.2f, 1.2f});
+  const Mesh mesh = test::box_mesh({-0.3f, -0.1f, 0.f}, {0.5f, 0.2f, 1.2f});
   ViewOptions o;
   o.layout = layout;
   o.orthographic = ortho;
@@ -102,7 +92,7 @@ INSTANTIATE_TEST_SUITE_P(All, Layouts,
                                           testing::Bool(), testing::Values(1, 11, 24)));
 
 TEST(ViewSet, DefaultIsElevenViewsWithTopBottomAndFront) {
-  const Mesh mesh = box_mesh({-1, -1, -1}, {1, 1, 1});
+  const Mesh mesh = test::box_mesh({-1, -1, -1}, {1, 1, 1});
   Result<std::vector<Camera>> cams = make_views(mesh);
   ASSERT_TRUE(cams.ok());
   ASSERT_EQ(cams->size(), 11u);
@@ -117,7 +107,7 @@ TEST(ViewSet, DefaultIsElevenViewsWithTopBottomAndFront) {
 }
 
 TEST(ViewSet, RejectsBadOptions) {
-  const Mesh mesh = box_mesh({0, 0, 0}, {1, 1, 1});
+  const Mesh mesh = test::box_mesh({0, 0, 0}, {1, 1, 1});
   ViewOptions o;
   o.num_views = 0;
   EXPECT_EQ(make_views(mesh, o).status().code(), StatusCode::kInvalidArgument);
@@ -128,7 +118,7 @@ TEST(ViewSet, RejectsBadOptions) {
 }
 
 TEST(CamerasJson, RoundTrip) {
-  const Mesh mesh = box_mesh({0, 0, 0}, {1, 2, 3});
+  const Mesh mesh = test::box_mesh({0, 0, 0}, {1, 2, 3});
   ViewOptions o;
   o.orthographic = true;
   o.num_views = 5;

@@ -158,6 +158,16 @@ void box_geometry(const Eigen::Vector3f& min, const Eigen::Vector3f& max, std::v
   }
 }
 
+Mesh box_mesh(const Eigen::Vector3f& min, const Eigen::Vector3f& max) {
+  std::vector<Eigen::Vector3f> p;
+  std::vector<std::array<unsigned, 3>> t;
+  box_geometry(min, max, p, t);
+  Mesh m;
+  m.positions = p;
+  for (const auto& tri : t) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
+  return m;
+}
+
 void cylinder_geometry(float radius, float y0, float y1, int segments, std::vector<Eigen::Vector3f>& positions,
                        std::vector<std::array<unsigned, 3>>& triangles) {
   const unsigned b = static_cast<unsigned>(positions.size());

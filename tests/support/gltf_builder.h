@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "g2p/mesh.h"
+
 namespace g2p::test {
 
 class GltfBuilder {
@@ -68,6 +70,9 @@ class GltfBuilder {
 // An axis-aligned box as 8 vertices and 12 outward-facing triangles.
 void box_geometry(const Eigen::Vector3f& min, const Eigen::Vector3f& max, std::vector<Eigen::Vector3f>& positions,
                   std::vector<std::array<unsigned, 3>>& triangles);
+
+// The same box as a libg2p Mesh (no provenance).
+Mesh box_mesh(const Eigen::Vector3f& min, const Eigen::Vector3f& max);
 
 // A closed cylinder along +Y (glTF up) with `segments` sides.
 void cylinder_geometry(float radius, float y0, float y1, int segments, std::vector<Eigen::Vector3f>& positions,

@@ -8,6 +8,7 @@
 #include "g2p/mesh.h"
 #include "g2p/model.h"
 #include "g2p/project.h"
+#include "g2p/properties.h"
 #include "g2p/refine.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"

@@ -1,0 +1,121 @@
+// Exact mass properties of solids and thin shells bounded by triangle meshes.
+//
+// Solid: each triangle (a, b, c), taken relative to a reference point r inside
+// the mesh's bounding box (for numerical accuracy), closes a tetrahedron with
+// r of signed volume V = a . (b x c) / 6; summed over a closed outward mesh
+// the signed volumes give the enclosed volume, and the tetrahedra's first and
+// second moments give the centre of mass and the covariance
+//   C = sum V / 20 (a a^T + b b^T + c c^T + s s^T),  s = a + b + c
+// (the second moment of a tetrahedron with a vertex at the origin).
+// Shell: each triangle of area A contributes its centroid and
+//   sum A / 12 (a a^T + b b^T + c c^T + s s^T)
+// (the second moment of a triangle), times rho * t.
+// Inertia about a point from the covariance: I = trace(C) Id - C.
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "g2p/properties.h"
+
+namespace g2p {
+namespace {
+
+Eigen::Matrix3d inertia_from_covariance(const Eigen::Matrix3d& c) {
+  return c.trace() * Eigen::Matrix3d::Identity() - c;
+}
+
+struct Moments {
+  double zeroth = 0.0;                               // volume or area
+  Eigen::Vector3d first = Eigen::Vector3d::Zero();   // integral of x
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();  // integral of x x^T
+};
+
+MassProperties finish(const Moments& m, double mass_per_unit, const Eigen::Vector3d& reference, double area) {
+  MassProperties p;
+  p.area_m2 = area;
+  p.mass_kg = mass_per_unit * m.zeroth;
+  const Eigen::Vector3d com_local = m.first / m.zeroth;
+  p.center_of_mass = reference + com_local;
+  // Covariance about the centre of mass (parallel-axis shift of the second moment).
+  const Eigen::Matrix3d c = mass_per_unit * (m.second - m.zeroth * com_local * com_local.transpose());
+  p.inertia = inertia_from_covariance(0.5 * (c + c.transpose()));
+  return p;
+}
+
+}  // namespace
+
+Eigen::Vector3d MassProperties::principal_moments() const {
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvalues();
+}
+
+Eigen::Matrix3d MassProperties::principal_axes() const {
+  Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvectors();
+  if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
+  return axes;
+}
+
+Result<MassProperties> solid_mass_properties(const Mesh& mesh, double density_kg_m3) {
+  G2P_RETURN_IF_ERROR(validate(mesh).with_context("mass properties"));
+  if (mesh.triangles.empty()) return Status::InvalidArgument("mass properties: the mesh has no triangles");
+  if (!(density_kg_m3 > 0.0) || !std::isfinite(density_kg_m3))
+    return Status::InvalidArgument("mass properties: density must be > 0 kg/m^3");
+  const Eigen::Vector3d reference = bounds(mesh).center();
+  Moments m;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>() - reference;
+    const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>() - reference;
+    const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>() - reference;
+    const double v = a.dot(b.cross(c)) / 6.0;
+    const Eigen::Vector3d s = a + b + c;
+    m.zeroth += v;
+    m.first += v * s / 4.0;
+    m.second += v / 20.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+  }
+  const double extent = bounds(mesh).diagonal().norm();
+  if (!(m.zeroth > 1e-12 * extent * extent * extent))
+    return Status::InvalidArgument("mass properties: the enclosed volume is " + std::to_string(m.zeroth) +
+                                   " m^3; the mesh must be closed and wound outward (complete it first)");
+  MassProperties p = finish(m, density_kg_m3, reference, surface_area(mesh));
+  p.volume_m3 = m.zeroth;
+  return p;
+}
+
+Result<MassProperties> shell_mass_properties(const Mesh& mesh, double density_kg_m3, double thickness_m) {
+  G2P_RETURN_IF_ERROR(validate(mesh).with_context("mass properties"));
+  if (!(density_kg_m3 > 0.0) || !std::isfinite(density_kg_m3) || !(thickness_m > 0.0) || !std::isfinite(thickness_m))
+    return Status::InvalidArgument("mass properties: density and wall thickness must be > 0");
+  const Eigen::Vector3d reference = bounds(mesh).center();
+  Moments m;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>() - reference;
+    const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>() - reference;
+    const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>() - reference;
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const Eigen::Vector3d s = a + b + c;
+    m.zeroth += area;
+    m.first += area * s / 3.0;
+    m.second += area / 12.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+  }
+  if (!(m.zeroth > 0.0)) return Status::InvalidArgument("mass properties: the surface has no area");
+  MassProperties p = finish(m, density_kg_m3 * thickness_m, reference, m.zeroth);
+  p.volume_m3 = m.zeroth * thickness_m;
+  return p;
+}
+
+MassProperties combine(const std::vector<MassProperties>& parts) {
+  MassProperties total;
+  for (const MassProperties& p : parts) {
+    total.mass_kg += p.mass_kg;
+    total.volume_m3 += p.volume_m3;
+    total.area_m2 += p.area_m2;
+    total.center_of_mass += p.mass_kg * p.center_of_mass;
+  }
+  if (!(total.mass_kg > 0.0)) return total;
+  total.center_of_mass /= total.mass_kg;
+  for (const MassProperties& p : parts) {
+    const Eigen::Vector3d d = p.center_of_mass - total.center_of_mass;
+    total.inertia += p.inertia + p.mass_kg * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  }
+  return total;
+}
+
+}  // namespace g2p

@@ -1,0 +1,139 @@
+// Mass properties against closed forms.
+#include "g2p/properties.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "g2p/io.h"
+#include "support/gltf_builder.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+Mesh from_geometry(const std::vector<Eigen::Vector3f>& p, const std::vector<std::array<unsigned, 3>>& t) {
+  Mesh m;
+  m.positions = p;
+  for (const auto& tri : t) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
+  return m;
+}
+
+// A UV sphere of radius r with n rings and 2n segments, wound outward.
+Mesh sphere(double r, int n) {
+  Mesh m;
+  m.positions.emplace_back(0.f, 0.f, static_cast<float>(r));
+  for (int i = 1; i < n; ++i) {
+    const double theta = M_PI * i / n;
+    for (int j = 0; j < 2 * n; ++j) {
+      const double phi = M_PI * j / n;
+      m.positions.emplace_back(r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi),
+                               r * std::cos(theta));
+    }
+  }
+  m.positions.emplace_back(0.f, 0.f, static_cast<float>(-r));
+  const int south = m.num_vertices() - 1;
+  auto ring = [n](int i, int j) { return 1 + (i - 1) * 2 * n + (j % (2 * n)); };
+  for (int j = 0; j < 2 * n; ++j) m.triangles.emplace_back(0, ring(1, j), ring(1, j + 1));
+  for (int i = 1; i < n - 1; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      m.triangles.emplace_back(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
+      m.triangles.emplace_back(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
+    }
+  for (int j = 0; j < 2 * n; ++j) m.triangles.emplace_back(south, ring(n - 1, j + 1), ring(n - 1, j));
+  return m;
+}
+
+void expect_relative(double got, double want, double tolerance, const char* what) {
+  EXPECT_NEAR(got / want, 1.0, tolerance) << what << ": " << got << " vs " << want;
+}
+
+TEST(MassProperties, UnitCubeAndOffsetCube) {
+  for (const Eigen::Vector3f offset : {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(3, -2, 5)}) {
+    std::vector<Eigen::Vector3f> p;
+    std::vector<std::array<unsigned, 3>> t;
+    test::box_geometry(offset, offset + Eigen::Vector3f::Ones(), p, t);
+    Result<MassProperties> m = solid_mass_properties(from_geometry(p, t), 1000.0);
+    ASSERT_TRUE(m.ok()) << m.status().to_string();
+    EXPECT_NEAR(m->mass_kg, 1000.0, 1e-9);
+    EXPECT_NEAR(m->volume_m3, 1.0, 1e-12);
+    EXPECT_NEAR(m->area_m2, 6.0, 1e-9);
+    EXPECT_TRUE(m->center_of_mass.isApprox((offset + Eigen::Vector3f::Constant(0.5f)).cast<double>(), 1e-9));
+    // A cube's inertia about its centre: m a^2 / 6 on the diagonal, no products.
+    EXPECT_TRUE(m->inertia.isApprox(Eigen::Matrix3d::Identity() * 1000.0 / 6.0, 1e-9)) << m->inertia;
+  }
+}
+
+TEST(MassProperties, SphereCylinderAndShellWithinTessellationError) {
+  // Sphere r = 0.5 m, steel: I = 2/5 m r^2. 128 rings: tessellation error well under 0.1 %.
+  const double r = 0.5;
+  Result<MassProperties> s = solid_mass_properties(sphere(r, 128), 7800.0);
+  ASSERT_TRUE(s.ok());
+  const double volume = 4.0 / 3.0 * M_PI * r * r * r;
+  expect_relative(s->volume_m3, volume, 1e-3, "sphere volume");
+  expect_relative(s->inertia(0, 0), 0.4 * s->mass_kg * r * r, 1e-3, "sphere Ixx");
+  expect_relative(s->inertia(2, 2), 0.4 * s->mass_kg * r * r, 1e-3, "sphere Izz");
+  EXPECT_LT(s->center_of_mass.norm(), 1e-9);
+
+  // Thin spherical shell: I = 2/3 m r^2, m = rho A t.
+  Result<MassProperties> shell = shell_mass_properties(sphere(r, 128), 2500.0, 0.004);
+  ASSERT_TRUE(shell.ok());
+  expect_relative(shell->mass_kg, 2500.0 * 4.0 * M_PI * r * r * 0.004, 1e-3, "shell mass");
+  expect_relative(shell->inertia(1, 1), 2.0 / 3.0 * shell->mass_kg * r * r, 1e-3, "shell Iyy");
+
+  // Closed cylinder (axis along glTF +Y), r = 0.1, h = 0.6: Iyy = m r^2 / 2, Ixx = m (3 r^2 + h^2) / 12.
+  std::vector<Eigen::Vector3f> p;
+  std::vector<std::array<unsigned, 3>> t;
+  test::cylinder_geometry(0.1f, 0.f, 0.6f, 512, p, t);
+  Result<MassProperties> c = solid_mass_properties(from_geometry(p, t), 700.0);
+  ASSERT_TRUE(c.ok());
+  expect_relative(c->volume_m3, M_PI * 0.01 * 0.6, 1e-3, "cylinder volume");
+  expect_relative(c->inertia(1, 1), 0.5 * c->mass_kg * 0.01, 1e-3, "cylinder Iyy");
+  expect_relative(c->inertia(0, 0), c->mass_kg * (3 * 0.01 + 0.36) / 12.0, 1e-3, "cylinder Ixx");
+  EXPECT_NEAR(c->center_of_mass.y(), 0.3, 1e-6);
+  // Principal axes: the symmetry axis carries the smallest moment.
+  EXPECT_NEAR(std::abs(c->principal_axes().col(0).y()), 1.0, 1e-6);
+  EXPECT_NEAR(c->principal_axes().determinant(), 1.0, 1e-9);
+}
+
+TEST(MassProperties, TwoMaterialHammerBalancesInItsHead) {
+  const std::string dir = test::scratch_dir("MassProperties.Hammer");
+  test::make_hammer().write(dir + "/hammer.glb");
+  Result<Model> model = load_model(dir + "/hammer.glb");
+  ASSERT_TRUE(model.ok());
+  // One mesh per material (steel 7800, oak 700 kg/m^3).
+  std::map<int, Mesh> parts;
+  for (int f = 0; f < model->mesh.num_faces(); ++f) {
+    Mesh& part = parts[model->mesh.face_source[f].material];
+    part.positions = model->mesh.positions;  // unused vertices do not count
+    part.triangles.push_back(model->mesh.triangles[f]);
+  }
+  const MassProperties head = *solid_mass_properties(parts[0], 7800.0);
+  const MassProperties handle = *solid_mass_properties(parts[1], 700.0);
+  const MassProperties hammer = combine({head, handle});
+  EXPECT_NEAR(hammer.mass_kg, head.mass_kg + handle.mass_kg, 1e-12);
+  // The head spans z in [0.30, 0.34] m (after the Y-up to Z-up import); the centre of mass lies in it.
+  EXPECT_GT(hammer.center_of_mass.z(), 0.30);
+  EXPECT_LT(hammer.center_of_mass.z(), 0.34);
+  EXPECT_GT(hammer.center_of_mass.z(), 0.5 * (0.0 + 0.34));  // far above the geometric middle
+  // Parallel axis: combined inertia about x exceeds the sum of the parts' own.
+  EXPECT_GT(hammer.inertia(0, 0), head.inertia(0, 0) + handle.inertia(0, 0));
+}
+
+TEST(MassProperties, Errors) {
+  EXPECT_EQ(solid_mass_properties(Mesh{}, 1000).status().code(), StatusCode::kInvalidArgument);
+  Mesh inward = test::box_mesh({0, 0, 0}, {1, 1, 1});
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  Result<MassProperties> bad = solid_mass_properties(inward, 1000);
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(bad.status().message().find("closed and wound outward"), std::string::npos);
+  EXPECT_EQ(solid_mass_properties(test::box_mesh({0, 0, 0}, {1, 1, 1}), -5).status().code(),
+            StatusCode::kInvalidArgument);
+  EXPECT_EQ(shell_mass_properties(test::box_mesh({0, 0, 0}, {1, 1, 1}), 1000, 0).status().code(),
+            StatusCode::kInvalidArgument);
+  EXPECT_EQ(combine({}).mass_kg, 0.0);
+}
+
+}  // namespace
+}  // namespace g2p

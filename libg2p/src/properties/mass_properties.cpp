@@ -29,6 +29,26 @@ struct Moments {
   Eigen::Matrix3d second = Eigen::Matrix3d::Zero();  // integral of x x^T
 };
 
+// Moments of the mesh about `reference`. `element` gives a triangle's weight w
+// (signed tetrahedron volume or area) from its vertices relative to the
+// reference; the first moment adds w s / first, the second
+// w / second (a a^T + b b^T + c c^T + s s^T), s = a + b + c.
+template <typename Element>
+Moments moments(const Mesh& mesh, const Eigen::Vector3d& reference, double first, double second, Element element) {
+  Moments m;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>() - reference;
+    const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>() - reference;
+    const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>() - reference;
+    const double w = element(a, b, c);
+    const Eigen::Vector3d s = a + b + c;
+    m.zeroth += w;
+    m.first += w * s / first;
+    m.second += w / second * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+  }
+  return m;
+}
+
 MassProperties finish(const Moments& m, double mass_per_unit, const Eigen::Vector3d& reference, double area) {
   MassProperties p;
   p.area_m2 = area;
@@ -59,17 +79,9 @@ Result<MassProperties> solid_mass_properties(const Mesh& mesh, double density_kg
   if (!(density_kg_m3 > 0.0) || !std::isfinite(density_kg_m3))
     return Status::InvalidArgument("mass properties: density must be > 0 kg/m^3");
   const Eigen::Vector3d reference = bounds(mesh).center();
-  Moments m;
-  for (const Eigen::Vector3i& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>() - reference;
-    const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>() - reference;
-    const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>() - reference;
-    const double v = a.dot(b.cross(c)) / 6.0;
-    const Eigen::Vector3d s = a + b + c;
-    m.zeroth += v;
-    m.first += v * s / 4.0;
-    m.second += v / 20.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
-  }
+  const Moments m = moments(mesh, reference, 4.0, 20.0, [](const auto& a, const auto& b, const auto& c) {
+    return a.dot(b.cross(c)) / 6.0;  // signed tetrahedron volume
+  });
   const double extent = bounds(mesh).diagonal().norm();
   if (!(m.zeroth > 1e-12 * extent * extent * extent))
     return Status::InvalidArgument("mass properties: the enclosed volume is " + std::to_string(m.zeroth) +
@@ -84,17 +96,9 @@ Result<MassProperties> shell_mass_properties(const Mesh& mesh, double density_kg
   if (!(density_kg_m3 > 0.0) || !std::isfinite(density_kg_m3) || !(thickness_m > 0.0) || !std::isfinite(thickness_m))
     return Status::InvalidArgument("mass properties: density and wall thickness must be > 0");
   const Eigen::Vector3d reference = bounds(mesh).center();
-  Moments m;
-  for (const Eigen::Vector3i& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>() - reference;
-    const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>() - reference;
-    const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>() - reference;
-    const double area = 0.5 * (b - a).cross(c - a).norm();
-    const Eigen::Vector3d s = a + b + c;
-    m.zeroth += area;
-    m.first += area * s / 3.0;
-    m.second += area / 12.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
-  }
+  const Moments m = moments(mesh, reference, 3.0, 12.0, [](const auto& a, const auto& b, const auto& c) {
+    return 0.5 * (b - a).cross(c - a).norm();  // triangle area
+  });
   if (!(m.zeroth > 0.0)) return Status::InvalidArgument("mass properties: the surface has no area");
   MassProperties p = finish(m, density_kg_m3 * thickness_m, reference, m.zeroth);
   p.volume_m3 = m.zeroth * thickness_m;

@@ -13,38 +13,6 @@
 namespace g2p {
 namespace {
 
-Mesh from_geometry(const std::vector<Eigen::Vector3f>& p, const std::vector<std::array<unsigned, 3>>& t) {
-  Mesh m;
-  m.positions = p;
-  for (const auto& tri : t) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
-  return m;
-}
-
-// A UV sphere of radius r with n rings and 2n segments, wound outward.
-Mesh sphere(double r, int n) {
-  Mesh m;
-  m.positions.emplace_back(0.f, 0.f, static_cast<float>(r));
-  for (int i = 1; i < n; ++i) {
-    const double theta = M_PI * i / n;
-    for (int j = 0; j < 2 * n; ++j) {
-      const double phi = M_PI * j / n;
-      m.positions.emplace_back(r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi),
-                               r * std::cos(theta));
-    }
-  }
-  m.positions.emplace_back(0.f, 0.f, static_cast<float>(-r));
-  const int south = m.num_vertices() - 1;
-  auto ring = [n](int i, int j) { return 1 + (i - 1) * 2 * n + (j % (2 * n)); };
-  for (int j = 0; j < 2 * n; ++j) m.triangles.emplace_back(0, ring(1, j), ring(1, j + 1));
-  for (int i = 1; i < n - 1; ++i)
-    for (int j = 0; j < 2 * n; ++j) {
-      m.triangles.emplace_back(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
-      m.triangles.emplace_back(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
-    }
-  for (int j = 0; j < 2 * n; ++j) m.triangles.emplace_back(south, ring(n - 1, j + 1), ring(n - 1, j));
-  return m;
-}
-
 void expect_relative(double got, double want, double tolerance, const char* what) {
   EXPECT_NEAR(got / want, 1.0, tolerance) << what << ": " << got << " vs " << want;
 }
@@ -54,7 +22,7 @@ TEST(MassProperties, UnitCubeAndOffsetCube) {
     std::vector<Eigen::Vector3f> p;
     std::vector<std::array<unsigned, 3>> t;
     test::box_geometry(offset, offset + Eigen::Vector3f::Ones(), p, t);
-    Result<MassProperties> m = solid_mass_properties(from_geometry(p, t), 1000.0);
+    Result<MassProperties> m = solid_mass_properties(test::mesh_from_geometry(p, t), 1000.0);
     ASSERT_TRUE(m.ok()) << m.status().to_string();
     EXPECT_NEAR(m->mass_kg, 1000.0, 1e-9);
     EXPECT_NEAR(m->volume_m3, 1.0, 1e-12);
@@ -68,7 +36,7 @@ TEST(MassProperties, UnitCubeAndOffsetCube) {
 TEST(MassProperties, SphereCylinderAndShellWithinTessellationError) {
   // Sphere r = 0.5 m, steel: I = 2/5 m r^2. 128 rings: tessellation error well under 0.1 %.
   const double r = 0.5;
-  Result<MassProperties> s = solid_mass_properties(sphere(r, 128), 7800.0);
+  Result<MassProperties> s = solid_mass_properties(test::sphere_mesh(r, 128), 7800.0);
   ASSERT_TRUE(s.ok());
   const double volume = 4.0 / 3.0 * M_PI * r * r * r;
   expect_relative(s->volume_m3, volume, 1e-3, "sphere volume");
@@ -77,7 +45,7 @@ TEST(MassProperties, SphereCylinderAndShellWithinTessellationError) {
   EXPECT_LT(s->center_of_mass.norm(), 1e-9);
 
   // Thin spherical shell: I = 2/3 m r^2, m = rho A t.
-  Result<MassProperties> shell = shell_mass_properties(sphere(r, 128), 2500.0, 0.004);
+  Result<MassProperties> shell = shell_mass_properties(test::sphere_mesh(r, 128), 2500.0, 0.004);
   ASSERT_TRUE(shell.ok());
   expect_relative(shell->mass_kg, 2500.0 * 4.0 * M_PI * r * r * 0.004, 1e-3, "shell mass");
   expect_relative(shell->inertia(1, 1), 2.0 / 3.0 * shell->mass_kg * r * r, 1e-3, "shell Iyy");
@@ -86,7 +54,7 @@ TEST(MassProperties, SphereCylinderAndShellWithinTessellationError) {
   std::vector<Eigen::Vector3f> p;
   std::vector<std::array<unsigned, 3>> t;
   test::cylinder_geometry(0.1f, 0.f, 0.6f, 512, p, t);
-  Result<MassProperties> c = solid_mass_properties(from_geometry(p, t), 700.0);
+  Result<MassProperties> c = solid_mass_properties(test::mesh_from_geometry(p, t), 700.0);
   ASSERT_TRUE(c.ok());
   expect_relative(c->volume_m3, M_PI * 0.01 * 0.6, 1e-3, "cylinder volume");
   expect_relative(c->inertia(1, 1), 0.5 * c->mass_kg * 0.01, 1e-3, "cylinder Iyy");

@@ -158,13 +158,42 @@ void box_geometry(const Eigen::Vector3f& min, const Eigen::Vector3f& max, std::v
   }
 }
 
+Mesh mesh_from_geometry(const std::vector<Eigen::Vector3f>& positions,
+                        const std::vector<std::array<unsigned, 3>>& triangles) {
+  Mesh m;
+  m.positions = positions;
+  for (const auto& tri : triangles) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
+  return m;
+}
+
 Mesh box_mesh(const Eigen::Vector3f& min, const Eigen::Vector3f& max) {
   std::vector<Eigen::Vector3f> p;
   std::vector<std::array<unsigned, 3>> t;
   box_geometry(min, max, p, t);
+  return mesh_from_geometry(p, t);
+}
+
+Mesh sphere_mesh(double r, int n) {
   Mesh m;
-  m.positions = p;
-  for (const auto& tri : t) m.triangles.emplace_back(tri[0], tri[1], tri[2]);
+  m.positions.emplace_back(0.f, 0.f, static_cast<float>(r));
+  for (int i = 1; i < n; ++i) {
+    const double theta = M_PI * i / n;
+    for (int j = 0; j < 2 * n; ++j) {
+      const double phi = M_PI * j / n;
+      m.positions.emplace_back(r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi),
+                               r * std::cos(theta));
+    }
+  }
+  m.positions.emplace_back(0.f, 0.f, static_cast<float>(-r));
+  const int south = m.num_vertices() - 1;
+  auto ring = [n](int i, int j) { return 1 + (i - 1) * 2 * n + (j % (2 * n)); };
+  for (int j = 0; j < 2 * n; ++j) m.triangles.emplace_back(0, ring(1, j), ring(1, j + 1));
+  for (int i = 1; i < n - 1; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      m.triangles.emplace_back(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
+      m.triangles.emplace_back(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
+    }
+  for (int j = 0; j < 2 * n; ++j) m.triangles.emplace_back(south, ring(n - 1, j + 1), ring(n - 1, j));
   return m;
 }
 

@@ -74,6 +74,13 @@ void box_geometry(const Eigen::Vector3f& min, const Eigen::Vector3f& max, std::v
 // The same box as a libg2p Mesh (no provenance).
 Mesh box_mesh(const Eigen::Vector3f& min, const Eigen::Vector3f& max);
 
+// A UV sphere of radius r about the origin with n rings and 2n segments, wound outward.
+Mesh sphere_mesh(double r, int n);
+
+// A Mesh of positions and index triples (no provenance).
+Mesh mesh_from_geometry(const std::vector<Eigen::Vector3f>& positions,
+                        const std::vector<std::array<unsigned, 3>>& triangles);
+
 // A closed cylinder along +Y (glTF up) with `segments` sides.
 void cylinder_geometry(float radius, float y0, float y1, int segments, std::vector<Eigen::Vector3f>& positions,
                        std::vector<std::array<unsigned, 3>>& triangles);

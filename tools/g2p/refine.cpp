@@ -114,6 +114,11 @@ int run_refine(const RefineCommandArgs& args) {
     return code;
   const std::string out = args.out.empty() ? args.dir + "/refined" : args.out;
   Status s = write_projection(out, *model, views, *projection, *table, report);
+  // The manifest travels along, so later stages can start from this folder.
+  nlohmann::json refined_manifest = manifest;
+  refined_manifest["refined_from"] = std::filesystem::absolute(args.dir).string();
+  refined_manifest["refiner"] = args.refine.name;
+  if (s.ok()) s = write_text_file(out + "/project.json", refined_manifest.dump(2) + "\n");
   if (!s.ok()) return fail(s);
   std::cout << "refined with '" << args.refine.name << "': " << projection->parts.size() << " parts -> " << out << "\n";
   print_parts(*projection, *table);

@@ -1,6 +1,7 @@
 // Umbrella header: the whole public API of libg2p.
 #pragma once
 
+#include "g2p/complete.h"
 #include "g2p/eval.h"
 #include "g2p/image.h"
 #include "g2p/io.h"

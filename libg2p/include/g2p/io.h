@@ -46,6 +46,11 @@ G2P_API Result<Model> load_model(const std::string& path, const ImportOptions& o
 G2P_API Result<Model> load_model_from_memory(const void* data, std::size_t size, const std::string& format_hint,
                                              const ImportOptions& options = {});
 
+// Writes a mesh's triangles by extension: .obj (text), .ply (binary
+// little-endian) or .stl (binary), in metres. Written under a temporary name
+// and renamed, so an existing file is never left half-overwritten.
+G2P_API Status write_mesh(const std::string& path, const Mesh& mesh);
+
 // Metres per unit for a unit name: "m", "cm", "mm", "in", "ft" (and long forms).
 G2P_API Result<double> parse_unit(const std::string& unit);
 

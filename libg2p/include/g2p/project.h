@@ -143,6 +143,17 @@ G2P_API LabelMap render_face_labels(const View& view, const std::vector<int>& fa
 G2P_API Status write_faces_csv(const std::string& path, const Model& model, const Projection& projection,
                                const MaterialTable& table);
 
+// Reads faces.csv back for `mesh` (written by write_faces_csv for the same
+// model): per-face labels (class names looked up in `table`) and the parts
+// they form. Fails, naming the line, when the row count, a source column or a
+// class name does not match.
+struct FacesFile {
+  std::vector<int> labels;     // per face
+  std::vector<int> face_part;  // per face
+  std::vector<Part> parts;     // indexed by the file's part column
+};
+G2P_API Result<FacesFile> read_faces_csv(const std::string& path, const Mesh& mesh, const MaterialTable& table);
+
 // A binary PLY of the mesh with per-face colours of the table (to look at).
 G2P_API Status write_labelled_ply(const std::string& path, const Mesh& mesh, const std::vector<int>& face_labels,
                                   const MaterialTable& table);

@@ -1,6 +1,8 @@
 // The project stage's files: faces.csv and a labelled PLY.
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <sstream>
 
 #include "core/file_util.h"
@@ -17,7 +19,89 @@ std::string csv_field(const std::string& s) {
   return q + "\"";
 }
 
+// Splits one CSV record (RFC 4180 quoting, no line breaks inside fields).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        out.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else if (c != '\r') {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+Result<FacesFile> read_faces_csv(const std::string& path, const Mesh& mesh, const MaterialTable& table) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path + ": cannot open");
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("source_mesh,source_face,source_material", 0) != 0)
+    return Status::ParseError(path + ": not a libg2p faces.csv (header)");
+  const std::size_t nf = mesh.triangles.size();
+  FacesFile out;
+  out.labels.reserve(nf);
+  out.face_part.reserve(nf);
+  int line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line == "\r") continue;
+    const std::vector<std::string> f = csv_fields(line);
+    auto where = [&] { return path + ":" + std::to_string(line_no) + ": "; };
+    if (f.size() != 8) return Status::ParseError(where() + "expected 8 fields, got " + std::to_string(f.size()));
+    const std::size_t face = out.labels.size();
+    if (face >= nf)
+      return Status::InvalidArgument(where() + "more rows than the mesh's " + std::to_string(nf) + " faces");
+    if (!mesh.face_source.empty()) {
+      const FaceSource& s = mesh.face_source[face];
+      if (f[0] != std::to_string(s.mesh) || f[1] != std::to_string(s.face) || f[2] != std::to_string(s.material))
+        return Status::InvalidArgument(where() + "the row does not describe face " + std::to_string(face) +
+                                       " of this model (another model's faces.csv?)");
+    }
+    int label = kUnknownLabel;
+    if (!f[4].empty()) {
+      label = table.find(f[4]);
+      if (label == kUnknownLabel) return Status::InvalidArgument(where() + "class '" + f[4] + "' is not in the table");
+    }
+    char* end = nullptr;
+    const long part = std::strtol(f[7].c_str(), &end, 10);
+    if (end == f[7].c_str() || *end != '\0' || part < -1 || part >= static_cast<long>(nf))
+      return Status::ParseError(where() + "bad part index '" + f[7] + "'");
+    out.labels.push_back(label);
+    out.face_part.push_back(static_cast<int>(part));
+    if (part >= 0) {
+      if (out.parts.size() <= static_cast<std::size_t>(part)) out.parts.resize(static_cast<std::size_t>(part) + 1);
+      Part& p = out.parts[static_cast<std::size_t>(part)];
+      if (!p.faces.empty() && p.label != label)
+        return Status::InvalidArgument(where() + "part " + f[7] + " mixes classes");
+      p.label = label;
+      p.faces.push_back(static_cast<int>(face));
+      p.area_m2 += face_area(mesh, static_cast<int>(face));
+    }
+  }
+  if (out.labels.size() != nf)
+    return Status::InvalidArgument(path + ": " + std::to_string(out.labels.size()) + " rows for a mesh of " +
+                                   std::to_string(nf) + " faces");
+  for (std::size_t p = 0; p < out.parts.size(); ++p)
+    if (out.parts[p].faces.empty())
+      return Status::InvalidArgument(path + ": part " + std::to_string(p) + " has no faces");
+  return out;
+}
 
 Status write_faces_csv(const std::string& path, const Model& model, const Projection& projection,
                        const MaterialTable& table) {

@@ -29,23 +29,18 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "core/settings.h"
 #include "refine/backends.h"
 
 namespace g2p {
 namespace {
-
-bool parse_double(const std::string& s, double& out) {
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  return end != s.c_str() && *end == '\0' && std::isfinite(out);
-}
 
 class SmoothRefiner final : public Refiner {
  public:
   Status configure(const BackendSettings& settings) override {
     for (const auto& [key, value] : settings) {
       double v = 0;
-      if (!parse_double(value, v))
+      if (!detail::parse_double(value, v))
         return Status::InvalidArgument("smooth: " + key + " needs a number, got '" + value + "'");
       if (key == "lambda" && v >= 0)
         lambda_ = v;

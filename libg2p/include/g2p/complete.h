@@ -1,0 +1,119 @@
+// complete: stage 5 of Gen2Physics, every part's surface patch closed into a
+// watertight volume, because mass properties need volumes and physics engines
+// need closed meshes. The paper calls the HoloPart model (a GPU diffusion
+// model); libg2p's default, `partition`, closes the whole object once on a
+// grid and splits its interior among the parts by nearest labelled surface,
+// so the parts tile the object's volume. Backends are swappable through
+// completer_registry(); the CGAL-based ones live in the optional GPL component
+// (g2p/complete_cgal.h).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "g2p/export.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/project.h"
+#include "g2p/registry.h"
+#include "g2p/segment.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// The object and its parts; all must outlive the call.
+struct CompletionInput {
+  const Mesh* mesh = nullptr;                // the whole object's surface (metres)
+  const std::vector<Part>* parts = nullptr;  // from the project stage; Part::faces index mesh->triangles
+  const MaterialTable* table = nullptr;      // optional: class names in messages and files
+};
+
+// The validation record of one closed mesh.
+struct G2P_API MeshChecks {
+  bool closed = false;    // every edge has exactly two triangles, wound in opposite directions
+  bool manifold = false;  // closed, and the triangles around every vertex form a single fan
+  bool outward = false;   // positive enclosed volume (normals point out)
+  bool self_intersection_free = false;
+  bool self_intersections_checked = false;  // false when the mesh was too large to test (see notes)
+  int num_components = 0;                   // edge-connected pieces
+  int num_self_intersections = 0;           // intersecting pairs of non-adjacent triangles found
+  double volume_m3 = 0.0;
+  double area_m2 = 0.0;
+  // Largest distance from a vertex of the closed mesh to the part's own patch,
+  // in metres and relative to the patch's bounding-box diagonal; -1 if no
+  // patch was given.
+  double max_distance_m = -1.0;
+  double relative_distance = -1.0;
+
+  // Closed, manifold, outward, positive volume and (when tested) free of
+  // self-intersections.
+  bool watertight() const;
+};
+
+struct MeshCheckOptions {
+  int max_faces_for_intersections = 2'000'000;  // larger meshes skip the self-intersection test
+};
+
+// Checks a closed-mesh candidate. `patch` (optional) is the surface it should
+// stay near, for the distance check.
+G2P_API MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch = nullptr,
+                                     const MeshCheckOptions& options = {});
+
+// One completed part.
+struct CompletedPart {
+  int part = -1;  // index into CompletionInput::parts
+  int label = kUnknownLabel;
+  Mesh mesh;  // closed, outward; positions in the object's frame
+  MeshChecks checks;
+  std::string backend;             // which backend produced `mesh` (after any fallback)
+  std::vector<std::string> notes;  // fallbacks, warnings
+  // Checks passed and the distance to the patch is within the completer's
+  // tolerance. A part that fails is kept but flagged; later stages say so.
+  bool ok = false;
+};
+
+struct Completion {
+  std::vector<CompletedPart> parts;  // one per input part, same order
+  // Volume of the whole closed object where the backend knows it (partition), else 0.
+  double object_volume_m3 = 0.0;
+  // Sum of the part volumes; with `partition` it equals object_volume_m3 up to
+  // the overlap where part borders meet the object's skin.
+  double parts_volume_m3 = 0.0;
+  double grid_spacing_m = 0.0;  // partition: the grid's cell size; 0 for other backends
+  std::vector<std::string> notes;
+};
+
+class G2P_API Completer {
+ public:
+  virtual ~Completer();
+  // Backend settings, key = value; unknown keys are errors.
+  virtual Status configure(const BackendSettings& settings);
+  // Closes every part of the object. A backend may fail single parts (their
+  // CompletedPart::ok = false) without failing the call; complete() below
+  // redoes those with a fallback.
+  virtual Result<Completion> complete(const CompletionInput& input) const = 0;
+};
+
+// Backends by name; libg2p registers "partition" (the default, no CGAL) and
+// "external" (a user command such as a HoloPart wrapper, docs/complete.md).
+// register_cgal_completers() adds "alpha-wrap" and "fill".
+G2P_API Registry<Completer>& completer_registry();
+G2P_API Result<std::unique_ptr<Completer>> make_completer(const std::string& name,
+                                                          const BackendSettings& settings = {});
+
+// Runs `completer`; parts it failed (not ok) are redone by `fallback` (if
+// given) and noted. The result always has one entry per part.
+G2P_API Result<Completion> complete(const CompletionInput& input, const Completer& completer,
+                                    const Completer* fallback = nullptr);
+
+// The part's own faces as a mesh (its open patch), vertices compacted.
+G2P_API Mesh part_patch(const Mesh& mesh, const Part& part);
+
+// ---- Output -----------------------------------------------------------------
+
+// Writes DIR/part_<i>_<class>.<ext> for every part and every extension in
+// `formats` ("obj", "ply", "stl"), and DIR/completion.json with the checks.
+G2P_API Status write_completion(const std::string& dir, const Completion& completion, const MaterialTable& table,
+                                const std::vector<std::string>& formats = {"obj"});
+
+}  // namespace g2p

@@ -1,0 +1,141 @@
+// The Completer base class, the registry, the fallback driver and the files
+// the stage writes.
+#include <nlohmann/json.hpp>
+
+#include "complete/backends.h"
+#include "core/file_util.h"
+#include "g2p/io.h"
+
+namespace g2p {
+
+Completer::~Completer() = default;
+
+Status Completer::configure(const BackendSettings& settings) {
+  if (settings.empty()) return Status::Ok();
+  return Status::InvalidArgument("this completer takes no settings (got '" + settings.begin()->first + "')");
+}
+
+Registry<Completer>& completer_registry() {
+  static Registry<Completer>* registry = [] {
+    auto* r = new Registry<Completer>();  // never destroyed: usable during static destruction
+    (void)r->add("partition", &make_partition_completer);
+    (void)r->add("external", &make_external_completer);
+    return r;
+  }();
+  return *registry;
+}
+
+Result<std::unique_ptr<Completer>> make_completer(const std::string& name, const BackendSettings& settings) {
+  Result<std::unique_ptr<Completer>> r = completer_registry().create(name);
+  if (!r.ok()) return r.status();
+  G2P_RETURN_IF_ERROR((*r)->configure(settings).with_context("completer '" + name + "'"));
+  return r;
+}
+
+Result<Completion> complete(const CompletionInput& input, const Completer& completer, const Completer* fallback) {
+  if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
+  const std::size_t np = input.parts->size();
+  Result<Completion> first = completer.complete(input);
+  Completion out;
+  if (first.ok()) {
+    out = std::move(*first);
+    if (out.parts.size() != np)
+      return Status::Internal("complete: the completer returned " + std::to_string(out.parts.size()) + " parts for " +
+                              std::to_string(np));
+  } else {
+    if (fallback == nullptr) return first.status();
+    out.notes.push_back("the completer failed (" + first.status().message() + "); every part uses the fallback");
+    out.parts.resize(np);
+    for (std::size_t p = 0; p < np; ++p) {
+      out.parts[p].part = static_cast<int>(p);
+      out.parts[p].label = (*input.parts)[p].label;
+    }
+  }
+  bool any_failed = false;
+  for (const CompletedPart& p : out.parts) any_failed |= !p.ok;
+  if (any_failed && fallback != nullptr) {
+    Result<Completion> second = fallback->complete(input);
+    if (!second.ok()) {
+      out.notes.push_back("the fallback failed too: " + second.status().message());
+    } else {
+      if (out.object_volume_m3 == 0.0) out.object_volume_m3 = second->object_volume_m3;
+      if (out.grid_spacing_m == 0.0) out.grid_spacing_m = second->grid_spacing_m;
+      for (std::size_t p = 0; p < np && p < second->parts.size(); ++p) {
+        CompletedPart& mine = out.parts[p];
+        if (mine.ok) continue;
+        CompletedPart& theirs = second->parts[p];
+        std::vector<std::string> notes = std::move(mine.notes);
+        notes.push_back("fell back to '" + theirs.backend + "'");
+        for (auto& n : theirs.notes) notes.push_back(std::move(n));
+        mine = std::move(theirs);
+        mine.notes = std::move(notes);
+      }
+      for (auto& n : second->notes) out.notes.push_back("fallback: " + n);
+    }
+  }
+  out.parts_volume_m3 = 0.0;
+  for (const CompletedPart& p : out.parts) out.parts_volume_m3 += p.checks.volume_m3;
+  return out;
+}
+
+namespace {
+
+nlohmann::json checks_json(const MeshChecks& c) {
+  nlohmann::json j;
+  j["watertight"] = c.watertight();
+  j["closed"] = c.closed;
+  j["manifold"] = c.manifold;
+  j["outward"] = c.outward;
+  j["self_intersections_checked"] = c.self_intersections_checked;
+  j["self_intersection_free"] = c.self_intersection_free;
+  j["num_self_intersections"] = c.num_self_intersections;
+  j["num_components"] = c.num_components;
+  j["volume_m3"] = c.volume_m3;
+  j["area_m2"] = c.area_m2;
+  j["max_distance_to_patch_m"] = c.max_distance_m;
+  j["relative_distance_to_patch"] = c.relative_distance;
+  return j;
+}
+
+}  // namespace
+
+Status write_completion(const std::string& dir, const Completion& completion, const MaterialTable& table,
+                        const std::vector<std::string>& formats) {
+  for (const std::string& f : formats)
+    if (f != "obj" && f != "ply" && f != "stl")
+      return Status::InvalidArgument("write_completion: unknown mesh format '" + f + "' (obj, ply, stl)");
+  G2P_RETURN_IF_ERROR(detail::ensure_directory(dir));
+  nlohmann::json doc;
+  doc["format"] = "g2p.completion";
+  doc["version"] = 1;
+  doc["object_volume_m3"] = completion.object_volume_m3;
+  doc["parts_volume_m3"] = completion.parts_volume_m3;
+  doc["grid_spacing_m"] = completion.grid_spacing_m;
+  doc["notes"] = completion.notes;
+  nlohmann::json parts = nlohmann::json::array();
+  for (const CompletedPart& p : completion.parts) {
+    const std::string name = table.valid_label(p.label) ? table[p.label].name : std::string("Unknown");
+    nlohmann::json j;
+    j["part"] = p.part;
+    j["label"] = name;
+    j["backend"] = p.backend;
+    j["ok"] = p.ok;
+    j["checks"] = checks_json(p.checks);
+    j["notes"] = p.notes;
+    j["vertices"] = p.mesh.num_vertices();
+    j["triangles"] = p.mesh.num_faces();
+    nlohmann::json files = nlohmann::json::object();
+    if (p.mesh.num_faces() > 0)
+      for (const std::string& f : formats) {
+        const std::string file = "part_" + std::to_string(p.part) + "_" + name + "." + f;
+        G2P_RETURN_IF_ERROR(write_mesh(dir + "/" + file, p.mesh));
+        files[f] = file;
+      }
+    j["files"] = files;
+    parts.push_back(j);
+  }
+  doc["parts"] = parts;
+  return write_text_file(dir + "/completion.json", doc.dump(2) + "\n");
+}
+
+}  // namespace g2p

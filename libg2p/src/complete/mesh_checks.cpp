@@ -1,0 +1,149 @@
+// check_closed_mesh: the validation every completed part goes through.
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+
+#include "complete/geometry.h"
+#include "g2p/complete.h"
+
+namespace g2p {
+
+namespace {
+
+std::uint64_t edge_key(int from, int to) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) | static_cast<std::uint32_t>(to);
+}
+
+int find_root(std::vector<int>& parent, int x) {
+  while (parent[static_cast<std::size_t>(x)] != x) {
+    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    x = parent[static_cast<std::size_t>(x)];
+  }
+  return x;
+}
+
+}  // namespace
+
+bool MeshChecks::watertight() const {
+  return closed && manifold && outward && volume_m3 > 0 && (!self_intersections_checked || self_intersection_free);
+}
+
+MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshCheckOptions& options) {
+  MeshChecks c;
+  const int nf = mesh.num_faces();
+  if (nf == 0 || !validate(mesh).ok()) return c;
+  c.area_m2 = surface_area(mesh);
+
+  // Directed edges, sorted, each with its face: closed and consistently
+  // oriented iff every directed edge occurs once and its reverse once.
+  std::vector<std::pair<std::uint64_t, int>> edges;
+  edges.reserve(static_cast<std::size_t>(nf) * 3);
+  for (int f = 0; f < nf; ++f) {
+    const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
+    for (int e = 0; e < 3; ++e) edges.emplace_back(edge_key(t[e], t[(e + 1) % 3]), f);
+  }
+  std::sort(edges.begin(), edges.end());
+  auto face_of = [&](std::uint64_t key) -> int {
+    auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, -1));
+    if (it == edges.end() || it->first != key) return -1;
+    auto next = it + 1;
+    if (next != edges.end() && next->first == key) return -2;  // the same directed edge twice
+    return it->second;
+  };
+  bool closed = true;
+  std::vector<int> parent(static_cast<std::size_t>(nf));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& [key, f] : edges) {
+    const int from = static_cast<int>(key >> 32), to = static_cast<int>(key & 0xffffffffu);
+    const int g = face_of(edge_key(to, from));
+    if (g < 0 || face_of(key) < 0) {
+      closed = false;
+      continue;
+    }
+    parent[static_cast<std::size_t>(find_root(parent, f))] = find_root(parent, g);
+  }
+  c.closed = closed;
+  for (int f = 0; f < nf; ++f) c.num_components += find_root(parent, f) == f;
+
+  // Vertex manifoldness: walking across edges around each vertex visits all of
+  // its triangles in one cycle.
+  if (closed) {
+    std::vector<int> incident(mesh.positions.size(), 0);
+    for (const auto& t : mesh.triangles)
+      for (int e = 0; e < 3; ++e) ++incident[static_cast<std::size_t>(t[e])];
+    std::vector<char> done(mesh.positions.size(), 0);
+    bool manifold = true;
+    for (int f = 0; f < nf && manifold; ++f) {
+      const Eigen::Vector3i& t0 = mesh.triangles[static_cast<std::size_t>(f)];
+      for (int corner = 0; corner < 3 && manifold; ++corner) {
+        const int v = t0[corner];
+        if (done[static_cast<std::size_t>(v)]) continue;
+        done[static_cast<std::size_t>(v)] = 1;
+        int face = f, steps = 0;
+        do {
+          const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(face)];
+          const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+          const int a = t[(k + 1) % 3];
+          face = face_of(edge_key(a, v));  // the neighbour across edge (v, a)
+          ++steps;
+        } while (face >= 0 && face != f && steps <= incident[static_cast<std::size_t>(v)]);
+        manifold = face == f && steps == incident[static_cast<std::size_t>(v)];
+      }
+    }
+    c.manifold = manifold;
+  }
+
+  // Enclosed volume (divergence theorem, about the centroid for precision).
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : mesh.positions) centre += p.cast<double>();
+  centre /= static_cast<double>(std::max<std::size_t>(1, mesh.positions.size()));
+  double six_v = 0.0;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(t[0])].cast<double>() - centre;
+    const Eigen::Vector3d b = mesh.positions[static_cast<std::size_t>(t[1])].cast<double>() - centre;
+    const Eigen::Vector3d d = mesh.positions[static_cast<std::size_t>(t[2])].cast<double>() - centre;
+    six_v += a.dot(b.cross(d));
+  }
+  c.volume_m3 = six_v / 6.0;
+  c.outward = c.closed && c.volume_m3 > 0;
+
+  if (nf <= options.max_faces_for_intersections) {
+    const detail::TriangleBins bins(mesh);
+    const auto pairs = bins.intersecting_pairs(1000);
+    c.self_intersections_checked = true;
+    c.num_self_intersections = static_cast<int>(pairs.size());
+    c.self_intersection_free = pairs.empty();
+  }
+
+  if (patch != nullptr && patch->num_faces() > 0) {
+    const detail::TriangleBins bins(*patch);
+    double worst = 0.0;
+    for (const auto& p : mesh.positions) worst = std::max(worst, bins.distance(p.cast<double>()));
+    c.max_distance_m = worst;
+    const double diag = bounds(*patch).diagonal().norm();
+    c.relative_distance = diag > 0 ? worst / diag : 0.0;
+  }
+  return c;
+}
+
+Mesh part_patch(const Mesh& mesh, const Part& part) {
+  Mesh out;
+  std::vector<int> remap(mesh.positions.size(), -1);
+  for (int f : part.faces) {
+    if (f < 0 || f >= mesh.num_faces()) continue;
+    Eigen::Vector3i t = mesh.triangles[static_cast<std::size_t>(f)];
+    for (int e = 0; e < 3; ++e) {
+      int& r = remap[static_cast<std::size_t>(t[e])];
+      if (r < 0) {
+        r = out.num_vertices();
+        out.positions.push_back(mesh.positions[static_cast<std::size_t>(t[e])]);
+      }
+      t[e] = r;
+    }
+    out.triangles.push_back(t);
+    if (!mesh.face_source.empty()) out.face_source.push_back(mesh.face_source[static_cast<std::size_t>(f)]);
+  }
+  return out;
+}
+
+}  // namespace g2p

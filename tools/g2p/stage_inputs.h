@@ -1,0 +1,35 @@
+// Reading a labelled object back for the stages after project/refine: from a
+// `g2p project` or `g2p refine` output folder (project.json + faces.csv), or
+// from a model file with ground-truth labels (labels.json, by material).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "common.h"
+#include "g2p/materials.h"
+#include "g2p/model.h"
+#include "g2p/project.h"
+
+namespace g2p::cli {
+
+// SOURCE plus --truth/--key for model files.
+struct LabelledSourceArgs {
+  std::string source;  // folder or model file
+  std::string truth;   // labels.json, for a model file
+  std::string key;     // entry in labels.json (default: the file's stem)
+  std::string materials;
+};
+void add_labelled_source_flags(CLI::App* cmd, LabelledSourceArgs& args);
+
+struct LabelledObject {
+  Model model;
+  MaterialTable table;
+  FacesFile faces;
+  std::string origin;  // "folder DIR" or "ground truth KEY of FILE"
+};
+
+// Loads the object; on failure prints the error and sets exit_code.
+Result<LabelledObject> load_labelled_source(const std::string& command, const LabelledSourceArgs& args, int& exit_code);
+
+}  // namespace g2p::cli

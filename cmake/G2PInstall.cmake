@@ -4,8 +4,9 @@ include(CMakePackageConfigHelpers)
 set(G2P_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/g2p)
 
 # Public headers: the hand-written ones plus the generated version.h.
+# complete_cgal.h belongs to the optional component g2p::cgal (below).
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/libg2p/include/g2p
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h")
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h" PATTERN "complete_cgal.h" EXCLUDE)
 install(FILES ${PROJECT_BINARY_DIR}/libg2p/generated/include/g2p/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/g2p)
 install(FILES ${PROJECT_SOURCE_DIR}/libg2p/data/materials.json ${PROJECT_SOURCE_DIR}/libg2p/data/refine_prompt.txt
@@ -17,6 +18,18 @@ install(TARGETS g2p EXPORT g2pTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
+# The optional GPL component, in the same export set: find_package(g2p
+# COMPONENTS cgal) then gives g2p::cgal.
+if(TARGET g2p_cgal)
+  install(TARGETS g2p_cgal EXPORT g2pTargets
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT development
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime
+    INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(FILES ${PROJECT_SOURCE_DIR}/libg2p/include/g2p/complete_cgal.h
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/g2p)
+endif()
+
 install(EXPORT g2pTargets NAMESPACE g2p:: DESTINATION ${G2P_INSTALL_CMAKEDIR})
 
 # Static builds make the private dependencies part of the link interface.
@@ -25,6 +38,9 @@ if(BUILD_SHARED_LIBS)
 else()
   set(G2P_STATIC_DEPENDENCIES
       "find_dependency(assimp)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(CURL)\nfind_dependency(OpenCV COMPONENTS core imgproc imgcodecs dnn)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)")
+  if(TARGET g2p_cgal)
+    string(APPEND G2P_STATIC_DEPENDENCIES "\nfind_dependency(CGAL 5.5)")
+  endif()
 endif()
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/g2pConfig.cmake.in

@@ -9,6 +9,9 @@
 
 #include "commands.h"
 #include "g2p/complete.h"
+#if defined(G2P_CLI_WITH_CGAL)
+#include "g2p/complete_cgal.h"
+#endif
 #include "g2p/io.h"
 #include "stage_inputs.h"
 
@@ -43,6 +46,12 @@ int run_complete(const CompleteArgs& args) {
     std::cerr << "g2p complete: error: --complete-set: " << settings.status().message() << "\n";
     return kExitUsage;
   }
+#if defined(G2P_CLI_WITH_CGAL)
+  if (Status s = register_cgal_completers(); !s.ok()) {
+    std::cerr << "g2p complete: error: " << s.to_string() << "\n";
+    return kExitFailure;
+  }
+#endif
   Result<std::unique_ptr<Completer>> completer = make_completer(args.completer, *settings);
   if (!completer.ok()) {
     std::cerr << "g2p complete: error: " << completer.status().to_string() << "\n";
@@ -99,7 +108,8 @@ void add_complete_command(CLI::App& app, Command& run) {
   CLI::App* cmd = app.add_subcommand("complete", "Close every part into a watertight volume (stage 5)");
   add_labelled_source_flags(cmd, args->source);
   cmd->add_option("-o,--output", args->out, "Output folder (default SOURCE/completed)");
-  cmd->add_option("--completer", args->completer, "Backend: partition (default), external, or a registered one");
+  cmd->add_option("--completer", args->completer,
+                  "Backend: partition (default), external, alpha-wrap and fill (CGAL builds)");
   cmd->add_option("--complete-set", args->settings, "Backend setting KEY=VALUE (repeatable), e.g. resolution=200");
   cmd->add_option("--fallback", args->fallback, "Backend for parts the completer fails, or 'none' (default partition)");
   cmd->add_option("--format", args->formats, "Mesh formats to write: obj, ply, stl (comma-separated)")

@@ -100,7 +100,7 @@ Eigen::Vector3i TriangleBins::cell_of(const Vector3d& p) const {
   return c;
 }
 
-double TriangleBins::distance(const Vector3d& p) const {
+double TriangleBins::distance(const Vector3d& p, double enough) const {
   if (items_.empty()) return std::numeric_limits<double>::infinity();
   // Search shells of cells around p's (clamped) cell until the best distance
   // found is below the distance to the next shell.
@@ -121,6 +121,7 @@ double TriangleBins::distance(const Vector3d& p) const {
             const Vector3d q = closest_point_on_triangle(p, tri(t, 0), tri(t, 1), tri(t, 2));
             best = std::min(best, (q - p).norm());
           }
+          if (best <= enough) return best;
         }
       }
     }

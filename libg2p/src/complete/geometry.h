@@ -33,7 +33,9 @@ class TriangleBins {
   TriangleBins(const Mesh& mesh, double triangles_per_cell = 4.0);
 
   // Distance from `p` to the nearest triangle (infinity for an empty mesh).
-  double distance(const Eigen::Vector3d& p) const;
+  // With `enough` >= 0 the search may stop at the first triangle closer than
+  // that and return its distance (for maxima of minimum distances).
+  double distance(const Eigen::Vector3d& p, double enough = -1.0) const;
 
   // Every pair (i < j) of triangles that share no vertex and intersect.
   std::vector<std::pair<int, int>> intersecting_pairs(int max_pairs) const;

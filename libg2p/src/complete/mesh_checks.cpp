@@ -118,7 +118,9 @@ MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshChec
   if (patch != nullptr && patch->num_faces() > 0) {
     const detail::TriangleBins bins(*patch);
     double worst = 0.0;
-    for (const auto& p : mesh.positions) worst = std::max(worst, bins.distance(p.cast<double>()));
+    // Only distances above the running maximum matter: each search stops at
+    // the first triangle closer than that.
+    for (const auto& p : mesh.positions) worst = std::max(worst, bins.distance(p.cast<double>(), worst));
     c.max_distance_m = worst;
     const double diag = bounds(*patch).diagonal().norm();
     c.relative_distance = diag > 0 ? worst / diag : 0.0;

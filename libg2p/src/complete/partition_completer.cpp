@@ -33,10 +33,10 @@
 #include <sstream>
 
 #include "complete/backends.h"
-#include "core/settings.h"
 #include "complete/geometry.h"
 #include "complete/segment_tester.h"
 #include "complete/simplify.h"
+#include "core/settings.h"
 
 namespace g2p {
 namespace {

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <queue>
 #include <vector>
 
@@ -67,9 +68,9 @@ int simplify_closed_mesh(Mesh& mesh, double max_error_m) {
     double best_cost = cost_at(best);
     // The quadric's minimiser, if well conditioned and near the edge.
     const Eigen::Matrix3d a = q.topLeftCorner<3, 3>();
-    Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
-    if (ldlt.info() == Eigen::Success && ldlt.rcond() > 1e-6) {
-      const Eigen::Vector3d p = ldlt.solve(-q.topRightCorner<3, 1>());
+    const double det = a.determinant();
+    if (std::abs(det) > 1e-9 * std::pow(a.norm(), 3)) {
+      const Eigen::Vector3d p = a.inverse() * (-q.topRightCorner<3, 1>());
       if ((p - best).norm() <= (pu - pv).norm()) {
         const double c = cost_at(p);
         if (c < best_cost) best = p, best_cost = c;

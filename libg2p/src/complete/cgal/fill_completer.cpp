@@ -1,0 +1,236 @@
+// The `fill` completer (GPL-3.0-or-later component g2p::cgal): each part's
+// patch keeps its own triangles and every hole in it is filled with
+// CGAL::Polygon_mesh_processing::triangulate_refine_and_fair_hole. This suits
+// parts whose holes are small openings where they met their neighbours; a
+// part with a hole wider than max_relative_hole of its diagonal, a patch that
+// is not an orientable manifold surface, or a fill that is not watertight is
+// left not ok, so complete() redoes it with the fallback.
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "g2p/complete_cgal.h"
+
+namespace g2p {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using Halfedge = SurfaceMesh::Halfedge_index;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+Status parse_positive(const std::string& key, const std::string& value, double& out) {
+  char* end = nullptr;
+  const double v = std::strtod(value.c_str(), &end);
+  if (end == value.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0))
+    return Status::InvalidArgument("fill: " + key + " needs a positive number, got '" + value + "'");
+  out = v;
+  return Status::Ok();
+}
+
+Mesh to_mesh(const SurfaceMesh& sm) {
+  Mesh m;
+  std::vector<int> index(sm.num_vertices(), -1);  // num_vertices() counts removed ones too
+  m.positions.reserve(sm.number_of_vertices());
+  for (SurfaceMesh::Vertex_index v : sm.vertices()) {
+    index[v.idx()] = static_cast<int>(m.positions.size());
+    const Point& p = sm.point(v);
+    m.positions.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+  }
+  m.triangles.reserve(sm.number_of_faces());
+  for (SurfaceMesh::Face_index f : sm.faces()) {
+    std::array<int, 3> t{};
+    int n = 0;
+    for (SurfaceMesh::Vertex_index v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
+      if (n < 3) t[static_cast<std::size_t>(n)] = index[v.idx()];
+      ++n;
+    }
+    if (n == 3) m.triangles.emplace_back(t[0], t[1], t[2]);
+  }
+  return m;
+}
+
+// Loads the patch as a Surface_mesh through CGAL's polygon-soup repair and
+// orientation; an error message when it is not an orientable manifold.
+std::string load_patch(const Mesh& patch, SurfaceMesh& sm) {
+  std::vector<Point> points;
+  points.reserve(patch.positions.size());
+  for (const Eigen::Vector3f& q : patch.positions) points.emplace_back(q.x(), q.y(), q.z());
+  std::vector<std::vector<std::size_t>> polygons;
+  polygons.reserve(patch.triangles.size());
+  for (const Eigen::Vector3i& t : patch.triangles)
+    polygons.push_back(
+        {static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]), static_cast<std::size_t>(t[2])});
+  PMP::repair_polygon_soup(points, polygons);  // merges duplicate points, drops degenerate and repeated triangles
+  if (polygons.empty()) return "no triangles are left after repairing the patch (all degenerate)";
+  if (!PMP::orient_polygon_soup(points, polygons))
+    return "the patch is not an orientable manifold surface (CGAL had to split vertices to orient it)";
+  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) return "the patch is not a manifold polygon mesh";
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
+  if (!CGAL::is_triangle_mesh(sm) || !sm.is_valid(false)) return "the patch did not load as a valid triangle mesh";
+  return {};
+}
+
+class FillCompleter final : public Completer {
+ public:
+  Status configure(const BackendSettings& settings) override {
+    double hole = max_relative_hole_, distance = max_relative_distance_;
+    unsigned continuity = fairing_continuity_;
+    for (const auto& [key, value] : settings) {
+      if (key == "max_relative_hole") {
+        G2P_RETURN_IF_ERROR(parse_positive(key, value, hole));
+      } else if (key == "max_relative_distance") {
+        G2P_RETURN_IF_ERROR(parse_positive(key, value, distance));
+      } else if (key == "fairing_continuity") {
+        if (value != "0" && value != "1" && value != "2")
+          return Status::InvalidArgument("fill: fairing_continuity must be 0, 1 or 2, got '" + value + "'");
+        continuity = static_cast<unsigned>(value[0] - '0');
+      } else {
+        return Status::InvalidArgument("fill: unknown setting '" + key +
+                                       "' (known: max_relative_hole, fairing_continuity, max_relative_distance)");
+      }
+    }
+    max_relative_hole_ = hole;
+    max_relative_distance_ = distance;
+    fairing_continuity_ = continuity;
+    return Status::Ok();
+  }
+
+  Result<Completion> complete(const CompletionInput& input) const override {
+    if (input.mesh == nullptr || input.parts == nullptr)
+      return Status::InvalidArgument("fill: needs the mesh and the parts");
+    Completion result;
+    for (std::size_t p = 0; p < input.parts->size(); ++p) {
+      const Part& part = (*input.parts)[p];
+      CompletedPart& out = result.parts.emplace_back();
+      out.part = static_cast<int>(p);
+      out.label = part.label;
+      out.backend = "fill";
+      const Mesh patch = part_patch(*input.mesh, part);
+      try {
+        fill_part(patch, out);
+      } catch (const std::exception& e) {
+        out.mesh = Mesh();
+        out.ok = false;
+        out.notes.push_back(std::string("fill: CGAL failed: ") + e.what());
+      }
+    }
+    for (const CompletedPart& c : result.parts) result.parts_volume_m3 += c.checks.volume_m3;
+    return result;
+  }
+
+ private:
+  // Closes one patch into out.mesh; leaves out.ok false with a note when it cannot.
+  void fill_part(const Mesh& patch, CompletedPart& out) const {
+    const double diag = patch.num_faces() > 0 ? bounds(patch).diagonal().norm() : 0.0;
+    if (!(diag > 0) || !std::isfinite(diag)) {
+      out.notes.push_back("fill: the part has no faces of positive extent");
+      return;
+    }
+    SurfaceMesh sm;
+    if (std::string why = load_patch(patch, sm); !why.empty()) {
+      out.notes.push_back("fill: " + why);
+      return;
+    }
+    std::vector<Halfedge> holes;
+    PMP::extract_boundary_cycles(sm, std::back_inserter(holes));
+
+    // Every hole must be small next to the part before any is filled.
+    double widest = 0.0;
+    for (Halfedge h : holes) {
+      Eigen::AlignedBox3d box;
+      for (Halfedge e : CGAL::halfedges_around_face(h, sm)) {
+        const Point& q = sm.point(sm.source(e));
+        box.extend(Eigen::Vector3d(q.x(), q.y(), q.z()));
+      }
+      widest = std::max(widest, box.diagonal().norm() / diag);
+    }
+    if (widest > max_relative_hole_) {
+      out.notes.push_back("fill: the widest of the " + std::to_string(holes.size()) + " holes spans " + number(widest) +
+                          " of the part's diagonal, more than max_relative_hole " + number(max_relative_hole_));
+      return;
+    }
+
+    int added_faces = 0, unfaired = 0;
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+      std::vector<SurfaceMesh::Face_index> faces;
+      std::vector<SurfaceMesh::Vertex_index> vertices;
+      const auto r =
+          PMP::triangulate_refine_and_fair_hole(sm, holes[i], std::back_inserter(faces), std::back_inserter(vertices),
+                                                CGAL::parameters::fairing_continuity(fairing_continuity_));
+      if (faces.empty()) {
+        out.notes.push_back("fill: CGAL found no triangulation for hole " + std::to_string(i + 1) + " of " +
+                            std::to_string(holes.size()));
+        return;
+      }
+      added_faces += static_cast<int>(faces.size());
+      if (!std::get<0>(r) && !vertices.empty()) ++unfaired;
+    }
+    if (!CGAL::is_closed(sm)) {
+      out.notes.push_back("fill: the patch is still open after filling its holes");
+      return;
+    }
+    bool reversed = false;
+    if (PMP::volume(sm) < 0) {
+      PMP::reverse_face_orientations(sm);
+      reversed = true;
+    }
+    out.mesh = to_mesh(sm);
+    if (holes.empty()) {
+      out.notes.push_back("fill: the patch was already closed");
+    } else {
+      out.notes.push_back("fill: filled " + std::to_string(holes.size()) + " hole(s) with " +
+                          std::to_string(added_faces) + " triangles (widest " + number(widest) +
+                          " of the diagonal, fairing continuity C" + std::to_string(fairing_continuity_) + ")");
+    }
+    if (unfaired > 0)
+      out.notes.push_back("fill: fairing failed for " + std::to_string(unfaired) + " hole(s); they are refined only");
+    if (reversed) out.notes.push_back("fill: reversed the faces to point outward");
+
+    out.checks = check_closed_mesh(out.mesh, &patch);
+    const bool near = out.checks.relative_distance <= max_relative_distance_;
+    out.ok = out.checks.watertight() && near;
+    if (!out.checks.watertight())
+      out.notes.push_back(std::string("fill: the filled mesh is not watertight (") +
+                          (out.checks.closed ? "" : "open, ") + (out.checks.manifold ? "" : "non-manifold, ") +
+                          (out.checks.outward ? "" : "not outward, ") +
+                          std::to_string(out.checks.num_self_intersections) + " self-intersections)");
+    if (!near)
+      out.notes.push_back("fill: the fill reaches " + number(out.checks.relative_distance) +
+                          " of the diagonal away from the patch (max_relative_distance " +
+                          number(max_relative_distance_) + ")");
+  }
+
+  double max_relative_hole_ = 0.3;
+  double max_relative_distance_ = 0.25;
+  unsigned fairing_continuity_ = 1;
+};
+
+}  // namespace
+
+std::unique_ptr<Completer> make_fill_completer() { return std::make_unique<FillCompleter>(); }
+
+}  // namespace g2p

@@ -71,9 +71,14 @@ TEST(ToolComplete, BadInputFailsWithAMessage) {
   ToolRun r = run_tool("complete " + quote(dir));  // an empty folder
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("project.json"), std::string::npos) << r.err;
-  r = run_tool("complete " + quote(test::source_path("examples/data/hammer.obj")));
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  r = run_tool("complete " + hammer + " -o " + quote(dir + "/out"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--truth"), std::string::npos) << r.err;
+  r = run_tool("complete " + hammer + " --truth " + quote(dir + "/labels.json"));  // no -o for a file
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("-o OUT"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
   r = run_tool("complete " + quote(dir) + " --format fbx");
   EXPECT_EQ(r.exit_code, 2);
   r = run_tool("complete " + quote(dir) + " --completer no-such");

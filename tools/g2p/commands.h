@@ -23,5 +23,6 @@ void add_eval_command(CLI::App& app, Command& run);
 void add_project_command(CLI::App& app, Command& run);
 void add_refine_command(CLI::App& app, Command& run);
 void add_complete_command(CLI::App& app, Command& run);
+void add_properties_command(CLI::App& app, Command& run);
 
 }  // namespace g2p::cli

@@ -1,5 +1,6 @@
 // g2p eval seg: segmentation accuracy over a labelled set of models, as the
 // paper's Table 2 (one confusion matrix over the set, IoU per class, mIoU).
+// g2p eval mass: mass errors over a CSV of predictions, as the paper's Table 1.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/eval.h"
+#include "g2p/io.h"
 #include "g2p/project.h"
 #include "g2p/segment.h"
 
@@ -152,6 +154,64 @@ int run_eval_seg(const EvalArgs& args) {
 
 }  // namespace
 
+struct MassArgs {
+  std::string csv;
+  std::string json_out;
+};
+
+// object,predicted_kg,true_kg (header required; extra columns ignored).
+int run_eval_mass(const MassArgs& args) {
+  std::ifstream in(args.csv, std::ios::binary);
+  if (!in) {
+    std::cerr << "g2p eval mass: error: " << args.csv << ": cannot open\n";
+    return kExitFailure;
+  }
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.rfind("object,predicted_kg,true_kg", 0) != 0) {
+    std::cerr << "g2p eval mass: error: " << args.csv << ":1: the header must start object,predicted_kg,true_kg\n";
+    return kExitFailure;
+  }
+  std::vector<std::string> names;
+  std::vector<double> predicted, truth;
+  for (int n = 2; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    std::stringstream row(line);
+    std::string name, p, t;
+    std::getline(row, name, ',');
+    std::getline(row, p, ',');
+    std::getline(row, t, ',');
+    char* end_p = nullptr;
+    char* end_t = nullptr;
+    const double pv = std::strtod(p.c_str(), &end_p), tv = std::strtod(t.c_str(), &end_t);
+    if (end_p == p.c_str() || *end_p != '\0' || end_t == t.c_str() || *end_t != '\0') {
+      std::cerr << "g2p eval mass: error: " << args.csv << ":" << n << ": expected two numbers, got '" << line << "'\n";
+      return kExitFailure;
+    }
+    names.push_back(name);
+    predicted.push_back(pv);
+    truth.push_back(tv);
+  }
+  Result<MassErrors> e = mass_errors(predicted, truth);
+  if (!e.ok()) {
+    std::cerr << "g2p eval mass: error: " << args.csv << ": " << e.status().message() << "\n";
+    return kExitFailure;
+  }
+  std::printf("%d objects: ADE %.4g kg, ALDE %.4f, APE %.4f, MnRE %.4f\n", e->objects, e->ade_kg, e->alde, e->ape,
+              e->mnre);
+  if (!args.json_out.empty()) {
+    const nlohmann::json j = {
+        {"objects", e->objects}, {"ade_kg", e->ade_kg}, {"alde", e->alde}, {"ape", e->ape}, {"mnre", e->mnre}};
+    if (Status s = write_text_file(args.json_out, j.dump(2) + "\n"); !s.ok()) {
+      std::cerr << "g2p eval mass: error: " << s.to_string() << "\n";
+      return kExitFailure;
+    }
+  }
+  return kExitOk;
+}
+
 void add_eval_command(CLI::App& app, Command& run) {
   CLI::App* eval = app.add_subcommand("eval", "Measure accuracy against ground truth");
   eval->require_subcommand(1);
@@ -167,6 +227,13 @@ void add_eval_command(CLI::App& app, Command& run) {
   add_view_flags(seg, args->views);
   add_segmenter_flags(seg, args->segmenter);
   seg->callback([args, &run] { run = [args] { return run_eval_seg(*args); }; });
+
+  auto margs = std::make_shared<MassArgs>();
+  CLI::App* mass = eval->add_subcommand(
+      "mass", "Mass errors (ADE, ALDE, APE, MnRE as in NeRF2Physics) over a CSV object,predicted_kg,true_kg");
+  mass->add_option("csv", margs->csv, "CSV with the header object,predicted_kg,true_kg")->required();
+  mass->add_option("--json", margs->json_out, "Also write the results as JSON to this file");
+  mass->callback([margs, &run] { run = [margs] { return run_eval_mass(*margs); }; });
 }
 
 }  // namespace g2p::cli

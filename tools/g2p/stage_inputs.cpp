@@ -1,13 +1,18 @@
 #include "stage_inputs.h"
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "commands.h"
 #include "g2p/segment.h"
+#if defined(G2P_CLI_WITH_CGAL)
+#include "g2p/complete_cgal.h"
+#endif
 
 namespace g2p::cli {
 namespace {
@@ -111,6 +116,64 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
   out.faces.parts = partition(mesh, *graph, out.faces.labels, out.faces.face_part);
   out.origin = "ground truth '" + key + "' of " + args.truth;
   return out;
+}
+
+Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs) {
+  BackendSettings s;
+  for (const std::string& p : pairs) {
+    const std::size_t eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) return Status::InvalidArgument("expected KEY=VALUE, got '" + p + "'");
+    s[p.substr(0, eq)] = p.substr(eq + 1);
+  }
+  return s;
+}
+
+void add_completer_flags(CLI::App* cmd, CompleterArgs& args) {
+  cmd->add_option("--completer", args.name,
+                  "Stage 5 backend: partition (default), external, alpha-wrap and fill (CGAL builds)");
+  cmd->add_option("--complete-set", args.settings, "Completer setting KEY=VALUE (repeatable), e.g. resolution=200");
+  cmd->add_option("--fallback", args.fallback, "Backend for parts the completer fails, or 'none' (default partition)");
+}
+
+Result<Completion> run_completion(const std::string& command, const CompleterArgs& args, const LabelledObject& object,
+                                  int& exit_code) {
+  auto fail = [&](const Status& s, int code) -> Status {
+    std::cerr << "g2p " << command << ": error: " << s.to_string() << "\n";
+    exit_code = code;
+    return s;
+  };
+#if defined(G2P_CLI_WITH_CGAL)
+  if (Status s = register_cgal_completers(); !s.ok()) return fail(s, kExitFailure);
+#endif
+  Result<BackendSettings> settings = parse_settings(args.settings);
+  if (!settings.ok()) return fail(settings.status().with_context("--complete-set"), kExitUsage);
+  Result<std::unique_ptr<Completer>> completer = make_completer(args.name, *settings);
+  if (!completer.ok()) return fail(completer.status(), kExitUsage);
+  std::unique_ptr<Completer> fallback;
+  if (args.fallback != "none" && args.fallback != args.name) {
+    Result<std::unique_ptr<Completer>> f = make_completer(args.fallback);
+    if (!f.ok()) return fail(f.status().with_context("--fallback"), kExitUsage);
+    fallback = std::move(*f);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  CompletionInput input{&object.model.mesh, &object.faces.parts, &object.table};
+  Result<Completion> done = complete(input, **completer, fallback.get());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!done.ok()) return fail(done.status(), kExitFailure);
+  std::cout << "completed " << done->parts.size() << " parts of " << object.origin << " with '" << args.name << "' in "
+            << std::fixed << std::setprecision(2) << seconds << " s\n";
+  for (const std::string& n : done->notes) std::cout << "  " << n << "\n";
+  for (const CompletedPart& p : done->parts) {
+    const std::string name = object.table.valid_label(p.label) ? object.table[p.label].name : "Unknown";
+    std::cout << "  part " << p.part << " " << name << ": " << (p.ok ? "ok" : "FAILED") << ", " << std::setprecision(6)
+              << p.checks.volume_m3 * 1e6 << " cm^3, " << p.mesh.num_faces() << " triangles (" << p.backend << ")";
+    for (const std::string& n : p.notes) std::cout << "; " << n;
+    std::cout << "\n";
+  }
+  std::cout << "  object " << done->object_volume_m3 * 1e6 << " cm^3, parts sum " << done->parts_volume_m3 * 1e6
+            << " cm^3\n";
+  std::cout.unsetf(std::ios::floatfield);
+  return done;
 }
 
 }  // namespace g2p::cli

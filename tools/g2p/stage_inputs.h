@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common.h"
+#include "g2p/complete.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/project.h"
@@ -31,5 +32,21 @@ struct LabelledObject {
 
 // Loads the object; on failure prints the error and sets exit_code.
 Result<LabelledObject> load_labelled_source(const std::string& command, const LabelledSourceArgs& args, int& exit_code);
+
+// --completer, --complete-set and --fallback.
+struct CompleterArgs {
+  std::string name = "partition";
+  std::vector<std::string> settings;
+  std::string fallback = "partition";
+};
+void add_completer_flags(CLI::App* cmd, CompleterArgs& args);
+
+// Runs stage 5 on the object with the flags' backends; on failure prints the
+// error and sets exit_code. Prints the result unless `quiet`.
+Result<Completion> run_completion(const std::string& command, const CompleterArgs& args, const LabelledObject& object,
+                                  int& exit_code);
+
+// KEY=VALUE pairs as BackendSettings.
+Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs);
 
 }  // namespace g2p::cli

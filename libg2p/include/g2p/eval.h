@@ -1,4 +1,4 @@
-// eval: accuracy of material segmentation, as the paper measures it (after
+// eval: accuracy of mass estimates (below) and of material segmentation, as the paper measures it (after
 // Cityscapes and MMSegmentation): one confusion matrix aggregated over a whole
 // set, IoU per class = TP / (TP + FP + FN), mIoU = the unweighted mean over
 // the classes present in the ground truth. Void (kUnknownLabel) ground truth
@@ -69,5 +69,23 @@ class G2P_API CalibrationBins {
  private:
   std::vector<double> weight_, confidence_, correct_;
 };
+
+// ---- Mass -------------------------------------------------------------------
+
+// Mass errors as NeRF2Physics defines them (Zhai et al. 2024) and the
+// Gen2Physics paper reports them (Table 1), each averaged over objects, with
+// p the predicted and g the true mass: ADE = |p - g| (kg), ALDE = |ln p - ln g|,
+// APE = |p - g| / g, MnRE = min(p / g, g / p) (higher is better).
+struct MassErrors {
+  int objects = 0;
+  double ade_kg = 0.0;
+  double alde = 0.0;
+  double ape = 0.0;
+  double mnre = 0.0;
+};
+
+// Fails unless both lists have the same non-zero length and every mass is
+// positive and finite (the error names the index).
+G2P_API Result<MassErrors> mass_errors(const std::vector<double>& predicted_kg, const std::vector<double>& true_kg);
 
 }  // namespace g2p

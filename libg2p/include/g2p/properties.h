@@ -1,16 +1,27 @@
 // properties: stage 6 of Gen2Physics, physical properties of the completed
-// parts. This header holds the exact mass properties of closed triangle meshes
-// (solid) and of surfaces with a wall thickness (hollow, the paper's
-// m = rho * A * t), and the combination of parts into an object. The
-// PropertyEstimator interface and its backends arrive with issue #8.
+// parts. A PropertyEstimator gives each part its density, structure (solid or
+// hollow, with a wall thickness) and contact parameters; the exact mass
+// properties of closed triangle meshes (solid) or of their surfaces with a
+// wall thickness (hollow, the paper's m = rho * A * t) follow, and the parts
+// combine into the object. docs/properties.md; report.json's fields in
+// docs/report-schema.md.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <string>
 #include <vector>
 
+#include "g2p/complete.h"
 #include "g2p/export.h"
+#include "g2p/materials.h"
 #include "g2p/mesh.h"
+#include "g2p/registry.h"
+#include "g2p/render.h"
+#include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/vlm.h"
 
 namespace g2p {
 
@@ -41,5 +52,115 @@ G2P_API Result<MassProperties> shell_mass_properties(const Mesh& mesh, double de
 // Several parts as one body: masses add, the centre of mass is the weighted
 // mean, inertias move to it by the parallel-axis theorem.
 G2P_API MassProperties combine(const std::vector<MassProperties>& parts);
+
+// ---- Walls ------------------------------------------------------------------
+
+// How thick a part's material is, measured by rays cast from points of its
+// patch into its closed volume: the distance to where the ray leaves the
+// volume (the part's local thickness) and, where the object has another
+// surface inside the volume before that (an inner wall: a bottle modelled
+// with its inside), the distance to it.
+struct WallMeasurement {
+  int rays = 0;               // rays that entered the closed volume
+  int inner_hits = 0;         // of those, rays that met an inner surface first
+  double thickness_m = 0.0;   // median local thickness of the closed volume
+  double inner_wall_m = 0.0;  // median distance to the inner surface, over the rays that met one
+  double inner_fraction() const { return rays > 0 ? static_cast<double>(inner_hits) / rays : 0.0; }
+};
+
+// `max_rays` sample points, area-weighted and deterministic.
+G2P_API Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, const Mesh& closed,
+                                              int max_rays = 2000);
+
+// ---- Estimating properties ----------------------------------------------------
+
+// Where a value came from.
+enum class ValueSource { kTable, kGeometry, kVlm, kUser };
+G2P_API const char* to_string(ValueSource source);  // "table", "geometry", "vlm", "user"
+
+struct PartProperties {
+  int label = kUnknownLabel;
+  double density_kg_m3 = 0.0;      // nominal
+  double density_min_kg_m3 = 0.0;  // plausible range, for the mass range
+  double density_max_kg_m3 = 0.0;
+  Structure structure = Structure::kSolid;
+  double wall_thickness_m = 0.0;  // the shell's thickness when hollow
+  // Hollow parts weigh rho * A * t over their own surface (the patch, not the
+  // closed volume's faces inside the object). When the model has both faces
+  // of the wall (inner surfaces found by measure_walls), each carries t / 2.
+  bool double_walled = false;
+  double friction_static = 0.5;  // Coulomb coefficients
+  double friction_dynamic = 0.5;
+  double restitution = 0.5;
+  // MuJoCo contact softness (MJCF solref = time constant s and damping ratio;
+  // solimp = dmin dmax width midpoint power), MuJoCo's defaults unless an
+  // estimator has better.
+  std::array<double, 2> solref{0.02, 1.0};
+  std::array<double, 5> solimp{0.9, 0.95, 0.001, 0.5, 2.0};
+  ValueSource density_source = ValueSource::kTable;
+  ValueSource structure_source = ValueSource::kTable;
+  ValueSource thickness_source = ValueSource::kTable;
+  ValueSource contact_source = ValueSource::kTable;
+  WallMeasurement walls;           // what the geometry said
+  std::vector<std::string> notes;  // the rule applied, fallbacks
+};
+
+// What an estimator looks at for one part; all must outlive the call.
+struct PropertyInput {
+  const Mesh* object = nullptr;              // the whole object's surface
+  const Part* part = nullptr;                // the part's faces in `object`
+  const CompletedPart* completed = nullptr;  // its closed volume (complete stage)
+  const MaterialTable* table = nullptr;
+  const std::vector<View>* views = nullptr;  // optional: renders of the object, for the vlm backend
+  // Optional object context: all parts and their closed volumes (same order).
+  const std::vector<Part>* all_parts = nullptr;
+  const Completion* all_completed = nullptr;
+};
+
+class G2P_API PropertyEstimator {
+ public:
+  virtual ~PropertyEstimator();
+  // Backend settings, key = value; unknown keys are errors.
+  virtual Status configure(const BackendSettings& settings);
+  virtual Result<PartProperties> estimate(const PropertyInput& input) const = 0;
+};
+
+// Backends by name: "table" (the default: the material table's values, solid
+// or hollow decided by measure_walls and the part's size, docs/properties.md
+// states the rule) and
+// "vlm" (asks a vision-language model, falls back to "table").
+G2P_API Registry<PropertyEstimator>& estimator_registry();
+G2P_API Result<std::unique_ptr<PropertyEstimator>> make_estimator(const std::string& name,
+                                                                  const BackendSettings& settings = {});
+// The vlm estimator with a client of the caller's.
+G2P_API std::unique_ptr<PropertyEstimator> make_vlm_estimator(std::shared_ptr<const VlmClient> client);
+
+// ---- The whole stage ----------------------------------------------------------
+
+struct PartReport {
+  int part = -1;
+  PartProperties properties;
+  MassProperties mass;  // nominal density
+  double mass_min_kg = 0.0, mass_max_kg = 0.0;
+  bool completed_ok = false;  // the complete stage's checks passed
+};
+
+struct PropertiesReport {
+  std::vector<PartReport> parts;
+  MassProperties object;  // all parts combined, about the object's centre of mass
+  double mass_min_kg = 0.0, mass_max_kg = 0.0;
+  std::vector<std::string> notes;
+};
+
+// Estimates every completed part and combines them. Parts whose completion
+// failed (no closed mesh) are left out of the totals and noted.
+G2P_API Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vector<Part>& parts,
+                                                     const Completion& completion, const MaterialTable& table,
+                                                     const PropertyEstimator& estimator,
+                                                     const std::vector<View>* views = nullptr);
+
+// report.json (docs/report-schema.md).
+G2P_API std::string report_json(const PropertiesReport& report, const MaterialTable& table);
+G2P_API Status write_report(const std::string& path, const PropertiesReport& report, const MaterialTable& table);
 
 }  // namespace g2p

@@ -69,3 +69,29 @@ bool SegmentTester::crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q) 
 }
 
 }  // namespace g2p::detail
+
+namespace g2p::detail {
+
+bool SegmentTester::first_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& d, double tmin, double tmax, double& t,
+                              int& triangle) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray.org_x = static_cast<float>(p.x());
+  rh.ray.org_y = static_cast<float>(p.y());
+  rh.ray.org_z = static_cast<float>(p.z());
+  rh.ray.dir_x = static_cast<float>(d.x());
+  rh.ray.dir_y = static_cast<float>(d.y());
+  rh.ray.dir_z = static_cast<float>(d.z());
+  rh.ray.tnear = static_cast<float>(tmin);
+  rh.ray.tfar = static_cast<float>(tmax);
+  rh.ray.mask = 0xffffffffu;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  t = rh.ray.tfar;
+  triangle = static_cast<int>(rh.hit.primID);
+  return true;
+}
+
+}  // namespace g2p::detail

@@ -1,6 +1,7 @@
-// Private: does a short segment cross the object's surface? Embree occlusion
-// queries in robust (watertight) mode, for the partition completer's
-// inside/outside decisions next to the surface.
+// Private: ray queries against a triangle mesh with Embree in robust
+// (watertight) mode: does a short segment cross the surface (the partition
+// completer's inside/outside decisions), where does a ray first hit it (the
+// properties stage's wall measurements).
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +21,12 @@ class SegmentTester {
 
   // True if the open segment (p, q) meets a triangle. Thread-safe.
   bool crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q) const;
+
+  // The first triangle along the ray p + t d (d of unit length, t in (tmin,
+  // tmax)): returns false if none, else its distance t and its index.
+  // Thread-safe.
+  bool first_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& d, double tmin, double tmax, double& t,
+                 int& triangle) const;
 
  private:
   SegmentTester() = default;

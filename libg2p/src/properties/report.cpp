@@ -1,0 +1,127 @@
+// estimate_properties (the whole stage) and report.json (docs/report-schema.md).
+#include <nlohmann/json.hpp>
+
+#include "g2p/io.h"
+#include "g2p/properties.h"
+
+namespace g2p {
+
+Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vector<Part>& parts,
+                                             const Completion& completion, const MaterialTable& table,
+                                             const PropertyEstimator& estimator, const std::vector<View>* views) {
+  if (completion.parts.size() != parts.size())
+    return Status::InvalidArgument("properties: " + std::to_string(completion.parts.size()) + " completed parts for " +
+                                   std::to_string(parts.size()) + " parts");
+  PropertiesReport report;
+  std::vector<MassProperties> masses;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const CompletedPart& completed = completion.parts[i];
+    PartReport r;
+    r.part = static_cast<int>(i);
+    r.completed_ok = completed.ok;
+    PropertyInput in{&object, &parts[i], &completed, &table, views, &parts, &completion};
+    Result<PartProperties> p = estimator.estimate(in);
+    if (!p.ok()) return p.status().with_context("part " + std::to_string(i));
+    r.properties = std::move(*p);
+    if (completed.mesh.num_faces() == 0) {
+      r.properties.notes.push_back("no closed volume: left out of the object's totals");
+      report.notes.push_back("part " + std::to_string(i) + " has no closed volume and is left out");
+      report.parts.push_back(std::move(r));
+      continue;
+    }
+    const PartProperties& pp = r.properties;
+    Result<MassProperties> m =
+        pp.structure == Structure::kHollow
+            ? shell_mass_properties(part_patch(object, parts[i]), pp.density_kg_m3,
+                                    pp.double_walled ? 0.5 * pp.wall_thickness_m : pp.wall_thickness_m)
+            : solid_mass_properties(completed.mesh, pp.density_kg_m3);
+    if (!m.ok()) {
+      r.properties.notes.push_back("mass properties failed: " + m.status().message());
+      report.notes.push_back("part " + std::to_string(i) + ": " + m.status().message() + "; left out");
+      report.parts.push_back(std::move(r));
+      continue;
+    }
+    r.mass = *m;
+    r.mass_min_kg = m->mass_kg * pp.density_min_kg_m3 / pp.density_kg_m3;
+    r.mass_max_kg = m->mass_kg * pp.density_max_kg_m3 / pp.density_kg_m3;
+    if (!completed.ok) report.notes.push_back("part " + std::to_string(i) + " failed its completion checks");
+    masses.push_back(r.mass);
+    report.mass_min_kg += r.mass_min_kg;
+    report.mass_max_kg += r.mass_max_kg;
+    report.parts.push_back(std::move(r));
+  }
+  if (masses.empty()) return Status::InvalidArgument("properties: no part has a closed volume");
+  report.object = combine(masses);
+  return report;
+}
+
+namespace {
+
+using nlohmann::json;
+
+json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+json mat(const Eigen::Matrix3d& m) {
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(json::array({m(r, 0), m(r, 1), m(r, 2)}));
+  return rows;
+}
+
+json mass_json(const MassProperties& m) {
+  return {{"mass_kg", m.mass_kg},
+          {"center_of_mass_m", vec(m.center_of_mass)},
+          {"inertia_kg_m2", mat(m.inertia)},
+          {"principal_moments_kg_m2", vec(m.principal_moments())},
+          {"principal_axes", mat(m.principal_axes())}};
+}
+
+}  // namespace
+
+std::string report_json(const PropertiesReport& report, const MaterialTable& table) {
+  json parts = json::array();
+  for (const PartReport& r : report.parts) {
+    const PartProperties& p = r.properties;
+    json j = mass_json(r.mass);
+    j["part"] = r.part;
+    j["material"] = table.valid_label(p.label) ? table[p.label].name : std::string("Unknown");
+    j["structure"] = to_string(p.structure);
+    j["density_kg_m3"] = p.density_kg_m3;
+    j["density_min_kg_m3"] = p.density_min_kg_m3;
+    j["density_max_kg_m3"] = p.density_max_kg_m3;
+    j["wall_thickness_m"] = p.structure == Structure::kHollow ? json(p.wall_thickness_m) : json(nullptr);
+    j["double_walled"] = p.double_walled;
+    j["material_volume_m3"] = r.mass.volume_m3;
+    j["area_m2"] = r.mass.area_m2;
+    j["mass_min_kg"] = r.mass_min_kg;
+    j["mass_max_kg"] = r.mass_max_kg;
+    j["friction_static"] = p.friction_static;
+    j["friction_dynamic"] = p.friction_dynamic;
+    j["restitution"] = p.restitution;
+    j["mujoco_solref"] = p.solref;
+    j["mujoco_solimp"] = p.solimp;
+    j["sources"] = {{"density", to_string(p.density_source)},
+                    {"structure", to_string(p.structure_source)},
+                    {"wall_thickness", to_string(p.thickness_source)},
+                    {"contact", to_string(p.contact_source)}};
+    j["walls"] = {{"rays", p.walls.rays},
+                  {"inner_fraction", p.walls.inner_fraction()},
+                  {"median_thickness_m", p.walls.thickness_m},
+                  {"median_inner_wall_m", p.walls.inner_wall_m}};
+    j["completion_ok"] = r.completed_ok;
+    j["notes"] = p.notes;
+    parts.push_back(j);
+  }
+  json object = mass_json(report.object);
+  object["mass_min_kg"] = report.mass_min_kg;
+  object["mass_max_kg"] = report.mass_max_kg;
+  object["material_volume_m3"] = report.object.volume_m3;
+  object["area_m2"] = report.object.area_m2;
+  json doc = {{"format", "g2p.properties"}, {"version", 1},   {"material_table", table.name()},
+              {"object", object},           {"parts", parts}, {"notes", report.notes}};
+  return doc.dump(2) + "\n";
+}
+
+Status write_report(const std::string& path, const PropertiesReport& report, const MaterialTable& table) {
+  return write_text_file(path, report_json(report, table));
+}
+
+}  // namespace g2p

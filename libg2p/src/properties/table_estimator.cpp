@@ -1,0 +1,185 @@
+// The PropertyEstimator base class, the registry and the `table` backend.
+//
+// The `table` rule for solid or hollow, from measure_walls and the class:
+// 1. Modelled walls: if at least half of the rays cast into the part's closed
+//    volume meet an inner surface of the object before leaving it (the model
+//    has an inside: a bottle's inner wall), the part is hollow and its wall
+//    thickness is the median distance to that surface (source: geometry).
+// 2. Otherwise the class's default structure and thickness (source: table),
+//    except that the parts of a dense class (>= 2000 kg/m^3: metal, glass,
+//    ceramic, stone) are hollow with the class's wall thickness when together
+//    they enclose more than half a litre of the object (source: geometry): a
+//    solid steel water bottle would weigh 14 kg; things that big are shells.
+//    (A hammer's steel head, 0.17 litres, stays solid.)
+// 3. Guards (source: geometry): a hollow part thinner than two walls (median
+//    local thickness <= 2 t), or whose shell A t would exceed its volume, is
+//    solid: its walls fill it.
+#include <cmath>
+#include <sstream>
+
+#include "core/settings.h"
+#include "properties/backends.h"
+
+namespace g2p {
+
+PropertyEstimator::~PropertyEstimator() = default;
+
+Status PropertyEstimator::configure(const BackendSettings& settings) {
+  if (settings.empty()) return Status::Ok();
+  return Status::InvalidArgument("this estimator takes no settings (got '" + settings.begin()->first + "')");
+}
+
+const char* to_string(ValueSource source) {
+  switch (source) {
+    case ValueSource::kTable: return "table";
+    case ValueSource::kGeometry: return "geometry";
+    case ValueSource::kVlm: return "vlm";
+    case ValueSource::kUser: return "user";
+  }
+  return "unknown";
+}
+
+namespace detail {
+
+namespace {
+std::string mm(double m) {
+  std::ostringstream s;
+  s.precision(3);
+  s << m * 1000 << " mm";
+  return s.str();
+}
+// The closed volume of all the object's parts of this part's class (just
+// this part's without the object context).
+double class_volume_m3(const PropertyInput& in) {
+  if (in.all_parts == nullptr || in.all_completed == nullptr || in.all_parts->size() != in.all_completed->parts.size())
+    return in.completed->checks.volume_m3;
+  double v = 0.0;
+  for (std::size_t i = 0; i < in.all_parts->size(); ++i)
+    if ((*in.all_parts)[i].label == in.part->label) v += in.all_completed->parts[i].checks.volume_m3;
+  return v;
+}
+
+}  // namespace
+
+const char* const kTableRuleKeys = "rays (integer >= 0), dense_kg_m3 (> 0), max_dense_solid_m3 (>= 0)";
+
+bool set_table_rule(TableRule& rule, const std::string& key, const std::string& value) {
+  double v = 0;
+  if (!parse_double(value, v)) return false;
+  if (key == "rays" && v >= 0 && v <= 1e6 && v == std::floor(v))
+    rule.rays = static_cast<int>(v);
+  else if (key == "dense_kg_m3" && v > 0)
+    rule.dense_kg_m3 = v;
+  else if (key == "max_dense_solid_m3" && v >= 0)
+    rule.max_dense_solid_m3 = v;
+  else
+    return false;
+  return true;
+}
+
+void apply_geometry_guards(PartProperties& p, const CompletedPart& completed) {
+  if (p.structure != Structure::kHollow) return;
+  const double t = p.wall_thickness_m;
+  if (p.walls.rays > 0 && p.walls.thickness_m <= 2 * t) {
+    p.structure = Structure::kSolid;
+    p.structure_source = ValueSource::kGeometry;
+    p.notes.push_back("solid: the part is " + mm(p.walls.thickness_m) + " thick, no more than two " + mm(t) + " walls");
+  } else if (completed.checks.area_m2 * t >= completed.checks.volume_m3) {
+    p.structure = Structure::kSolid;
+    p.structure_source = ValueSource::kGeometry;
+    p.notes.push_back("solid: a " + mm(t) + " shell over its area would exceed its volume");
+  }
+}
+
+Result<PartProperties> table_properties(const PropertyInput& in, const TableRule& rule) {
+  if (in.object == nullptr || in.part == nullptr || in.completed == nullptr || in.table == nullptr)
+    return Status::InvalidArgument("properties: needs the object, the part, its completed volume and the table");
+  const MaterialTable& table = *in.table;
+  const int label = in.part->label;
+  if (!table.valid_label(label))
+    return Status::InvalidArgument("properties: part with label " + std::to_string(label) +
+                                   " has no class in the table '" + table.name() + "'");
+  const MaterialClass& c = table[label];
+  PartProperties p;
+  p.label = label;
+  p.density_kg_m3 = c.density_kg_m3;
+  p.density_min_kg_m3 = c.density_min_kg_m3;
+  p.density_max_kg_m3 = c.density_max_kg_m3;
+  p.structure = c.structure;
+  p.wall_thickness_m = c.wall_thickness_m;
+  p.friction_static = c.friction_static;
+  p.friction_dynamic = c.friction_dynamic;
+  p.restitution = c.restitution;
+  if (in.completed->mesh.num_faces() > 0) {
+    Result<WallMeasurement> w = measure_walls(*in.object, *in.part, in.completed->mesh, rule.rays);
+    if (!w.ok()) return w.status();
+    p.walls = *w;
+  }
+  if (p.walls.rays > 0 && p.walls.inner_fraction() >= 0.5 && p.walls.inner_wall_m > 0) {
+    p.structure = Structure::kHollow;
+    p.wall_thickness_m = p.walls.inner_wall_m;
+    p.double_walled = true;
+    p.structure_source = p.thickness_source = ValueSource::kGeometry;
+    p.notes.push_back("hollow: " + std::to_string(static_cast<int>(100 * p.walls.inner_fraction())) +
+                      "% of rays into the part meet an inner surface, at a median " + mm(p.walls.inner_wall_m));
+  } else if (const double class_volume = class_volume_m3(in); c.structure == Structure::kSolid &&
+                                                              c.density_kg_m3 >= rule.dense_kg_m3 &&
+                                                              class_volume > rule.max_dense_solid_m3) {
+    p.structure = Structure::kHollow;
+    p.structure_source = ValueSource::kGeometry;
+    std::ostringstream note;
+    note.precision(3);
+    note << "hollow: the object's " << c.name << " parts enclose " << class_volume * 1000
+         << " litres, which would weigh " << class_volume * c.density_kg_m3
+         << " kg solid; dense parts this large are shells (" << mm(p.wall_thickness_m) << " walls, the class's)";
+    p.notes.push_back(note.str());
+  } else {
+    p.notes.push_back(std::string(to_string(c.structure)) + ": the class's default (no modelled inner walls)");
+  }
+  apply_geometry_guards(p, *in.completed);
+  return p;
+}
+
+}  // namespace detail
+
+namespace {
+
+class TableEstimator final : public PropertyEstimator {
+ public:
+  Status configure(const BackendSettings& settings) override {
+    for (const auto& [key, value] : settings)
+      if (!detail::set_table_rule(rule_, key, value))
+        return Status::InvalidArgument("table: bad setting " + key + "=" + value +
+                                       " (known: " + detail::kTableRuleKeys + ")");
+    return Status::Ok();
+  }
+  Result<PartProperties> estimate(const PropertyInput& input) const override {
+    return detail::table_properties(input, rule_);
+  }
+
+ private:
+  detail::TableRule rule_;
+};
+
+}  // namespace
+
+std::unique_ptr<PropertyEstimator> make_table_estimator() { return std::make_unique<TableEstimator>(); }
+
+Registry<PropertyEstimator>& estimator_registry() {
+  static Registry<PropertyEstimator>* registry = [] {
+    auto* r = new Registry<PropertyEstimator>();  // never destroyed: usable during static destruction
+    (void)r->add("table", &make_table_estimator);
+    (void)r->add("vlm", [] { return make_vlm_estimator(); });
+    return r;
+  }();
+  return *registry;
+}
+
+Result<std::unique_ptr<PropertyEstimator>> make_estimator(const std::string& name, const BackendSettings& settings) {
+  Result<std::unique_ptr<PropertyEstimator>> r = estimator_registry().create(name);
+  if (!r.ok()) return r.status();
+  G2P_RETURN_IF_ERROR((*r)->configure(settings).with_context("estimator '" + name + "'"));
+  return r;
+}
+
+}  // namespace g2p

@@ -48,16 +48,36 @@ Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, cons
                               b * (object.positions[static_cast<std::size_t>(t[2])].cast<double>() - p0);
     const Eigen::Vector3d n = face_normal(object, f);
     if (n.isZero()) continue;
-    // Into the closed volume: the direction along which the ray leaves it
-    // through an outward-facing triangle of the closed mesh (the patch may be
-    // wound either way).
+    // Where the ray along d leaves the closed volume: the first hit on an
+    // outward-facing triangle of the closed mesh (hits on inward-facing ones,
+    // where the patch sits just outside the closed surface, are stepped over).
+    auto exit_along = [&](const Eigen::Vector3d& d) {
+      double from = eps;
+      for (int step = 0; step < 4; ++step) {
+        double hit = 0;
+        int tri = -1;
+        if (!(*in_closed)->first_hit(p, d, from, 2 * diag, hit, tri)) return -1.0;
+        if (face_normal(closed, tri).dot(d) > 0) return hit;
+        from = hit + eps;
+      }
+      return -1.0;
+    };
+    const double out_minus = exit_along(-n), out_plus = exit_along(n);
+    if (out_minus > 0 && out_plus > 0 && std::min(out_minus, out_plus) > 1e-3 * diag) {
+      // Inside the closed volume in both directions: the patch here is an
+      // inner surface of the part (the inside of a modelled wall); the wall
+      // reaches to the nearer side.
+      ++w.rays;
+      ++w.inner_hits;
+      thickness.push_back(out_minus + out_plus);
+      inner.push_back(std::min(out_minus, out_plus));
+      continue;
+    }
     for (const Eigen::Vector3d& d : {Eigen::Vector3d(-n), Eigen::Vector3d(n)}) {
-      double exit_t = 0;
-      int exit_tri = -1;
-      if (!(*in_closed)->first_hit(p, d, eps, 2 * diag, exit_t, exit_tri)) continue;
-      if (face_normal(closed, exit_tri).dot(d) <= 0) continue;  // entering, so p was outside along d
-      // The patch itself may sit a little inside the closed surface; skip
-      // hits at the start, then look for an inner surface of the object.
+      const double exit_t = d.dot(n) < 0 ? out_minus : out_plus;
+      if (!(exit_t > 0)) continue;
+      // Skip hits at the start (the patch itself), then look for an inner
+      // surface of the object before the ray leaves the volume.
       double hit_t = 0;
       int hit_tri = -1;
       const double skip = std::max(eps, 1e-3 * exit_t);

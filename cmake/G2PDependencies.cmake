@@ -33,6 +33,23 @@ g2p_require(nlohmann_json_FOUND nlohmann-json3-dev)
 
 find_package(Threads REQUIRED)
 
+# URDF export goes through urdfdom's model and writer (which print with TinyXML 2.6).
+find_package(urdfdom QUIET)
+g2p_require(urdfdom_FOUND liburdfdom-dev)
+find_path(G2P_TINYXML_INCLUDE tinyxml.h)
+find_library(G2P_TINYXML_LIBRARY tinyxml)
+g2p_require(G2P_TINYXML_INCLUDE libtinyxml-dev)
+g2p_require(G2P_TINYXML_LIBRARY libtinyxml-dev)
+
+# MuJoCo checks exported MJCF files in the engine (check_in_mujoco, g2p validate).
+if(G2P_WITH_MUJOCO)
+  find_package(mujoco 2.2 QUIET)
+  if(NOT mujoco_FOUND)
+    message(FATAL_ERROR "G2P_WITH_MUJOCO=ON needs the Debian packages 'libmujoco-dev libqhull-dev libgl-dev "
+                        "libopengl-dev' (or configure with -DG2P_WITH_MUJOCO=OFF).")
+  endif()
+endif()
+
 if(G2P_WITH_CGAL)
   find_package(CGAL 5.5 QUIET)
   if(NOT CGAL_FOUND)

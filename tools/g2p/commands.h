@@ -24,5 +24,6 @@ void add_project_command(CLI::App& app, Command& run);
 void add_refine_command(CLI::App& app, Command& run);
 void add_complete_command(CLI::App& app, Command& run);
 void add_properties_command(CLI::App& app, Command& run);
+void add_export_command(CLI::App& app, Command& run);  // export and validate
 
 }  // namespace g2p::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   g2p::cli::add_refine_command(app, run);
   g2p::cli::add_complete_command(app, run);
   g2p::cli::add_properties_command(app, run);
+  g2p::cli::add_export_command(app, run);
   g2p::cli::add_eval_command(app, run);
 
   try {

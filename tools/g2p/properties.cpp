@@ -20,8 +20,7 @@ struct PropertiesArgs {
   LabelledSourceArgs source;
   CompleterArgs completer;
   std::string out;
-  std::string estimator = "table";
-  std::vector<std::string> settings;
+  EstimatorArgs estimator;
 };
 
 // The plausible mass range of labels.json's entry, if it has one.
@@ -45,26 +44,22 @@ int run_properties(const PropertiesArgs& args) {
     std::cerr << "g2p properties: error: give -o OUT for a model file\n";
     return kExitUsage;
   }
-  Result<BackendSettings> settings = parse_settings(args.settings);
-  if (!settings.ok()) {
-    std::cerr << "g2p properties: error: --estimate-set: " << settings.status().message() << "\n";
-    return kExitUsage;
-  }
-  Result<std::unique_ptr<PropertyEstimator>> estimator = make_estimator(args.estimator, *settings);
-  if (!estimator.ok()) {
-    std::cerr << "g2p properties: error: " << estimator.status().to_string() << "\n";
-    return kExitUsage;
+  {  // Bad estimator flags fail before any work.
+    Result<BackendSettings> settings = parse_settings(args.estimator.settings);
+    if (!settings.ok() || !make_estimator(args.estimator.name, *settings).ok()) {
+      std::cerr << "g2p properties: error: "
+                << (settings.ok() ? make_estimator(args.estimator.name, *settings).status().to_string()
+                                  : settings.status().to_string())
+                << "\n";
+      return kExitUsage;
+    }
   }
   Result<LabelledObject> object = load_labelled_source("properties", args.source, exit_code);
   if (!object.ok()) return exit_code;
   Result<Completion> done = run_completion("properties", args.completer, *object, exit_code);
   if (!done.ok()) return exit_code;
-  Result<PropertiesReport> report =
-      estimate_properties(object->model.mesh, object->faces.parts, *done, object->table, **estimator);
-  if (!report.ok()) {
-    std::cerr << "g2p properties: error: " << report.status().to_string() << "\n";
-    return kExitFailure;
-  }
+  Result<PropertiesReport> report = run_estimation("properties", args.estimator, *object, *done, exit_code);
+  if (!report.ok()) return exit_code;
   const std::string out = args.out.empty() ? args.source.source + "/properties" : args.out;
   Status s = write_completion(out + "/completed", *done, object->table);
   if (s.ok()) s = write_report(out + "/report.json", *report, object->table);
@@ -101,9 +96,7 @@ void add_properties_command(CLI::App& app, Command& run) {
       "properties", "Close every part and estimate density, structure and mass properties (stages 5 and 6)");
   add_labelled_source_flags(cmd, args->source);
   cmd->add_option("-o,--output", args->out, "Output folder (default SOURCE/properties for a folder)");
-  cmd->add_option("--estimator", args->estimator, "Property backend: table (default) or vlm");
-  cmd->add_option("--estimate-set", args->settings,
-                  "Estimator setting KEY=VALUE (repeatable), e.g. model=qwen2.5-vl url=http://host/v1");
+  add_estimator_flags(cmd, args->estimator);
   add_completer_flags(cmd, args->completer);
   cmd->callback([args, &run] { run = [args] { return run_properties(*args); }; });
 }

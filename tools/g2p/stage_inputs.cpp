@@ -128,6 +128,35 @@ Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs) {
   return s;
 }
 
+void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args) {
+  cmd->add_option("--estimator", args.name, "Stage 6 backend: table (default) or vlm");
+  cmd->add_option("--estimate-set", args.settings,
+                  "Estimator setting KEY=VALUE (repeatable), e.g. model=qwen2.5-vl url=http://host/v1");
+}
+
+Result<PropertiesReport> run_estimation(const std::string& command, const EstimatorArgs& args,
+                                        const LabelledObject& object, const Completion& completion, int& exit_code) {
+  Result<BackendSettings> settings = parse_settings(args.settings);
+  if (!settings.ok()) {
+    std::cerr << "g2p " << command << ": error: --estimate-set: " << settings.status().message() << "\n";
+    exit_code = kExitUsage;
+    return settings.status();
+  }
+  Result<std::unique_ptr<PropertyEstimator>> estimator = make_estimator(args.name, *settings);
+  if (!estimator.ok()) {
+    std::cerr << "g2p " << command << ": error: " << estimator.status().to_string() << "\n";
+    exit_code = kExitUsage;
+    return estimator.status();
+  }
+  Result<PropertiesReport> report =
+      estimate_properties(object.model.mesh, object.faces.parts, completion, object.table, **estimator);
+  if (!report.ok()) {
+    std::cerr << "g2p " << command << ": error: " << report.status().to_string() << "\n";
+    exit_code = kExitFailure;
+  }
+  return report;
+}
+
 void add_completer_flags(CLI::App* cmd, CompleterArgs& args) {
   cmd->add_option("--completer", args.name,
                   "Stage 5 backend: partition (default), external, alpha-wrap and fill (CGAL builds)");

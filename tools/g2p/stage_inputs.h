@@ -11,6 +11,7 @@
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/project.h"
+#include "g2p/properties.h"
 
 namespace g2p::cli {
 
@@ -45,6 +46,17 @@ void add_completer_flags(CLI::App* cmd, CompleterArgs& args);
 // error and sets exit_code. Prints the result unless `quiet`.
 Result<Completion> run_completion(const std::string& command, const CompleterArgs& args, const LabelledObject& object,
                                   int& exit_code);
+
+// --estimator and --estimate-set.
+struct EstimatorArgs {
+  std::string name = "table";
+  std::vector<std::string> settings;
+};
+void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args);
+
+// Stage 6 on a completed object; on failure prints the error and sets exit_code.
+Result<PropertiesReport> run_estimation(const std::string& command, const EstimatorArgs& args,
+                                        const LabelledObject& object, const Completion& completion, int& exit_code);
 
 // KEY=VALUE pairs as BackendSettings.
 Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs);

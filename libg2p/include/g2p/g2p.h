@@ -3,6 +3,7 @@
 
 #include "g2p/complete.h"
 #include "g2p/eval.h"
+#include "g2p/exporters.h"
 #include "g2p/image.h"
 #include "g2p/io.h"
 #include "g2p/materials.h"

@@ -1,0 +1,92 @@
+// exporters: the last step of Gen2Physics, simulation-ready assets. The
+// completed parts with their properties become one rigid body for MuJoCo
+// (MJCF), ROS tools (URDF) and Gazebo (SDF 1.9), with per-part meshes beside
+// them. Output folders are self-contained and relocatable (relative paths
+// only). docs/formats.md shows what each file holds.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "g2p/complete.h"
+#include "g2p/export.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/project.h"
+#include "g2p/properties.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// One part as the exporters see it.
+struct AssetPart {
+  std::string name;      // "part_3_Metal", unique, safe in file and XML names
+  std::string material;  // class name
+  std::array<double, 4> rgba{0.5, 0.5, 0.5, 1.0};
+  Mesh collision;  // the closed volume (complete stage)
+  Mesh visual;     // the part's own surface from the input
+  PartProperties properties;
+  MassProperties mass;
+};
+
+// A rigid object ready for export.
+struct SimulationAsset {
+  std::string name;  // model, body and link name
+  std::vector<AssetPart> parts;
+  MassProperties total;  // about the centre of mass, in the object's frame (+Z up, metres)
+  std::vector<std::string> notes;
+};
+
+// Gathers the stages' results. Parts without a closed volume are left out
+// (noted); at least one must remain.
+G2P_API Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, const std::vector<Part>& parts,
+                                           const Completion& completion, const PropertiesReport& report,
+                                           const MaterialTable& table);
+
+struct ExportOptions {
+  bool free_joint = true;  // MJCF: the body floats (a free joint); false: fixed to the world
+  // MuJoCo has one friction coefficient per geom (plus torsional and rolling):
+  // the class's dynamic (sliding) coefficient by default, else the static one.
+  bool use_static_friction = false;
+};
+
+// The texts of the three formats; meshes are referenced as meshes/NAME.stl
+// (collision) and meshes/NAME_visual.stl.
+G2P_API std::string mjcf_text(const SimulationAsset& asset, const ExportOptions& options = {});
+G2P_API Result<std::string> urdf_text(const SimulationAsset& asset);  // through urdfdom's model and writer
+G2P_API std::string sdf_text(const SimulationAsset& asset);
+
+// Writes DIR/NAME.xml, DIR/NAME.urdf and/or DIR/NAME.sdf (formats "mjcf",
+// "urdf", "sdf") and DIR/meshes/. Every file is written under a temporary
+// name and renamed.
+G2P_API Status write_asset(const std::string& dir, const SimulationAsset& asset,
+                           const std::vector<std::string>& formats, const ExportOptions& options = {});
+
+// ---- Validation in a real engine ---------------------------------------------
+
+// What MuJoCo makes of an MJCF file: the body's mass properties as the engine
+// compiled them, and a drop onto a plane.
+struct EngineCheck {
+  double mass_kg = 0.0;
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();     // in the body frame
+  Eigen::Vector3d principal_moments = Eigen::Vector3d::Zero();  // ascending, kg m^2
+  // Drop: released from rest with its lowest point `drop_height_m` above a
+  // plane, simulated for `drop_seconds`.
+  bool dropped = false;
+  bool finite = false;            // no NaN or blow-up
+  double lowest_point_m = 0.0;    // min over the run of the lowest collision-mesh vertex's height
+  double resting_lowest_m = 0.0;  // the lowest vertex's height at the end (soft contacts: slightly < 0)
+  double final_speed_m_s = 0.0;   // of the centre of mass at the end
+  double final_height_m = 0.0;    // of the centre of mass at the end
+  std::string engine;             // "MuJoCo 2.2.2"
+};
+
+// Whether libg2p was built with MuJoCo.
+G2P_API bool have_mujoco();
+
+// Loads an MJCF file written by write_asset into MuJoCo and runs the drop.
+// Unavailable when libg2p was built without MuJoCo.
+G2P_API Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_height_m = 0.2,
+                                            double drop_seconds = 2.0);
+
+}  // namespace g2p

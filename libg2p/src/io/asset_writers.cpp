@@ -1,0 +1,172 @@
+// make_asset, MJCF and SDF texts, and write_asset.
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <sstream>
+
+#include "core/file_util.h"
+#include "g2p/exporters.h"
+#include "g2p/io.h"
+
+namespace g2p {
+namespace {
+
+// Letters, digits and underscores only: safe in file names and XML names.
+std::string safe_name(const std::string& s) {
+  std::string out;
+  for (unsigned char c : s) out += std::isalnum(c) ? static_cast<char>(c) : '_';
+  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "m_" + out;
+  return out;
+}
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.9g", v);
+  return b;
+}
+
+std::string vec3(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else if (c == '-' && !out.empty() && out.back() == '-')
+      out += ' ';  // never "--" inside comments
+    else
+      out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, const std::vector<Part>& parts,
+                                   const Completion& completion, const PropertiesReport& report,
+                                   const MaterialTable& table) {
+  if (parts.size() != completion.parts.size() || parts.size() != report.parts.size())
+    return Status::InvalidArgument("make_asset: parts, completion and report disagree in length");
+  SimulationAsset a;
+  a.name = safe_name(name);
+  std::vector<MassProperties> masses;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const CompletedPart& c = completion.parts[i];
+    const PartReport& r = report.parts[i];
+    if (c.mesh.num_faces() == 0 || !(r.mass.mass_kg > 0)) {
+      a.notes.push_back("part " + std::to_string(i) + " has no closed volume or mass and is not exported");
+      continue;
+    }
+    AssetPart p;
+    p.material = table.valid_label(parts[i].label) ? table[parts[i].label].name : "Unknown";
+    p.name = "part_" + std::to_string(i) + "_" + safe_name(p.material);
+    if (table.valid_label(parts[i].label))
+      for (int k = 0; k < 3; ++k)
+        p.rgba[static_cast<std::size_t>(k)] = table[parts[i].label].color[static_cast<std::size_t>(k)] / 255.0;
+    p.collision = c.mesh;
+    p.visual = part_patch(object, parts[i]);
+    p.properties = r.properties;
+    p.mass = r.mass;
+    if (!c.ok) a.notes.push_back(p.name + " failed its completion checks; exported as it is");
+    masses.push_back(p.mass);
+    a.parts.push_back(std::move(p));
+  }
+  if (a.parts.empty()) return Status::InvalidArgument("make_asset: no part has a closed volume and a mass");
+  a.total = combine(masses);
+  return a;
+}
+
+std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
+  std::ostringstream x;
+  const MassProperties& m = a.total;
+  x << "<mujoco model=\"" << a.name << "\">\n"
+    << "  <!-- Written by libg2p (Gen2Physics). Metres, kilograms, seconds; +Z up. The body's inertial is\n"
+    << "       libg2p's exact mass properties of the completed parts; geoms carry no mass. MuJoCo collides\n"
+    << "       non-convex mesh geoms as their convex hulls: contacts on concave parts are approximate until a\n"
+    << "       convex decomposition is added. -->\n";
+  for (const std::string& n : a.notes) x << "  <!-- " << xml_escape(n) << " -->\n";
+  x << "  <compiler angle=\"radian\" meshdir=\"meshes\" inertiafromgeom=\"false\"/>\n"
+    << "  <option gravity=\"0 0 -9.81\"/>\n  <asset>\n";
+  // OBJ: MuJoCo 2.2 reads at most 200000 triangles from an STL file.
+  for (const AssetPart& p : a.parts) x << "    <mesh name=\"" << p.name << "\" file=\"" << p.name << ".obj\"/>\n";
+  x << "  </asset>\n  <worldbody>\n    <body name=\"" << a.name << "\">\n";
+  if (options.free_joint) x << "      <freejoint name=\"" << a.name << "_free\"/>\n";
+  const Eigen::Matrix3d& I = m.inertia;
+  x << "      <inertial pos=\"" << vec3(m.center_of_mass) << "\" mass=\"" << num(m.mass_kg) << "\" fullinertia=\""
+    << num(I(0, 0)) << " " << num(I(1, 1)) << " " << num(I(2, 2)) << " " << num(I(0, 1)) << " " << num(I(0, 2)) << " "
+    << num(I(1, 2)) << "\"/>\n";
+  for (const AssetPart& p : a.parts) {
+    const PartProperties& pp = p.properties;
+    const double mu = options.use_static_friction ? pp.friction_static : pp.friction_dynamic;
+    x << "      <!-- " << p.name << ": " << to_string(pp.structure) << ", " << num(pp.density_kg_m3) << " kg/m^3, "
+      << num(p.mass.mass_kg) << " kg -->\n"
+      << "      <geom name=\"" << p.name << "\" type=\"mesh\" mesh=\"" << p.name << "\" rgba=\"" << num(p.rgba[0])
+      << " " << num(p.rgba[1]) << " " << num(p.rgba[2]) << " " << num(p.rgba[3]) << "\" friction=\"" << num(mu)
+      << " 0.005 0.0001\" solref=\"" << num(pp.solref[0]) << " " << num(pp.solref[1]) << "\" solimp=\""
+      << num(pp.solimp[0]) << " " << num(pp.solimp[1]) << " " << num(pp.solimp[2]) << " " << num(pp.solimp[3]) << " "
+      << num(pp.solimp[4]) << "\"/>\n";
+  }
+  x << "    </body>\n  </worldbody>\n</mujoco>\n";
+  return x.str();
+}
+
+std::string sdf_text(const SimulationAsset& a) {
+  std::ostringstream x;
+  const MassProperties& m = a.total;
+  const Eigen::Matrix3d& I = m.inertia;
+  x << "<?xml version=\"1.0\"?>\n<!-- Written by libg2p (Gen2Physics). Metres, kilograms; +Z up. -->\n"
+    << "<sdf version=\"1.9\">\n  <model name=\"" << a.name << "\">\n    <link name=\"" << a.name << "\">\n"
+    << "      <inertial>\n        <pose>" << vec3(m.center_of_mass) << " 0 0 0</pose>\n        <mass>" << num(m.mass_kg)
+    << "</mass>\n        <inertia>\n          <ixx>" << num(I(0, 0)) << "</ixx>\n          <ixy>" << num(I(0, 1))
+    << "</ixy>\n          <ixz>" << num(I(0, 2)) << "</ixz>\n          <iyy>" << num(I(1, 1))
+    << "</iyy>\n          <iyz>" << num(I(1, 2)) << "</iyz>\n          <izz>" << num(I(2, 2))
+    << "</izz>\n        </inertia>\n      </inertial>\n";
+  for (const AssetPart& p : a.parts) {
+    const PartProperties& pp = p.properties;
+    x << "      <collision name=\"" << p.name << "\">\n        <geometry><mesh><uri>meshes/" << p.name
+      << ".stl</uri></mesh></geometry>\n        <surface>\n          <friction><ode><mu>" << num(pp.friction_static)
+      << "</mu><mu2>" << num(pp.friction_static)
+      << "</mu2></ode></friction>\n          <bounce><restitution_coefficient>" << num(pp.restitution)
+      << "</restitution_coefficient></bounce>\n        </surface>\n      </collision>\n"
+      << "      <visual name=\"" << p.name << "_visual\">\n        <geometry><mesh><uri>meshes/" << p.name
+      << "_visual.stl</uri></mesh></geometry>\n        <material><diffuse>" << num(p.rgba[0]) << " " << num(p.rgba[1])
+      << " " << num(p.rgba[2]) << " " << num(p.rgba[3]) << "</diffuse></material>\n      </visual>\n";
+  }
+  x << "    </link>\n  </model>\n</sdf>\n";
+  return x.str();
+}
+
+Status write_asset(const std::string& dir, const SimulationAsset& a, const std::vector<std::string>& formats,
+                   const ExportOptions& options) {
+  for (const std::string& f : formats)
+    if (f != "mjcf" && f != "urdf" && f != "sdf")
+      return Status::InvalidArgument("write_asset: unknown format '" + f + "' (mjcf, urdf, sdf)");
+  std::string urdf;
+  for (const std::string& f : formats)
+    if (f == "urdf") {
+      Result<std::string> u = urdf_text(a);
+      if (!u.ok()) return u.status();
+      urdf = *u;
+    }
+  G2P_RETURN_IF_ERROR(detail::ensure_directory(dir + "/meshes"));
+  for (const AssetPart& p : a.parts) {
+    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + ".stl", p.collision));
+    if (std::find(formats.begin(), formats.end(), "mjcf") != formats.end())
+      G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + ".obj", p.collision));
+    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_visual.stl", p.visual));
+  }
+  for (const std::string& f : formats) {
+    if (f == "mjcf") G2P_RETURN_IF_ERROR(write_text_file(dir + "/" + a.name + ".xml", mjcf_text(a, options)));
+    if (f == "urdf") G2P_RETURN_IF_ERROR(write_text_file(dir + "/" + a.name + ".urdf", urdf));
+    if (f == "sdf") G2P_RETURN_IF_ERROR(write_text_file(dir + "/" + a.name + ".sdf", sdf_text(a)));
+  }
+  return Status::Ok();
+}
+
+}  // namespace g2p

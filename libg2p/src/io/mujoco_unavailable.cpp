@@ -1,0 +1,12 @@
+// check_in_mujoco when libg2p is built without MuJoCo (G2P_WITH_MUJOCO=OFF).
+#include "g2p/exporters.h"
+
+namespace g2p {
+
+bool have_mujoco() { return false; }
+
+Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double, double) {
+  return Status::Unavailable(mjcf_path + ": libg2p was built without MuJoCo (G2P_WITH_MUJOCO=OFF)");
+}
+
+}  // namespace g2p

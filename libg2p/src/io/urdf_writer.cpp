@@ -1,0 +1,72 @@
+// urdf_text: the asset as a URDF, built with urdfdom's model types and written
+// by its exporter (so what ROS tools parse is what urdfdom writes). One link
+// with the combined inertial and a visual and a collision element per part.
+#include <tinyxml.h>
+#include <urdf_model/model.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <memory>
+
+#include "g2p/exporters.h"
+
+namespace g2p {
+
+Result<std::string> urdf_text(const SimulationAsset& a) {
+  urdf::ModelInterface model;
+  model.name_ = a.name;
+  auto link = std::make_shared<urdf::Link>();
+  link->name = a.name;
+  auto inertial = std::make_shared<urdf::Inertial>();
+  const MassProperties& m = a.total;
+  inertial->origin.position = urdf::Vector3(m.center_of_mass.x(), m.center_of_mass.y(), m.center_of_mass.z());
+  inertial->mass = m.mass_kg;
+  inertial->ixx = m.inertia(0, 0);
+  inertial->ixy = m.inertia(0, 1);
+  inertial->ixz = m.inertia(0, 2);
+  inertial->iyy = m.inertia(1, 1);
+  inertial->iyz = m.inertia(1, 2);
+  inertial->izz = m.inertia(2, 2);
+  link->inertial = inertial;
+  for (const AssetPart& p : a.parts) {
+    auto material = std::make_shared<urdf::Material>();
+    material->name = p.material;
+    material->color.r = static_cast<float>(p.rgba[0]);
+    material->color.g = static_cast<float>(p.rgba[1]);
+    material->color.b = static_cast<float>(p.rgba[2]);
+    material->color.a = static_cast<float>(p.rgba[3]);
+    model.materials_[material->name] = material;
+
+    auto visual_mesh = std::make_shared<urdf::Mesh>();
+    visual_mesh->filename = "meshes/" + p.name + "_visual.stl";
+    visual_mesh->scale = urdf::Vector3(1, 1, 1);
+    auto visual = std::make_shared<urdf::Visual>();
+    visual->name = p.name;
+    visual->geometry = visual_mesh;
+    visual->material_name = material->name;
+    visual->material = material;
+    link->visual_array.push_back(visual);
+
+    auto collision_mesh = std::make_shared<urdf::Mesh>();
+    collision_mesh->filename = "meshes/" + p.name + ".stl";
+    collision_mesh->scale = urdf::Vector3(1, 1, 1);
+    auto collision = std::make_shared<urdf::Collision>();
+    collision->name = p.name;
+    collision->geometry = collision_mesh;
+    link->collision_array.push_back(collision);
+  }
+  if (!link->visual_array.empty()) link->visual = link->visual_array.front();
+  if (!link->collision_array.empty()) link->collision = link->collision_array.front();
+  model.links_[link->name] = link;
+  model.root_link_ = link;
+
+  std::unique_ptr<TiXmlDocument> doc(urdf::exportURDF(model));
+  if (!doc) return Status::Internal("urdfdom could not export the model");
+  TiXmlPrinter printer;
+  printer.SetIndent("  ");
+  doc->Accept(&printer);
+  return "<?xml version=\"1.0\"?>\n<!-- Written by libg2p (Gen2Physics) through urdfdom. Metres, kilograms; +Z up. "
+         "-->\n" +
+         std::string(printer.CStr());
+}
+
+}  // namespace g2p

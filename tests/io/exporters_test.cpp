@@ -1,0 +1,211 @@
+// Exported assets in the real consumers: MuJoCo compiles and simulates the
+// MJCF, urdfdom (and check_urdf) reads the URDF, TinyXML the SDF.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "g2p/complete.h"
+#include "g2p/exporters.h"
+#include "g2p/io.h"
+#include "g2p/project.h"
+#include "g2p/properties.h"
+#include "g2p/segment.h"
+#include "support/gltf_builder.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+constexpr int kWood = static_cast<int>(PaperClass::kWood);
+constexpr int kMetal = static_cast<int>(PaperClass::kMetal);
+
+// The generated hammer through stages 5 and 6; `head_label` is the head's class.
+SimulationAsset hammer_asset(int head_label) {
+  const std::string path = test::scratch_dir("ExportHammer") + "/hammer.glb";
+  test::make_hammer().write(path);
+  const Model model = *load_model(path);
+  std::vector<Part> parts(2);
+  parts[0].label = head_label;
+  parts[1].label = kWood;
+  for (int f = 0; f < model.mesh.num_faces(); ++f)
+    parts[static_cast<std::size_t>(model.mesh.face_source[static_cast<std::size_t>(f)].material)].faces.push_back(f);
+  const MaterialTable& table = MaterialTable::paper_default();
+  const Completion completion = *(*make_completer("partition"))->complete({&model.mesh, &parts, &table});
+  const PropertiesReport report = *estimate_properties(model.mesh, parts, completion, table, **make_estimator("table"));
+  Result<SimulationAsset> asset = make_asset("hammer", model.mesh, parts, completion, report, table);
+  EXPECT_TRUE(asset.ok()) << asset.status().to_string();
+  return *asset;
+}
+
+void expect_relative(double got, double want, double tolerance, const char* what) {
+  EXPECT_NEAR(got, want, tolerance * std::abs(want)) << what;
+}
+
+TEST(Exporters, MujocoCompilesTheHammerWithLibg2psMassProperties) {
+  const SimulationAsset asset = hammer_asset(kMetal);
+  const std::string dir = test::scratch_dir("ExportMjcf");
+  ASSERT_TRUE(write_asset(dir, asset, {"mjcf", "urdf", "sdf"}).ok());
+  Result<EngineCheck> c = check_in_mujoco(dir + "/hammer.xml");
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  expect_relative(c->mass_kg, asset.total.mass_kg, 1e-6, "mass");
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(c->center_of_mass[a], asset.total.center_of_mass[a], 1e-6);
+  const Eigen::Vector3d ours = asset.total.principal_moments();
+  for (int a = 0; a < 3; ++a) expect_relative(c->principal_moments[a], ours[a], 1e-6, "principal moment");
+  // Dropped on a plane it comes to rest without exploding or sinking through.
+  EXPECT_TRUE(c->dropped);
+  EXPECT_TRUE(c->finite);
+  // MuJoCo's contacts are soft: a little penetration on impact, less at rest.
+  EXPECT_GT(c->lowest_point_m, -0.03);
+  EXPECT_GT(c->resting_lowest_m, -0.005);
+  EXPECT_LT(c->resting_lowest_m, 0.005);
+  EXPECT_LT(c->final_speed_m_s, 0.05);
+  // The folder is relocatable: the files name their meshes relatively.
+  for (const char* f : {"hammer.xml", "hammer.urdf", "hammer.sdf"})
+    EXPECT_EQ(test::read_file(dir + "/" + f).find(dir), std::string::npos) << f;
+}
+
+// |angular acceleration| of the hammer hinged on a horizontal axis (body y)
+// through its bounding-box centre, handle horizontal, released from rest.
+double hinge_acceleration(const SimulationAsset& asset, const std::string& dir, double& predicted) {
+  EXPECT_TRUE(write_asset(dir, asset, {"mjcf"}).ok());
+  std::string xml = test::read_file(dir + "/hammer.xml");
+  Eigen::AlignedBox3d box;
+  for (const AssetPart& p : asset.parts) box.extend(bounds(p.collision));
+  const Eigen::Vector3d hinge = box.center();
+  char joint[256];
+  std::snprintf(joint, sizeof joint, "<joint name=\"hinge\" type=\"hinge\" axis=\"0 1 0\" pos=\"%.9g %.9g %.9g\"/>",
+                hinge.x(), hinge.y(), hinge.z());
+  const std::string free = "<freejoint name=\"hammer_free\"/>";
+  const std::size_t at = xml.find(free);
+  EXPECT_NE(at, std::string::npos);
+  xml.replace(at, free.size(), joint);
+  // Turn the body so its +Z (the handle) lies along world +X.
+  const std::string open = "<body name=\"hammer\">";
+  xml.replace(xml.find(open), open.size(), "<body name=\"hammer\" quat=\"0.70710678 0 0.70710678 0\">");
+  test::write_file(dir + "/hinged.xml", xml);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML((dir + "/hinged.xml").c_str(), nullptr, error, sizeof error);
+  EXPECT_NE(m, nullptr) << error;
+  if (m == nullptr) return 0;
+  mjData* d = mj_makeData(m);
+  mj_forward(m, d);
+  const double qacc = d->qacc[0];
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  // m g d / I about the hinge: d is the centre of mass's offset along the
+  // handle (horizontal), I the moment about the hinge axis.
+  const MassProperties& t = asset.total;
+  const Eigen::Vector3d r = t.center_of_mass - hinge;
+  const double inertia = t.inertia(1, 1) + t.mass_kg * (r.x() * r.x() + r.z() * r.z());
+  predicted = t.mass_kg * 9.81 * std::abs(r.z()) / inertia;
+  return std::abs(qacc);
+}
+
+TEST(Exporters, HingedHammerSwingsHeadDownAsPhysicsSays) {
+  double predicted = 0, predicted_uniform = 0;
+  const double two_materials = hinge_acceleration(hammer_asset(kMetal), test::scratch_dir("ExportHinge"), predicted);
+  EXPECT_NEAR(two_materials / predicted, 1.0, 0.01);
+  // Uniform density (all wood): the centre of mass sits near the geometric
+  // centre, and the hammer swings measurably less.
+  const double uniform =
+      hinge_acceleration(hammer_asset(kWood), test::scratch_dir("ExportHingeUniform"), predicted_uniform);
+  EXPECT_NEAR(uniform / predicted_uniform, 1.0, 0.01);
+  EXPECT_LT(uniform, 0.8 * two_materials) << "uniform " << uniform << " vs two materials " << two_materials;
+}
+
+TEST(Exporters, UrdfdomAndCheckUrdfReadTheUrdf) {
+  const SimulationAsset asset = hammer_asset(kMetal);
+  const std::string dir = test::scratch_dir("ExportUrdf");
+  ASSERT_TRUE(write_asset(dir, asset, {"urdf"}).ok());
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(test::read_file(dir + "/hammer.urdf"));
+  ASSERT_NE(model, nullptr);
+  auto link = model->getLink("hammer");
+  ASSERT_NE(link, nullptr);
+  ASSERT_NE(link->inertial, nullptr);
+  expect_relative(link->inertial->mass, asset.total.mass_kg, 1e-6, "URDF mass");
+  EXPECT_EQ(link->visual_array.size(), asset.parts.size());
+  EXPECT_EQ(link->collision_array.size(), asset.parts.size());
+  for (const auto& v : link->visual_array) {
+    auto mesh = std::dynamic_pointer_cast<urdf::Mesh>(v->geometry);
+    ASSERT_NE(mesh, nullptr);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + mesh->filename)) << mesh->filename;
+  }
+  if (std::filesystem::exists("/usr/bin/check_urdf"))
+    EXPECT_EQ(std::system(("/usr/bin/check_urdf " + dir + "/hammer.urdf > /dev/null").c_str()), 0);
+}
+
+TEST(Exporters, SdfIsWellFormedWithTheSameInertial) {
+  const SimulationAsset asset = hammer_asset(kMetal);
+  TiXmlDocument doc;
+  doc.Parse(sdf_text(asset).c_str());
+  ASSERT_FALSE(doc.Error()) << doc.ErrorDesc();
+  TiXmlElement* sdf = doc.FirstChildElement("sdf");
+  ASSERT_NE(sdf, nullptr);
+  EXPECT_STREQ(sdf->Attribute("version"), "1.9");
+  TiXmlElement* link = sdf->FirstChildElement("model")->FirstChildElement("link");
+  ASSERT_NE(link, nullptr);
+  expect_relative(std::atof(link->FirstChildElement("inertial")->FirstChildElement("mass")->GetText()),
+                  asset.total.mass_kg, 1e-6, "SDF mass");
+  int collisions = 0;
+  for (TiXmlElement* c = link->FirstChildElement("collision"); c; c = c->NextSiblingElement("collision")) ++collisions;
+  EXPECT_EQ(collisions, static_cast<int>(asset.parts.size()));
+}
+
+TEST(Exporters, BadInputIsRefused) {
+  const SimulationAsset asset = hammer_asset(kMetal);
+  EXPECT_EQ(write_asset(test::scratch_dir("ExportBad"), asset, {"fbx"}).code(), StatusCode::kInvalidArgument);
+  EXPECT_FALSE(check_in_mujoco(test::scratch_dir("ExportBad2") + "/missing.xml").ok());
+  const std::string dir = test::scratch_dir("ExportBad3");
+  test::write_file(dir + "/broken.xml",
+                   "<mujoco><worldbody><body><geom type=\"mesh\" mesh=\"nope\"/></body></worldbody></mujoco>");
+  Result<EngineCheck> c = check_in_mujoco(dir + "/broken.xml");
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("MuJoCo"), std::string::npos) << c.status().message();
+}
+
+// Every shared asset, labelled with its ground truth, exports an MJCF that
+// MuJoCo compiles with libg2p's mass properties and drops without blowing up.
+class ExportAssets : public testing::TestWithParam<const char*> {};
+
+TEST_P(ExportAssets, MujocoAgreesAndTheDropSettles) {
+  const std::string name = GetParam();
+  const Model model = *load_model(test::asset_path(name));
+  const MaterialTable& table = MaterialTable::paper_default();
+  const std::vector<int> by_material = *material_labels_from_json(test::read_file(test::labels_json_path()), name,
+                                                                  table, static_cast<int>(model.materials.size()));
+  std::vector<int> labels(static_cast<std::size_t>(model.mesh.num_faces()));
+  for (int f = 0; f < model.mesh.num_faces(); ++f) {
+    const int l = by_material[static_cast<std::size_t>(model.mesh.face_source[static_cast<std::size_t>(f)].material)];
+    labels[static_cast<std::size_t>(f)] = l == kUnknownLabel ? static_cast<int>(PaperClass::kOther) : l;
+  }
+  std::vector<int> face_part;
+  const std::vector<Part> parts = partition(model.mesh, *build_face_graph(model.mesh), labels, face_part);
+  const Completion completion = *(*make_completer("partition"))->complete({&model.mesh, &parts, &table});
+  const PropertiesReport report = *estimate_properties(model.mesh, parts, completion, table, **make_estimator("table"));
+  const SimulationAsset asset = *make_asset(name, model.mesh, parts, completion, report, table);
+  const std::string dir = test::scratch_dir("ExportAsset" + name);
+  ASSERT_TRUE(write_asset(dir, asset, {"mjcf", "urdf", "sdf"}).ok());
+  Result<EngineCheck> c = check_in_mujoco(dir + "/" + asset.name + ".xml");
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  expect_relative(c->mass_kg, asset.total.mass_kg, 1e-6, "mass");
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(c->center_of_mass[a], asset.total.center_of_mass[a], 1e-6);
+  const Eigen::Vector3d ours = asset.total.principal_moments();
+  for (int a = 0; a < 3; ++a) expect_relative(c->principal_moments[a], ours[a], 1e-6, "principal moment");
+  EXPECT_TRUE(c->finite);
+  EXPECT_GT(c->resting_lowest_m, -0.01);
+  EXPECT_LT(c->final_speed_m_s, 0.1);
+  if (std::filesystem::exists("/usr/bin/check_urdf"))
+    EXPECT_EQ(std::system(("/usr/bin/check_urdf " + dir + "/" + asset.name + ".urdf > /dev/null").c_str()), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedAssets, ExportAssets,
+                         testing::Values("SheenChair", "GlamVelvetSofa", "GlassHurricaneCandleHolder", "WaterBottle",
+                                         "Avocado"));
+
+}  // namespace
+}  // namespace g2p

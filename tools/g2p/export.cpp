@@ -1,0 +1,156 @@
+// g2p export SOURCE -o OUT: stages 5 and 6 and the simulation assets (MJCF,
+// URDF, SDF with per-part meshes, report.json). g2p validate DIR: the MJCF in
+// MuJoCo next to libg2p's numbers, and a drop onto a plane.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "g2p/exporters.h"
+#include "g2p/io.h"
+#include "stage_inputs.h"
+
+namespace g2p::cli {
+namespace {
+
+struct ExportArgs {
+  LabelledSourceArgs source;
+  CompleterArgs completer;
+  EstimatorArgs estimator;
+  std::string out, name;
+  std::vector<std::string> formats{"mjcf", "urdf", "sdf"};
+  bool fixed = false;
+};
+
+int run_export(const ExportArgs& args) {
+  int exit_code = kExitOk;
+  if (args.out.empty()) {
+    std::cerr << "g2p export: error: give -o OUT\n";
+    return kExitUsage;
+  }
+  Result<LabelledObject> object = load_labelled_source("export", args.source, exit_code);
+  if (!object.ok()) return exit_code;
+  Result<Completion> done = run_completion("export", args.completer, *object, exit_code);
+  if (!done.ok()) return exit_code;
+  Result<PropertiesReport> report = run_estimation("export", args.estimator, *object, *done, exit_code);
+  if (!report.ok()) return exit_code;
+  namespace fs = std::filesystem;
+  std::string name = args.name;
+  if (name.empty()) {
+    const fs::path source(args.source.source);
+    name =
+        fs::is_directory(source) ? fs::absolute(source).lexically_normal().filename().string() : source.stem().string();
+    if (name.empty()) name = "object";
+  }
+  Result<SimulationAsset> asset =
+      make_asset(name, object->model.mesh, object->faces.parts, *done, *report, object->table);
+  if (!asset.ok()) {
+    std::cerr << "g2p export: error: " << asset.status().to_string() << "\n";
+    return kExitFailure;
+  }
+  ExportOptions options;
+  options.free_joint = !args.fixed;
+  Status s = write_asset(args.out, *asset, args.formats, options);
+  if (s.ok()) s = write_report(args.out + "/report.json", *report, object->table);
+  if (!s.ok()) {
+    std::cerr << "g2p export: error: " << s.to_string() << "\n";
+    return kExitFailure;
+  }
+  std::printf("exported '%s': %zu parts, %.4g kg, centre of mass (%.4g %.4g %.4g) m -> %s\n", asset->name.c_str(),
+              asset->parts.size(), asset->total.mass_kg, asset->total.center_of_mass.x(),
+              asset->total.center_of_mass.y(), asset->total.center_of_mass.z(), args.out.c_str());
+  for (const std::string& n : asset->notes) std::printf("  note: %s\n", n.c_str());
+  return kExitOk;
+}
+
+struct ValidateArgs {
+  std::string dir;
+  double height = 0.2, seconds = 2.0;
+};
+
+int run_validate(const ValidateArgs& args) {
+  namespace fs = std::filesystem;
+  std::string mjcf;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(args.dir, ec))
+    if (e.path().extension() == ".xml") mjcf = e.path().string();
+  if (ec || mjcf.empty()) {
+    std::cerr << "g2p validate: error: " << args.dir << ": no MJCF (.xml) file (is this a g2p export folder?)\n";
+    return kExitFailure;
+  }
+  if (!have_mujoco()) {
+    std::cerr << "g2p validate: error: this libg2p was built without MuJoCo (G2P_WITH_MUJOCO=OFF)\n";
+    return kExitFailure;
+  }
+  Result<EngineCheck> c = check_in_mujoco(mjcf, args.height, args.seconds);
+  if (!c.ok()) {
+    std::cerr << "g2p validate: error: " << c.status().to_string() << "\n";
+    return kExitFailure;
+  }
+  bool pass = c->finite && c->resting_lowest_m > -0.01;
+  std::printf("%s: %s\n", mjcf.c_str(), c->engine.c_str());
+  std::printf("  %-24s %-36s %s\n", "", "engine", "libg2p (report.json)");
+  std::ifstream in(args.dir + "/report.json");
+  const nlohmann::json report = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
+  if (report.is_object() && report.contains("object")) {
+    const nlohmann::json& o = report["object"];
+    const double mass = o["mass_kg"].get<double>();
+    std::printf("  %-24s %-36.6g %.6g\n", "mass (kg)", c->mass_kg, mass);
+    char engine[96], ours[96];
+    std::snprintf(engine, sizeof engine, "%.5g %.5g %.5g", c->center_of_mass.x(), c->center_of_mass.y(),
+                  c->center_of_mass.z());
+    std::snprintf(ours, sizeof ours, "%.5g %.5g %.5g", o["center_of_mass_m"][0].get<double>(),
+                  o["center_of_mass_m"][1].get<double>(), o["center_of_mass_m"][2].get<double>());
+    std::printf("  %-24s %-36s %s\n", "centre of mass (m)", engine, ours);
+    std::snprintf(engine, sizeof engine, "%.5g %.5g %.5g", c->principal_moments.x(), c->principal_moments.y(),
+                  c->principal_moments.z());
+    std::snprintf(ours, sizeof ours, "%.5g %.5g %.5g", o["principal_moments_kg_m2"][0].get<double>(),
+                  o["principal_moments_kg_m2"][1].get<double>(), o["principal_moments_kg_m2"][2].get<double>());
+    std::printf("  %-24s %-36s %s\n", "principal moments", engine, ours);
+    pass = pass && std::abs(c->mass_kg - mass) <= 1e-6 * mass;
+    for (int a = 0; a < 3; ++a)
+      pass = pass && std::abs(c->center_of_mass[a] - o["center_of_mass_m"][a].get<double>()) <= 1e-6 &&
+             std::abs(c->principal_moments[a] - o["principal_moments_kg_m2"][a].get<double>()) <=
+                 1e-6 * std::abs(o["principal_moments_kg_m2"][a].get<double>()) + 1e-12;
+  } else {
+    std::printf("  mass %.6g kg (no report.json to compare with)\n", c->mass_kg);
+  }
+  if (c->dropped)
+    std::printf(
+        "  drop from %.3g m for %.3g s: lowest point %.4g m, at rest %.4g m above the plane, final speed %.3g m/s%s\n",
+        args.height, args.seconds, c->lowest_point_m, c->resting_lowest_m, c->final_speed_m_s,
+        c->finite ? "" : ", NOT FINITE");
+  std::printf("%s\n", pass ? "PASS" : "FAIL");
+  return pass ? kExitOk : kExitFailure;
+}
+
+}  // namespace
+
+void add_export_command(CLI::App& app, Command& run) {
+  auto args = std::make_shared<ExportArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "export", "Close the parts, estimate their properties and write MJCF, URDF and SDF assets (stages 5, 6, export)");
+  add_labelled_source_flags(cmd, args->source);
+  cmd->add_option("-o,--output", args->out, "Output folder")->required();
+  cmd->add_option("--name", args->name, "Model name (default: the model file's stem or the folder's name)");
+  cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf (comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"mjcf", "urdf", "sdf"}));
+  cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
+  add_completer_flags(cmd, args->completer);
+  add_estimator_flags(cmd, args->estimator);
+  cmd->callback([args, &run] { run = [args] { return run_export(*args); }; });
+
+  auto vargs = std::make_shared<ValidateArgs>();
+  CLI::App* v = app.add_subcommand("validate", "Load an exported MJCF in MuJoCo, compare, and drop it on a plane");
+  v->add_option("dir", vargs->dir, "Output folder of g2p export")->required();
+  v->add_option("--drop-height", vargs->height, "Drop height above the plane, m (default 0.2)");
+  v->add_option("--seconds", vargs->seconds, "Simulated time, s (default 2)");
+  v->callback([vargs, &run] { run = [vargs] { return run_validate(*vargs); }; });
+}
+
+}  // namespace g2p::cli

@@ -68,9 +68,12 @@ struct WallMeasurement {
   double inner_fraction() const { return rays > 0 ? static_cast<double>(inner_hits) / rays : 0.0; }
 };
 
-// `max_rays` sample points, area-weighted and deterministic.
+// `max_rays` sample points, area-weighted and deterministic. A patch point
+// counts as inside the closed volume (an inner surface) only if it lies
+// deeper than `surface_tolerance_m` (the completion's grid spacing: closed
+// surfaces from a grid sit up to a cell off the patch).
 G2P_API Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, const Mesh& closed,
-                                              int max_rays = 2000);
+                                              int max_rays = 2000, double surface_tolerance_m = 0.0);
 
 // ---- Estimating properties ----------------------------------------------------
 

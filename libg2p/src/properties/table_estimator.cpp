@@ -82,10 +82,12 @@ void apply_geometry_guards(PartProperties& p, const CompletedPart& completed) {
   const double t = p.wall_thickness_m;
   if (p.walls.rays > 0 && p.walls.thickness_m <= 2 * t) {
     p.structure = Structure::kSolid;
+    p.double_walled = false;
     p.structure_source = ValueSource::kGeometry;
     p.notes.push_back("solid: the part is " + mm(p.walls.thickness_m) + " thick, no more than two " + mm(t) + " walls");
   } else if (completed.checks.area_m2 * t >= completed.checks.volume_m3) {
     p.structure = Structure::kSolid;
+    p.double_walled = false;
     p.structure_source = ValueSource::kGeometry;
     p.notes.push_back("solid: a " + mm(t) + " shell over its area would exceed its volume");
   }
@@ -111,7 +113,8 @@ Result<PartProperties> table_properties(const PropertyInput& in, const TableRule
   p.friction_dynamic = c.friction_dynamic;
   p.restitution = c.restitution;
   if (in.completed->mesh.num_faces() > 0) {
-    Result<WallMeasurement> w = measure_walls(*in.object, *in.part, in.completed->mesh, rule.rays);
+    Result<WallMeasurement> w = measure_walls(*in.object, *in.part, in.completed->mesh, rule.rays,
+                                              in.all_completed != nullptr ? in.all_completed->grid_spacing_m : 0.0);
     if (!w.ok()) return w.status();
     p.walls = *w;
   }

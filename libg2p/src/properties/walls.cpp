@@ -14,9 +14,14 @@ double median(std::vector<double>& v) {
   return v[v.size() / 2];
 }
 
+// Surfaces nearer than this to each other are duplicates (coincident faces
+// of a model), not the two sides of a wall.
+constexpr double kMinWall = 1e-4;  // metres
+
 }  // namespace
 
-Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, const Mesh& closed, int max_rays) {
+Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, const Mesh& closed, int max_rays,
+                                      double surface_tolerance_m) {
   if (part.faces.empty() || closed.num_faces() == 0 || max_rays <= 0) return WallMeasurement{};
   Result<std::unique_ptr<detail::SegmentTester>> in_object = detail::SegmentTester::create(object);
   if (!in_object.ok()) return in_object.status();
@@ -63,7 +68,10 @@ Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, cons
       return -1.0;
     };
     const double out_minus = exit_along(-n), out_plus = exit_along(n);
-    if (out_minus > 0 && out_plus > 0 && std::min(out_minus, out_plus) > 1e-3 * diag) {
+    // Inside only if deeper than the closed surface's own tolerance (a grid
+    // cell) and than 0.1 mm: coincident duplicate faces are not walls.
+    if (out_minus > 0 && out_plus > 0 &&
+        std::min(out_minus, out_plus) > std::max({kMinWall, surface_tolerance_m, 1e-3 * (out_minus + out_plus)})) {
       // Inside the closed volume in both directions: the patch here is an
       // inner surface of the part (the inside of a modelled wall); the wall
       // reaches to the nearer side.
@@ -80,7 +88,7 @@ Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, cons
       // surface of the object before the ray leaves the volume.
       double hit_t = 0;
       int hit_tri = -1;
-      const double skip = std::max(eps, 1e-3 * exit_t);
+      const double skip = std::max({eps, kMinWall, 1e-3 * exit_t});
       ++w.rays;
       thickness.push_back(exit_t);
       if ((*in_object)->first_hit(p, d, skip, 0.9 * exit_t, hit_t, hit_tri)) {

@@ -7,7 +7,9 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "g2p/complete.h"
 #include "g2p/exporters.h"
@@ -25,10 +27,11 @@ constexpr int kWood = static_cast<int>(PaperClass::kWood);
 constexpr int kMetal = static_cast<int>(PaperClass::kMetal);
 
 // The generated hammer through stages 5 and 6; `head_label` is the head's class.
-SimulationAsset hammer_asset(int head_label) {
+SimulationAsset hammer_asset(int head_label, Model* model_out = nullptr, std::vector<Part>* parts_out = nullptr) {
   const std::string path = test::scratch_dir("ExportHammer") + "/hammer.glb";
   test::make_hammer().write(path);
   const Model model = *load_model(path);
+  if (model_out != nullptr) *model_out = model;
   std::vector<Part> parts(2);
   parts[0].label = head_label;
   parts[1].label = kWood;
@@ -37,6 +40,7 @@ SimulationAsset hammer_asset(int head_label) {
   const MaterialTable& table = MaterialTable::paper_default();
   const Completion completion = *(*make_completer("partition"))->complete({&model.mesh, &parts, &table});
   const PropertiesReport report = *estimate_properties(model.mesh, parts, completion, table, **make_estimator("table"));
+  if (parts_out != nullptr) *parts_out = parts;
   Result<SimulationAsset> asset = make_asset("hammer", model.mesh, parts, completion, report, table);
   EXPECT_TRUE(asset.ok()) << asset.status().to_string();
   return *asset;
@@ -154,6 +158,44 @@ TEST(Exporters, SdfIsWellFormedWithTheSameInertial) {
   int collisions = 0;
   for (TiXmlElement* c = link->FirstChildElement("collision"); c; c = c->NextSiblingElement("collision")) ++collisions;
   EXPECT_EQ(collisions, static_cast<int>(asset.parts.size()));
+}
+
+TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
+  Model model;
+  std::vector<Part> parts;
+  const SimulationAsset asset = hammer_asset(kMetal, &model, &parts);
+  const std::string path = test::scratch_dir("ExportGlb") + "/hammer.glb";
+  ASSERT_TRUE(write_glb(path, model, parts, asset).ok());
+  // libg2p's own strict glTF import reads it back: the input's faces plus the
+  // closed volumes, the input's materials, the same place in space.
+  Result<Model> back = load_model(path);
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  int collision_faces = 0;
+  for (const AssetPart& p : asset.parts) collision_faces += p.collision.num_faces();
+  EXPECT_EQ(back->mesh.num_faces(), model.mesh.num_faces() + collision_faces);
+  ASSERT_EQ(back->materials.size(), model.materials.size());
+  EXPECT_EQ(back->materials[0].name, model.materials[0].name);
+  EXPECT_FLOAT_EQ(back->materials[0].metallic, model.materials[0].metallic);
+  const Eigen::AlignedBox3d a = bounds(model.mesh), b = bounds(back->mesh);
+  EXPECT_LT((a.min() - b.min()).norm(), 2e-3);  // the closed volumes reach a little past the input
+  EXPECT_LT((a.max() - b.max()).norm(), 2e-3);
+  // The JSON chunk: properties in the nodes' extras, in glTF's +Y-up frame.
+  const std::string bytes = test::read_file(path);
+  std::uint32_t json_length = 0;
+  std::memcpy(&json_length, bytes.data() + 12, 4);
+  const nlohmann::json doc = nlohmann::json::parse(bytes.substr(20, json_length));
+  const nlohmann::json& root = doc["nodes"][0]["extras"]["g2p"];
+  EXPECT_NEAR(root["mass_kg"].get<double>(), asset.total.mass_kg, 1e-9);
+  EXPECT_NEAR(root["center_of_mass_m"][1].get<double>(), asset.total.center_of_mass.z(), 1e-9);  // z up -> y up
+  int parts_with_density = 0, collision_nodes = 0;
+  for (const auto& n : doc["nodes"]) {
+    if (!n.contains("extras")) continue;
+    const auto& g = n["extras"]["g2p"];
+    parts_with_density += g.contains("density_kg_m3");
+    collision_nodes += g.value("collision", false);
+  }
+  EXPECT_EQ(parts_with_density, 2);
+  EXPECT_EQ(collision_nodes, 2);
 }
 
 TEST(Exporters, BadInputIsRefused) {

@@ -19,7 +19,8 @@ TEST(ToolExport, WritesAssetsThatValidateInMujoco) {
   ToolRun r = run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
                        quote(dir + "/labels.json") + " -o " + quote(dir + "/out"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  for (const char* f : {"hammer.xml", "hammer.urdf", "hammer.sdf", "report.json", "meshes/part_1_Metal.stl"})
+  for (const char* f :
+       {"hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb", "report.json", "meshes/part_1_Metal.stl"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/out/" + f)) << f;
   // Relocatable: validate a moved copy.
   std::filesystem::rename(dir + "/out", dir + "/moved");

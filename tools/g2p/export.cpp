@@ -1,6 +1,7 @@
 // g2p export SOURCE -o OUT: stages 5 and 6 and the simulation assets (MJCF,
 // URDF, SDF with per-part meshes, report.json). g2p validate DIR: the MJCF in
 // MuJoCo next to libg2p's numbers, and a drop onto a plane.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,17 +23,19 @@ struct ExportArgs {
   CompleterArgs completer;
   EstimatorArgs estimator;
   std::string out, name;
-  std::vector<std::string> formats{"mjcf", "urdf", "sdf"};
+  std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
   bool fixed = false;
 };
 
 int run_export(const ExportArgs& args) {
   int exit_code = kExitOk;
+  LabelledSourceArgs source = args.source;
+  source.textures = std::find(args.formats.begin(), args.formats.end(), "glb") != args.formats.end();
   if (args.out.empty()) {
     std::cerr << "g2p export: error: give -o OUT\n";
     return kExitUsage;
   }
-  Result<LabelledObject> object = load_labelled_source("export", args.source, exit_code);
+  Result<LabelledObject> object = load_labelled_source("export", source, exit_code);
   if (!object.ok()) return exit_code;
   Result<Completion> done = run_completion("export", args.completer, *object, exit_code);
   if (!done.ok()) return exit_code;
@@ -54,7 +57,16 @@ int run_export(const ExportArgs& args) {
   }
   ExportOptions options;
   options.free_joint = !args.fixed;
-  Status s = write_asset(args.out, *asset, args.formats, options);
+  std::vector<std::string> engine_formats;
+  bool glb = false;
+  for (const std::string& f : args.formats) {
+    if (f == "glb")
+      glb = true;
+    else
+      engine_formats.push_back(f);
+  }
+  Status s = write_asset(args.out, *asset, engine_formats, options);
+  if (s.ok() && glb) s = write_glb(args.out + "/" + asset->name + ".glb", object->model, object->faces.parts, *asset);
   if (s.ok()) s = write_report(args.out + "/report.json", *report, object->table);
   if (!s.ok()) {
     std::cerr << "g2p export: error: " << s.to_string() << "\n";
@@ -137,9 +149,9 @@ void add_export_command(CLI::App& app, Command& run) {
   add_labelled_source_flags(cmd, args->source);
   cmd->add_option("-o,--output", args->out, "Output folder")->required();
   cmd->add_option("--name", args->name, "Model name (default: the model file's stem or the folder's name)");
-  cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf (comma-separated)")
+  cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"mjcf", "urdf", "sdf"}));
+      ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
   cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
   add_completer_flags(cmd, args->completer);
   add_estimator_flags(cmd, args->estimator);

@@ -61,7 +61,7 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
     import.unit = imp.value("unit", "");
     import.up = imp.value("up", "auto");
     import.keep_axes = imp.value("keep_axes", false);
-    import.no_textures = true;  // later stages need geometry only
+    import.no_textures = !args.textures;  // most later stages need geometry only
     Result<Model> model = load_with_flags(command, manifest.value("model", ""), import, exit_code);
     if (!model.ok()) return model.status();
     out.model = std::move(*model);
@@ -80,7 +80,7 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
         Status::InvalidArgument(args.source + " is not a folder; for a model file give its ground truth with --truth"),
         kExitUsage);
   ImportArgs import;
-  import.no_textures = true;
+  import.no_textures = !args.textures;
   Result<Model> model = load_with_flags(command, args.source, import, exit_code);
   if (!model.ok()) return model.status();
   out.model = std::move(*model);

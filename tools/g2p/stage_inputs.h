@@ -21,6 +21,7 @@ struct LabelledSourceArgs {
   std::string truth;   // labels.json, for a model file
   std::string key;     // entry in labels.json (default: the file's stem)
   std::string materials;
+  bool textures = false;  // decode textures (for outputs that show the model's appearance)
 };
 void add_labelled_source_flags(CLI::App* cmd, LabelledSourceArgs& args);
 

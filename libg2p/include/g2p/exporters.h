@@ -12,6 +12,7 @@
 #include "g2p/export.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
+#include "g2p/model.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/status.h"
@@ -20,6 +21,7 @@ namespace g2p {
 
 // One part as the exporters see it.
 struct AssetPart {
+  int part = -1;         // index into the parts given to make_asset
   std::string name;      // "part_3_Metal", unique, safe in file and XML names
   std::string material;  // class name
   std::array<double, 4> rgba{0.5, 0.5, 0.5, 1.0};
@@ -61,6 +63,17 @@ G2P_API std::string sdf_text(const SimulationAsset& asset);
 // name and renamed.
 G2P_API Status write_asset(const std::string& dir, const SimulationAsset& asset,
                            const std::vector<std::string>& formats, const ExportOptions& options = {});
+
+// A GLB of the object for engines and viewers that read glTF: one node per
+// part with the input's own meshes, UVs and materials (base colour and
+// metallic-roughness factors and textures, alpha mode), the part's physical
+// properties in the node's `extras.g2p`, the object's totals in the root
+// node's, and each part's closed volume as a separate node named
+// NAME_collision (extras.g2p.collision = true). glTF's frame is +Y up:
+// positions, centres of mass and inertia tensors are rotated from libg2p's
+// +Z up (x, y, z) -> (x, z, -y). docs/formats.md lists the fields.
+G2P_API Status write_glb(const std::string& path, const Model& model, const std::vector<Part>& parts,
+                         const SimulationAsset& asset);
 
 // ---- Validation in a real engine ---------------------------------------------
 

@@ -64,6 +64,7 @@ Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, 
       continue;
     }
     AssetPart p;
+    p.part = static_cast<int>(i);
     p.material = table.valid_label(parts[i].label) ? table[parts[i].label].name : "Unknown";
     p.name = "part_" + std::to_string(i) + "_" + safe_name(p.material);
     if (table.valid_label(parts[i].label))

@@ -1,0 +1,220 @@
+// write_glb: the object as a binary glTF 2.0 with its physical properties.
+#include <cstring>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "core/file_util.h"
+#include "g2p/exporters.h"
+#include "io/image_io.h"
+
+namespace g2p {
+namespace {
+
+using nlohmann::json;
+
+// libg2p's +Z up to glTF's +Y up.
+Eigen::Matrix3d to_gltf() {
+  Eigen::Matrix3d r;
+  r << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  return r;
+}
+
+class GlbBuilder {
+ public:
+  json doc = {{"asset", {{"version", "2.0"}, {"generator", "libg2p"}}}};
+  std::string bin;
+
+  int view(const void* data, std::size_t bytes, int target) {
+    while (bin.size() % 4) bin.push_back('\0');
+    json v = {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes}};
+    if (target) v["target"] = target;
+    bin.append(static_cast<const char*>(data), bytes);
+    doc["bufferViews"].push_back(v);
+    return static_cast<int>(doc["bufferViews"].size()) - 1;
+  }
+  int accessor(const std::vector<float>& values, int components, bool with_bounds) {
+    const int v = view(values.data(), values.size() * sizeof(float), 34962);
+    json a = {{"bufferView", v},
+              {"componentType", 5126},
+              {"count", values.size() / static_cast<std::size_t>(components)},
+              {"type", components == 3 ? "VEC3" : "VEC2"}};
+    if (with_bounds) {
+      std::vector<float> lo(static_cast<std::size_t>(components), 1e30f),
+          hi(static_cast<std::size_t>(components), -1e30f);
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::size_t c = i % static_cast<std::size_t>(components);
+        lo[c] = std::min(lo[c], values[i]);
+        hi[c] = std::max(hi[c], values[i]);
+      }
+      a["min"] = lo;
+      a["max"] = hi;
+    }
+    doc["accessors"].push_back(a);
+    return static_cast<int>(doc["accessors"].size()) - 1;
+  }
+  int indices(const std::vector<std::uint32_t>& idx) {
+    const int v = view(idx.data(), idx.size() * sizeof(std::uint32_t), 34963);
+    doc["accessors"].push_back({{"bufferView", v}, {"componentType", 5125}, {"count", idx.size()}, {"type", "SCALAR"}});
+    return static_cast<int>(doc["accessors"].size()) - 1;
+  }
+  // A PNG image of a decoded texture, once per image.
+  Result<int> texture(const Texture& t) {
+    auto found = textures_.find(t.image.get());
+    if (found != textures_.end()) return found->second;
+    Result<std::string> png = detail::encode_png(*t.image);
+    if (!png.ok()) return png.status();
+    const int v = view(png->data(), png->size(), 0);
+    doc["images"].push_back({{"bufferView", v}, {"mimeType", "image/png"}});
+    auto wrap = [](WrapMode w) {
+      return w == WrapMode::kClampToEdge ? 33071 : w == WrapMode::kMirroredRepeat ? 33648 : 10497;
+    };
+    doc["samplers"].push_back({{"wrapS", wrap(t.wrap_u)}, {"wrapT", wrap(t.wrap_v)}});
+    const int index = static_cast<int>(doc["textures"].size());
+    doc["textures"].push_back({{"source", static_cast<int>(doc["images"].size()) - 1},
+                               {"sampler", static_cast<int>(doc["samplers"].size()) - 1}});
+    textures_[t.image.get()] = index;
+    return index;
+  }
+  std::string glb() {
+    while (bin.size() % 4) bin.push_back('\0');
+    doc["buffers"] = json::array({{{"byteLength", bin.size()}}});
+    std::string text = doc.dump();
+    while (text.size() % 4) text.push_back(' ');
+    std::string out;
+    auto u32 = [&](std::uint32_t v) {
+      char b[4];
+      std::memcpy(b, &v, 4);
+      out.append(b, 4);
+    };
+    out.append("glTF", 4);
+    u32(2);
+    u32(static_cast<std::uint32_t>(12 + 8 + text.size() + 8 + bin.size()));
+    u32(static_cast<std::uint32_t>(text.size()));
+    out.append("JSON", 4);
+    out += text;
+    u32(static_cast<std::uint32_t>(bin.size()));
+    out.append("BIN\0", 4);
+    out += bin;
+    return out;
+  }
+
+ private:
+  std::map<const ImageU8*, int> textures_;
+};
+
+json mass_extras(const MassProperties& m) {
+  const Eigen::Matrix3d r = to_gltf();
+  const Eigen::Vector3d c = r * m.center_of_mass;
+  const Eigen::Matrix3d i = r * m.inertia * r.transpose();
+  json rows = json::array();
+  for (int a = 0; a < 3; ++a) rows.push_back({i(a, 0), i(a, 1), i(a, 2)});
+  return {{"mass_kg", m.mass_kg}, {"center_of_mass_m", {c.x(), c.y(), c.z()}}, {"inertia_kg_m2", rows}};
+}
+
+}  // namespace
+
+Status write_glb(const std::string& path, const Model& model, const std::vector<Part>& parts,
+                 const SimulationAsset& asset) {
+  const Mesh& mesh = model.mesh;
+  const Eigen::Matrix3d r = to_gltf();
+  GlbBuilder g;
+  // Materials: the input's, in its order.
+  for (const SourceMaterial& m : model.materials) {
+    json pbr = {{"baseColorFactor", {m.base_color.x(), m.base_color.y(), m.base_color.z(), m.base_color.w()}},
+                {"metallicFactor", m.metallic},
+                {"roughnessFactor", m.roughness}};
+    if (!m.base_color_texture.empty()) {
+      Result<int> t = g.texture(m.base_color_texture);
+      if (!t.ok()) return t.status();
+      pbr["baseColorTexture"] = {{"index", *t}};
+    }
+    if (!m.metallic_roughness_texture.empty()) {
+      Result<int> t = g.texture(m.metallic_roughness_texture);
+      if (!t.ok()) return t.status();
+      pbr["metallicRoughnessTexture"] = {{"index", *t}};
+    }
+    json mat = {{"name", m.name}, {"pbrMetallicRoughness", pbr}, {"doubleSided", m.double_sided}};
+    if (m.alpha_mode == AlphaMode::kMask) mat["alphaMode"] = "MASK", mat["alphaCutoff"] = m.alpha_cutoff;
+    if (m.alpha_mode == AlphaMode::kBlend) mat["alphaMode"] = "BLEND";
+    g.doc["materials"].push_back(mat);
+  }
+  json root = {{"name", asset.name}, {"children", json::array()}};
+  json totals = mass_extras(asset.total);
+  totals["frame"] = "glTF: +Y up, metres; libg2p's +Z-up frame rotated by (x, y, z) -> (x, z, -y)";
+  root["extras"]["g2p"] = totals;
+  std::vector<json> nodes;
+  for (const AssetPart& p : asset.parts) {
+    if (p.part < 0 || p.part >= static_cast<int>(parts.size()))
+      return Status::InvalidArgument("write_glb: asset part " + p.name + " has no input part");
+    // One primitive per source material of the part's faces.
+    std::map<int, std::vector<int>> by_material;
+    for (int f : parts[static_cast<std::size_t>(p.part)].faces)
+      by_material[mesh.face_source.empty() ? -1 : mesh.face_source[static_cast<std::size_t>(f)].material].push_back(f);
+    json primitives = json::array();
+    for (const auto& [material, faces] : by_material) {
+      std::map<int, std::uint32_t> remap;
+      std::vector<float> pos, nrm, uv;
+      std::vector<std::uint32_t> idx;
+      for (int f : faces)
+        for (int c = 0; c < 3; ++c) {
+          const int v = mesh.triangles[static_cast<std::size_t>(f)][c];
+          auto [it, inserted] = remap.emplace(v, static_cast<std::uint32_t>(remap.size()));
+          if (inserted) {
+            const Eigen::Vector3d q = r * mesh.positions[static_cast<std::size_t>(v)].cast<double>();
+            pos.insert(pos.end(), {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z())});
+            if (mesh.has_normals()) {
+              const Eigen::Vector3d n = r * mesh.normals[static_cast<std::size_t>(v)].cast<double>();
+              nrm.insert(nrm.end(), {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())});
+            }
+            if (mesh.has_uvs())
+              uv.insert(uv.end(),
+                        {mesh.uvs[static_cast<std::size_t>(v)].x(), mesh.uvs[static_cast<std::size_t>(v)].y()});
+          }
+          idx.push_back(it->second);
+        }
+      json prim = {{"attributes", {{"POSITION", g.accessor(pos, 3, true)}}}, {"indices", g.indices(idx)}};
+      if (!nrm.empty()) prim["attributes"]["NORMAL"] = g.accessor(nrm, 3, false);
+      if (!uv.empty()) prim["attributes"]["TEXCOORD_0"] = g.accessor(uv, 2, false);
+      if (material >= 0 && material < static_cast<int>(model.materials.size())) prim["material"] = material;
+      primitives.push_back(prim);
+    }
+    g.doc["meshes"].push_back({{"name", p.name}, {"primitives", primitives}});
+    json extras = mass_extras(p.mass);
+    const PartProperties& pp = p.properties;
+    extras["material"] = p.material;
+    extras["structure"] = to_string(pp.structure);
+    extras["density_kg_m3"] = pp.density_kg_m3;
+    extras["wall_thickness_m"] = pp.structure == Structure::kHollow ? json(pp.wall_thickness_m) : json(nullptr);
+    extras["friction_static"] = pp.friction_static;
+    extras["friction_dynamic"] = pp.friction_dynamic;
+    extras["restitution"] = pp.restitution;
+    nodes.push_back(
+        {{"name", p.name}, {"mesh", static_cast<int>(g.doc["meshes"].size()) - 1}, {"extras", {{"g2p", extras}}}});
+
+    // The closed volume as its own node.
+    std::vector<float> cpos;
+    std::vector<std::uint32_t> cidx;
+    for (const auto& v : p.collision.positions) {
+      const Eigen::Vector3d q = r * v.cast<double>();
+      cpos.insert(cpos.end(), {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z())});
+    }
+    for (const auto& t : p.collision.triangles)
+      for (int c = 0; c < 3; ++c) cidx.push_back(static_cast<std::uint32_t>(t[c]));
+    g.doc["meshes"].push_back({{"name", p.name + "_collision"},
+                               {"primitives", json::array({{{"attributes", {{"POSITION", g.accessor(cpos, 3, true)}}},
+                                                            {"indices", g.indices(cidx)}}})}});
+    nodes.push_back({{"name", p.name + "_collision"},
+                     {"mesh", static_cast<int>(g.doc["meshes"].size()) - 1},
+                     {"extras", {{"g2p", {{"collision", true}, {"part", p.name}}}}}});
+  }
+  g.doc["nodes"] = json::array({root});
+  for (json& n : nodes) {
+    g.doc["nodes"][0]["children"].push_back(static_cast<int>(g.doc["nodes"].size()));
+    g.doc["nodes"].push_back(std::move(n));
+  }
+  g.doc["scenes"] = json::array({{{"nodes", {0}}}});
+  g.doc["scene"] = 0;
+  return detail::write_file_atomically(path, g.glb());
+}
+
+}  // namespace g2p

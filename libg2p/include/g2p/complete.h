@@ -39,9 +39,9 @@ struct G2P_API MeshChecks {
   int num_self_intersections = 0;           // intersecting pairs of non-adjacent triangles found
   double volume_m3 = 0.0;
   double area_m2 = 0.0;
-  // Largest distance from a vertex of the closed mesh to the part's own patch,
-  // in metres and relative to the patch's bounding-box diagonal; -1 if no
-  // patch was given.
+  // Largest distance from a vertex of the closed mesh to the part's own patch
+  // (over up to MeshCheckOptions::max_distance_samples vertices), in metres
+  // and relative to the patch's bounding-box diagonal; -1 if no patch was given.
   double max_distance_m = -1.0;
   double relative_distance = -1.0;
 
@@ -52,6 +52,7 @@ struct G2P_API MeshChecks {
 
 struct MeshCheckOptions {
   int max_faces_for_intersections = 2'000'000;  // larger meshes skip the self-intersection test
+  int max_distance_samples = 20'000;            // vertices whose distance to the patch is measured (evenly spread)
 };
 
 // Checks a closed-mesh candidate. `patch` (optional) is the surface it should

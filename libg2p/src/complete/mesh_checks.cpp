@@ -119,8 +119,13 @@ MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshChec
     const detail::TriangleBins bins(*patch);
     double worst = 0.0;
     // Only distances above the running maximum matter: each search stops at
-    // the first triangle closer than that.
-    for (const auto& p : mesh.positions) worst = std::max(worst, bins.distance(p.cast<double>(), worst));
+    // the first triangle closer than that. Large meshes are sampled: at most
+    // `max_distance_samples` vertices, evenly spread over the vertex order.
+    const std::size_t n = mesh.positions.size();
+    const std::size_t step =
+        std::max<std::size_t>(1, n / static_cast<std::size_t>(std::max(1, options.max_distance_samples)));
+    for (std::size_t v = 0; v < n; v += step)
+      worst = std::max(worst, bins.distance(mesh.positions[v].cast<double>(), worst));
     c.max_distance_m = worst;
     const double diag = bounds(*patch).diagonal().norm();
     c.relative_distance = diag > 0 ? worst / diag : 0.0;

@@ -228,6 +228,8 @@ class PartitionCompleter final : public Completer {
         min_cells_across_ = v;
       else if (key == "simplify" && v >= 0 && v <= 1)
         simplify_ = v;
+      else if (key == "simplify_max_triangles" && v >= 0 && v <= 1e9 && v == std::floor(v))
+        simplify_max_triangles_ = static_cast<int>(v);
       else if (key == "refine_min_area_fraction" && v >= 0 && v <= 1)
         refine_min_area_fraction_ = v;
       else if (key == "gap" && v >= 1 && v <= 16 && v == std::floor(v))
@@ -237,11 +239,12 @@ class PartitionCompleter final : public Completer {
       else if (key == "max_relative_distance" && v > 0)  // checked on every part
         max_relative_distance_ = v;
       else
-        return Status::InvalidArgument("partition: bad setting " + key + "=" + value +
-                                       " (known: resolution and max_resolution in [8, 2048], min_cells_across in "
-                                       "[0, 64], refine_min_area_fraction and simplify in [0, 1], gap an integer in "
-                                       "[1, 16], max_cells in [1e3, 1e9], "
-                                       "max_relative_distance > 0)");
+        return Status::InvalidArgument(
+            "partition: bad setting " + key + "=" + value +
+            " (known: resolution and max_resolution in [8, 2048], min_cells_across in "
+            "[0, 64], refine_min_area_fraction and simplify in [0, 1], simplify_max_triangles >= 0, gap an integer in "
+            "[1, 16], max_cells in [1e3, 1e9], "
+            "max_relative_distance > 0)");
     }
     return Status::Ok();
   }
@@ -249,12 +252,15 @@ class PartitionCompleter final : public Completer {
   Result<Completion> complete(const CompletionInput& input) const override;
 
  private:
-  double resolution_ = 160;      // cells along the object's longest side
-  double max_resolution_ = 256;  // the finest grid thin parts may ask for (cells along the longest side)
-  double refine_min_area_fraction_ = 0.01;
-  double simplify_ = 0.1;
-  bool nested_ = false;  // closing one small part on its own grid  // largest surface change of the simplification,
-                         // cells (0 = keep every triangle)  // parts with less of the total area do not refine the grid
+  double resolution_ = 160;                 // cells along the object's longest side
+  double max_resolution_ = 256;             // the finest grid thin parts may ask for (cells along the longest side)
+  double refine_min_area_fraction_ = 0.01;  // parts with less of the total area do not refine the grid
+  double simplify_ = 0.1;  // largest surface change of the simplification, cells (0 = keep every triangle)
+  // Larger surfaces are not simplified: on the shared assets such attempts
+  // almost always end with touching sheets (and the dense surface) and cost
+  // about twice the rest of the stage (docs/performance.md).
+  int simplify_max_triangles_ = 100'000;
+  bool nested_ = false;          // closing one small part on its own grid
   double min_cells_across_ = 4;  // a stick-like part's second-largest extent spans at least this many cells
   int gap_ = 2;                  // closing radius, cells
   double max_cells_ = 1 << 24;   // memory guard: grid points (about 30 bytes each)
@@ -571,6 +577,11 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
     bool done = false;
     for (double tolerance : {simplify_}) {
       if (!(tolerance > 0)) break;
+      if (out.mesh.num_faces() > simplify_max_triangles_) {
+        out.notes.push_back("partition: " + std::to_string(out.mesh.num_faces()) +
+                            " triangles, more than simplify_max_triangles; not simplified");
+        break;
+      }
       Mesh simplified = out.mesh;
       detail::simplify_closed_mesh(simplified, tolerance * h);
       MeshChecks checks = check_closed_mesh(simplified, &patch);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "support/test_data.h"
 #include "support/tool_run.h"
@@ -29,6 +30,27 @@ TEST(ToolExport, WritesAssetsThatValidateInMujoco) {
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("PASS"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("MuJoCo"), std::string::npos) << r.out;
+}
+
+TEST(ToolExport, StartsFromAPropertiesOutput) {
+  const std::string dir = test::scratch_dir("ToolExportFromProperties");
+  test::write_file(dir + "/labels.json", R"({"models": {"hammer": {"labels": {"0": "Wood", "1": "Metal"}}}})");
+  ToolRun r = run_tool("properties " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
+                       quote(dir + "/labels.json") + " -o " + quote(dir + "/props"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = run_tool("export " + quote(dir + "/props") + " --format mjcf,urdf,sdf,glb -o " + quote(dir + "/assets"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("using the closed parts and properties of"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("completed "), std::string::npos) << "stage 5 ran again: " << r.out;
+  for (const char* f : {"hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/assets/" + f)) << f;
+  const auto mass = [](const std::string& report) {
+    return nlohmann::json::parse(test::read_file(report))["object"]["mass_kg"].get<double>();
+  };
+  EXPECT_NEAR(mass(dir + "/assets/report.json"), mass(dir + "/props/report.json"), 1e-9);
+  r = run_tool("validate " + quote(dir + "/assets"));
+  if (r.err.find("without MuJoCo") != std::string::npos) GTEST_SKIP() << "libg2p built without MuJoCo";
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
 }
 
 TEST(ToolExport, BadInputFailsWithAMessage) {

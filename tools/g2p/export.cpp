@@ -35,18 +35,32 @@ int run_export(const ExportArgs& args) {
     std::cerr << "g2p export: error: give -o OUT\n";
     return kExitUsage;
   }
-  Result<LabelledObject> object = load_labelled_source("export", source, exit_code);
-  if (!object.ok()) return exit_code;
-  Result<Completion> done = run_completion("export", args.completer, *object, exit_code);
-  if (!done.ok()) return exit_code;
-  Result<PropertiesReport> report = run_estimation("export", args.estimator, *object, *done, exit_code);
-  if (!report.ok()) return exit_code;
+  // A `g2p properties` folder is used as it is; any other source runs stages 5 and 6 first.
+  Result<PropertiesOutput> previous = Status::NotFound("");
+  if (is_properties_folder(args.source.source)) {
+    previous = load_properties_output("export", args.source.source, exit_code);
+    if (!previous.ok()) return exit_code;
+    std::cout << "using the closed parts and properties of " << args.source.source << "\n";
+  } else {
+    Result<LabelledObject> loaded = load_labelled_source("export", source, exit_code);
+    if (!loaded.ok()) return exit_code;
+    PropertiesOutput fresh;
+    fresh.object = std::move(*loaded);
+    Result<Completion> done = run_completion("export", args.completer, fresh.object, exit_code);
+    if (!done.ok()) return exit_code;
+    Result<PropertiesReport> report = run_estimation("export", args.estimator, fresh.object, *done, exit_code);
+    if (!report.ok()) return exit_code;
+    fresh.completion = std::move(*done);
+    fresh.report = std::move(*report);
+    previous = std::move(fresh);
+  }
+  const LabelledObject* object = &previous->object;
+  const Completion* done = &previous->completion;
+  const PropertiesReport* report = &previous->report;
   namespace fs = std::filesystem;
   std::string name = args.name;
   if (name.empty()) {
-    const fs::path source(args.source.source);
-    name =
-        fs::is_directory(source) ? fs::absolute(source).lexically_normal().filename().string() : source.stem().string();
+    name = fs::path(object->model.info.path).stem().string();  // the model file's stem
     if (name.empty()) name = "object";
   }
   Result<SimulationAsset> asset =
@@ -149,7 +163,7 @@ void add_export_command(CLI::App& app, Command& run) {
       "export", "Close the parts, estimate their properties and write MJCF, URDF and SDF assets (stages 5, 6, export)");
   add_labelled_source_flags(cmd, args->source);
   cmd->add_option("-o,--output", args->out, "Output folder")->required();
-  cmd->add_option("--name", args->name, "Model name (default: the model file's stem or the folder's name)");
+  cmd->add_option("--name", args->name, "Model name (default: the model file's stem)");
   cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
       ->delimiter(',')
       ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "g2p/io.h"
 #include "g2p/segment.h"
 #if defined(G2P_CLI_WITH_CGAL)
 #include "g2p/complete_cgal.h"
@@ -115,6 +116,117 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
   out.faces.labels = assign_labels(mesh, *graph, votes).label;
   out.faces.parts = partition(mesh, *graph, out.faces.labels, out.faces.face_part);
   out.origin = "ground truth '" + key + "' of " + args.truth;
+  return out;
+}
+
+Status write_properties_manifest(const std::string& out, const LabelledSourceArgs& source) {
+  namespace fs = std::filesystem;
+  const nlohmann::json j = {{"format", "g2p-properties"},
+                            {"version", 1},
+                            {"source", fs::absolute(source.source).string()},
+                            {"truth", source.truth.empty() ? "" : fs::absolute(source.truth).string()},
+                            {"key", source.key},
+                            {"materials", source.materials.empty() ? "" : fs::absolute(source.materials).string()}};
+  return write_text_file(out + "/properties.json", j.dump(2) + "\n");
+}
+
+bool is_properties_folder(const std::string& dir) {
+  return std::filesystem::exists(dir + "/properties.json") && std::filesystem::exists(dir + "/report.json");
+}
+
+Result<PropertiesOutput> load_properties_output(const std::string& command, const std::string& dir, int& exit_code) {
+  auto fail = [&](const Status& s) -> Status {
+    std::cerr << "g2p " << command << ": error: " << s.to_string() << "\n";
+    exit_code = kExitFailure;
+    return s;
+  };
+  auto parse = [&](const std::string& path) -> Result<nlohmann::json> {
+    Result<std::string> text = read_text(path);
+    if (!text.ok()) return text.status();
+    nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+    if (j.is_discarded()) return Status::ParseError(path + ": not JSON");
+    return j;
+  };
+  Result<nlohmann::json> manifest = parse(dir + "/properties.json");
+  if (!manifest.ok()) return fail(manifest.status());
+  LabelledSourceArgs source;
+  source.source = manifest->value("source", "");
+  source.truth = manifest->value("truth", "");
+  source.key = manifest->value("key", "");
+  source.materials = manifest->value("materials", "");
+  source.textures = true;
+  PropertiesOutput out;
+  Result<LabelledObject> object = load_labelled_source(command, source, exit_code);
+  if (!object.ok()) return object.status();
+  out.object = std::move(*object);
+  Result<nlohmann::json> completion = parse(dir + "/completed/completion.json");
+  Result<nlohmann::json> report = parse(dir + "/report.json");
+  if (!completion.ok()) return fail(completion.status());
+  if (!report.ok()) return fail(report.status());
+  const std::size_t np = out.object.faces.parts.size();
+  if ((*completion)["parts"].size() != np || (*report)["parts"].size() != np)
+    return fail(Status::InvalidArgument(dir + ": its parts do not match the source's " + std::to_string(np) +
+                                        " parts (was the source changed?)"));
+  try {
+    out.completion.object_volume_m3 = (*completion)["object_volume_m3"].get<double>();
+    for (std::size_t i = 0; i < np; ++i) {
+      const nlohmann::json& c = (*completion)["parts"][i];
+      CompletedPart part;
+      part.part = static_cast<int>(i);
+      part.label = out.object.faces.parts[i].label;
+      part.backend = c["backend"].get<std::string>();
+      part.ok = c["ok"].get<bool>();
+      if (c["files"].contains("obj")) {
+        ImportOptions io;
+        io.z_up = false;
+        io.unit_scale = 1.0;
+        io.up_axis = UpAxis::kZ;
+        io.load_textures = false;
+        Result<Model> m = load_model(dir + "/completed/" + c["files"]["obj"].get<std::string>(), io);
+        if (!m.ok()) return fail(m.status());
+        part.mesh.positions = std::move(m->mesh.positions);
+        part.mesh.triangles = std::move(m->mesh.triangles);
+      }
+      part.checks.volume_m3 = c["checks"]["volume_m3"].get<double>();
+      part.checks.area_m2 = c["checks"]["area_m2"].get<double>();
+      out.completion.parts.push_back(std::move(part));
+
+      const nlohmann::json& r = (*report)["parts"][i];
+      PartReport pr;
+      pr.part = static_cast<int>(i);
+      pr.completed_ok = r["completion_ok"].get<bool>();
+      PartProperties& p = pr.properties;
+      p.label = out.object.faces.parts[i].label;
+      p.density_kg_m3 = r["density_kg_m3"].get<double>();
+      p.density_min_kg_m3 = r["density_min_kg_m3"].get<double>();
+      p.density_max_kg_m3 = r["density_max_kg_m3"].get<double>();
+      p.structure = r["structure"].get<std::string>() == "hollow" ? Structure::kHollow : Structure::kSolid;
+      if (!r["wall_thickness_m"].is_null()) p.wall_thickness_m = r["wall_thickness_m"].get<double>();
+      p.double_walled = r.value("double_walled", false);
+      p.friction_static = r["friction_static"].get<double>();
+      p.friction_dynamic = r["friction_dynamic"].get<double>();
+      p.restitution = r["restitution"].get<double>();
+      for (int k = 0; k < 2; ++k) p.solref[static_cast<std::size_t>(k)] = r["mujoco_solref"][k].get<double>();
+      for (int k = 0; k < 5; ++k) p.solimp[static_cast<std::size_t>(k)] = r["mujoco_solimp"][k].get<double>();
+      pr.mass.mass_kg = r["mass_kg"].get<double>();
+      pr.mass.volume_m3 = r["material_volume_m3"].get<double>();
+      pr.mass.area_m2 = r["area_m2"].get<double>();
+      for (int a = 0; a < 3; ++a) {
+        pr.mass.center_of_mass[a] = r["center_of_mass_m"][a].get<double>();
+        for (int b = 0; b < 3; ++b) pr.mass.inertia(a, b) = r["inertia_kg_m2"][a][b].get<double>();
+      }
+      pr.mass_min_kg = r["mass_min_kg"].get<double>();
+      pr.mass_max_kg = r["mass_max_kg"].get<double>();
+      out.report.parts.push_back(std::move(pr));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return fail(Status::ParseError(dir + ": completion.json or report.json: " + e.what()));
+  }
+  std::vector<MassProperties> masses;
+  for (const PartReport& r : out.report.parts)
+    if (r.mass.mass_kg > 0) masses.push_back(r.mass);
+  if (masses.empty()) return fail(Status::InvalidArgument(dir + "/report.json: no part has a mass"));
+  out.report.object = combine(masses);
   return out;
 }
 

@@ -59,6 +59,18 @@ void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args);
 Result<PropertiesReport> run_estimation(const std::string& command, const EstimatorArgs& args,
                                         const LabelledObject& object, const Completion& completion, int& exit_code);
 
+// A `g2p properties` output folder: properties.json records the source it
+// was made from, so `g2p export` can start from the folder and reuse its
+// closed parts (completed/) and properties (report.json) as they are.
+Status write_properties_manifest(const std::string& out, const LabelledSourceArgs& source);
+bool is_properties_folder(const std::string& dir);
+struct PropertiesOutput {
+  LabelledObject object;
+  Completion completion;
+  PropertiesReport report;
+};
+Result<PropertiesOutput> load_properties_output(const std::string& command, const std::string& dir, int& exit_code);
+
 // KEY=VALUE pairs as BackendSettings.
 Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs);
 

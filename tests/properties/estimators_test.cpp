@@ -9,6 +9,7 @@
 #include "g2p/complete.h"
 #include "g2p/io.h"
 #include "g2p/properties.h"
+#include "g2p/render.h"
 #include "support/gltf_builder.h"
 #include "support/test_data.h"
 
@@ -128,9 +129,11 @@ class ScriptedVlm final : public VlmClient {
   explicit ScriptedVlm(Result<std::string> answer) : answer_(std::move(answer)) {}
   Result<std::string> complete(const VlmRequest& request) const override {
     last_prompt = request.prompt;
+    last_images = static_cast<int>(request.images.size());
     return answer_;
   }
   mutable std::string last_prompt;
+  mutable int last_images = 0;
 
  private:
   Result<std::string> answer_;
@@ -170,6 +173,27 @@ TEST(VlmEstimator, UsesValidAnswersAndFallsBackOnBadOnes) {
     for (const auto& n : p.notes) notes += n + "\n";
     EXPECT_NE(notes.find("the table's values stand"), std::string::npos) << notes;
   }
+}
+
+TEST(VlmEstimator, ShowsTheModelTheObjectWithThePartColouredIn) {
+  const Mesh cube = test::box_mesh({0, 0, 0}, {0.05f, 0.05f, 0.05f});
+  const Stage s = complete_object(cube, test::single_part(cube, kMetal));
+  Model model;
+  model.mesh = cube;
+  auto renderer = std::move(*renderer_registry().create("embree"));
+  ViewOptions vo;
+  vo.width = vo.height = 64;
+  const std::vector<View> views = *render_views(*renderer, model, *make_views(model.mesh, vo));
+  auto client = std::make_shared<ScriptedVlm>(std::string("{\"density_kg_m3\": 2700, \"structure\": \"solid\"}"));
+  auto e = make_vlm_estimator(client);
+  ASSERT_TRUE(e->configure({{"max_views", "3"}}).ok());
+  PropertyInput in{&s.mesh, &s.parts[0], &s.completion.parts[0], &table(), &views};
+  Result<PartProperties> p = e->estimate(in);
+  ASSERT_TRUE(p.ok()) << p.status().to_string();
+  EXPECT_EQ(p->density_kg_m3, 2700);
+  // Every third of the 11 views (0, 4, 8), each as a render and as the part mask.
+  EXPECT_EQ(client->last_images, 6);
+  EXPECT_NE(client->last_prompt.find("images show"), std::string::npos);
 }
 
 TEST(PropertiesReport, JsonHasEveryFieldWithUnits) {

@@ -260,8 +260,15 @@ Result<PropertiesReport> run_estimation(const std::string& command, const Estima
     exit_code = kExitUsage;
     return estimator.status();
   }
-  Result<PropertiesReport> report =
-      estimate_properties(object.model.mesh, object.faces.parts, completion, object.table, **estimator);
+  // The vlm estimator looks at the object: the default views, rendered here.
+  std::vector<View> views;
+  if (args.name == "vlm") {
+    Result<std::vector<View>> rendered = render_with_flags(command, object.model, ViewArgs{}, exit_code);
+    if (!rendered.ok()) return rendered.status();
+    views = std::move(*rendered);
+  }
+  Result<PropertiesReport> report = estimate_properties(object.model.mesh, object.faces.parts, completion, object.table,
+                                                        **estimator, views.empty() ? nullptr : &views);
   if (!report.ok()) {
     std::cerr << "g2p " << command << ": error: " << report.status().to_string() << "\n";
     exit_code = kExitFailure;

@@ -29,24 +29,13 @@ class VlmEstimator final : public PropertyEstimator {
   Status configure(const BackendSettings& settings) override {
     for (const auto& [key, value] : settings) {
       double v = 0;
-      const bool number = detail::parse_double(value, v);
-      if (key == "url")
-        options_.base_url = value;
-      else if (key == "model")
-        options_.model = value;
-      else if (key == "api_key_env")
-        options_.api_key_env = value;
-      else if (key == "timeout" && number && v > 0)
-        options_.timeout_s = v;
-      else if (key == "retries" && number && v >= 0 && v <= 10 && v == std::floor(v))
-        options_.retries = static_cast<int>(v);
-      else if (key == "max_views" && number && v >= 0 && v <= 100 && v == std::floor(v))
+      if (detail::set_openai_option(options_, key, value)) continue;
+      if (key == "max_views" && detail::parse_double(value, v) && v >= 0 && v <= 100 && v == std::floor(v))
         max_views_ = static_cast<int>(v);
       else if (!detail::set_table_rule(rule_, key, value))
         return Status::InvalidArgument("vlm: bad setting " + key + "=" + value +
-                                       " (known: url, model, api_key_env, timeout, retries, max_views, and the "
-                                       "table fallback's " +
-                                       detail::kTableRuleKeys + ")");
+                                       " (known: " + detail::kOpenAiOptionKeys +
+                                       ", max_views, and the table fallback's " + detail::kTableRuleKeys + ")");
     }
     if (!injected_ && !options_.model.empty()) {
       Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);

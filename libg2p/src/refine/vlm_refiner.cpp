@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/settings.h"
 #include "g2p/segment.h"
 #include "g2p/vlm.h"
 #include "io/image_io.h"
@@ -42,32 +43,16 @@ class VlmRefiner final : public Refiner {
 
   Status configure(const BackendSettings& settings) override {
     for (const auto& [key, value] : settings) {
-      char* end = nullptr;
-      const double number = std::strtod(value.c_str(), &end);
-      const bool is_number = end != value.c_str() && *end == '\0' && std::isfinite(number);
-      const bool is_count = is_number && number >= 0.0 && number == std::floor(number);
-      if (key == "url")
-        options_.base_url = value;
-      else if (key == "model")
-        options_.model = value;
-      else if (key == "api_key_env")
-        options_.api_key_env = value;
-      else if (key == "prompt_file")
+      double number = 0;
+      const bool is_count = detail::parse_double(value, number) && number >= 0.0 && number == std::floor(number);
+      if (detail::set_openai_option(options_, key, value)) continue;
+      if (key == "prompt_file")
         prompt_file_ = value;
-      else if (key == "timeout" && is_number)
-        options_.timeout_s = number;
-      else if (key == "retries" && is_count && number <= 10)
-        options_.retries = static_cast<int>(number);
-      else if (key == "backoff" && is_number)
-        options_.backoff_s = number;
-      else if (key == "max_response_bytes" && is_count && number >= 1 && number <= 1e9)
-        options_.max_response_bytes = static_cast<std::size_t>(number);
       else if (key == "max_views" && is_count && number >= 1 && number <= 100)
         max_views_ = static_cast<int>(number);
       else
         return Status::InvalidArgument("vlm: bad setting " + key + "=" + value +
-                                       " (known: url, model, api_key_env, timeout, retries, backoff, "
-                                       "max_response_bytes, prompt_file, max_views)");
+                                       " (known: " + detail::kOpenAiOptionKeys + ", prompt_file, max_views)");
     }
     if (!injected_ && !options_.model.empty()) {
       Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);

@@ -48,6 +48,7 @@ TEST(ToolExport, StartsFromAPropertiesOutput) {
     return nlohmann::json::parse(test::read_file(report))["object"]["mass_kg"].get<double>();
   };
   EXPECT_NEAR(mass(dir + "/assets/report.json"), mass(dir + "/props/report.json"), 1e-9);
+  EXPECT_NE(test::read_file(dir + "/assets/report.json").find("convex hull"), std::string::npos);
   r = run_tool("validate " + quote(dir + "/assets"));
   if (r.err.find("without MuJoCo") != std::string::npos) GTEST_SKIP() << "libg2p built without MuJoCo";
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;

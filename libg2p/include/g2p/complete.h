@@ -8,6 +8,7 @@
 // (g2p/complete_cgal.h).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,18 @@ G2P_API Result<std::unique_ptr<Completer>> make_completer(const std::string& nam
 // given) and noted. The result always has one entry per part.
 G2P_API Result<Completion> complete(const CompletionInput& input, const Completer& completer,
                                     const Completer* fallback = nullptr);
+
+// For completers that close each part on its own from its patch (alpha-wrap,
+// fill, external, a learned model such as HoloPart): calls `close` for every
+// part with the part's patch. `close` puts the closed mesh in out.mesh (and
+// may add notes); an error rejects the part (its message becomes a note; a
+// mesh it left is still checked and kept, flagged). Exceptions fail the part
+// only. Each mesh is then checked against its patch: the part is ok when
+// `close` succeeded, the mesh is watertight and it lies within
+// `max_relative_distance` of the patch (x the patch's diagonal).
+using ClosePart = std::function<Status(int part, const Mesh& patch, CompletedPart& out)>;
+G2P_API Result<Completion> complete_each_part(const CompletionInput& input, const std::string& backend,
+                                              double max_relative_distance, const ClosePart& close);
 
 // The part's own faces as a mesh (its open patch), vertices compacted.
 G2P_API Mesh part_patch(const Mesh& mesh, const Part& part);

@@ -1,5 +1,6 @@
 // The Completer base class, the registry, the fallback driver and the files
 // the stage writes.
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "complete/backends.h"
@@ -76,6 +77,47 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
   out.parts_volume_m3 = 0.0;
   for (const CompletedPart& p : out.parts) out.parts_volume_m3 += p.checks.volume_m3;
   return out;
+}
+
+Result<Completion> complete_each_part(const CompletionInput& input, const std::string& backend,
+                                      double max_relative_distance, const ClosePart& close) {
+  if (input.mesh == nullptr || input.parts == nullptr)
+    return Status::InvalidArgument(backend + ": needs the mesh and the parts");
+  Completion result;
+  for (std::size_t p = 0; p < input.parts->size(); ++p) {
+    const Part& part = (*input.parts)[p];
+    CompletedPart& out = result.parts.emplace_back();
+    out.part = static_cast<int>(p);
+    out.label = part.label;
+    out.backend = backend;
+    const Mesh patch = part_patch(*input.mesh, part);
+    Status closed;
+    try {
+      closed = close(static_cast<int>(p), patch, out);
+    } catch (const std::exception& e) {
+      out.mesh = Mesh();
+      closed = Status::Internal(backend + ": failed: " + e.what());
+    }
+    if (!closed.ok()) out.notes.push_back(closed.message());
+    if (out.mesh.num_faces() == 0) continue;
+    out.checks = check_closed_mesh(out.mesh, &patch);
+    const bool near = out.checks.relative_distance <= max_relative_distance;
+    out.ok = closed.ok() && out.checks.watertight() && near;
+    if (!out.checks.watertight()) {
+      const MeshChecks& c = out.checks;
+      out.notes.push_back(backend + ": the closed mesh failed the checks (" + (c.closed ? "" : "open, ") +
+                          (c.manifold ? "" : "non-manifold, ") + (c.outward ? "" : "not outward, ") +
+                          std::to_string(c.num_self_intersections) + " self-intersections)");
+    }
+    if (!near) {
+      char text[160];
+      std::snprintf(text, sizeof text, ": the closed mesh lies %.3g of the patch's diagonal from it (at most %.3g)",
+                    out.checks.relative_distance, max_relative_distance);
+      out.notes.push_back(backend + text);
+    }
+  }
+  for (const CompletedPart& c : result.parts) result.parts_volume_m3 += c.checks.volume_m3;
+  return result;
 }
 
 namespace {

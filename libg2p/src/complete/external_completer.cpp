@@ -108,56 +108,35 @@ class ExternalCompleter final : public Completer {
     const std::string object_path = (work / ("object." + format_)).string();
     G2P_RETURN_IF_ERROR(write_mesh(object_path, *input.mesh));
 
-    Completion result;
-    for (std::size_t p = 0; p < input.parts->size(); ++p) {
-      const Part& part = (*input.parts)[p];
-      CompletedPart& out = result.parts.emplace_back();
-      out.part = static_cast<int>(p);
-      out.label = part.label;
-      out.backend = "external";
-      const Mesh patch = part_patch(*input.mesh, part);
-      const std::string in_path = (work / ("part_" + std::to_string(p) + "." + format_)).string();
-      const std::string out_path = (work / ("part_" + std::to_string(p) + "_closed." + format_)).string();
-      const std::string label =
-          input.table != nullptr && input.table->valid_label(part.label) ? (*input.table)[part.label].name : "Unknown";
-      Status s = write_mesh(in_path, patch);
-      if (s.ok()) {
-        std::string cmd = command_;
-        replace_all(cmd, "{input}", shell_quote(in_path));
-        replace_all(cmd, "{output}", shell_quote(out_path));
-        replace_all(cmd, "{object}", shell_quote(object_path));
-        replace_all(cmd, "{label}", shell_quote(label));
-        replace_all(cmd, "{part}", std::to_string(p));
-        s = run_command(cmd, timeout_s_);
-      }
-      if (s.ok()) {
-        ImportOptions io;
-        io.z_up = false;  // the command answers in the frame it was given
-        io.unit_scale = 1.0;
-        io.up_axis = UpAxis::kZ;
-        io.load_textures = false;
-        Result<Model> closed = load_model(out_path, io);
-        if (closed.ok()) {
-          out.mesh = std::move(closed->mesh);
-          out.mesh.normals.clear();
-          out.mesh.uvs.clear();
-          out.mesh.face_source.clear();
-          out.mesh.face_flags.clear();
-        } else {
-          s = closed.status();
-        }
-      }
-      if (!s.ok()) {
-        out.notes.push_back(s.message());
-        continue;
-      }
-      out.checks = check_closed_mesh(out.mesh, &patch);
-      out.ok = out.checks.watertight() && out.checks.relative_distance <= max_relative_distance_;
-      if (!out.ok) out.notes.push_back("external: the returned mesh failed the checks");
-    }
+    Result<Completion> result = complete_each_part(
+        input, "external", max_relative_distance_, [&](int p, const Mesh& patch, CompletedPart& out) -> Status {
+          const Part& part = (*input.parts)[static_cast<std::size_t>(p)];
+          const std::string stem = (work / ("part_" + std::to_string(p))).string();
+          const std::string in_path = stem + "." + format_, out_path = stem + "_closed." + format_;
+          const std::string label = input.table != nullptr && input.table->valid_label(part.label)
+                                        ? (*input.table)[part.label].name
+                                        : "Unknown";
+          G2P_RETURN_IF_ERROR(write_mesh(in_path, patch));
+          std::string cmd = command_;
+          replace_all(cmd, "{input}", shell_quote(in_path));
+          replace_all(cmd, "{output}", shell_quote(out_path));
+          replace_all(cmd, "{object}", shell_quote(object_path));
+          replace_all(cmd, "{label}", shell_quote(label));
+          replace_all(cmd, "{part}", std::to_string(p));
+          G2P_RETURN_IF_ERROR(run_command(cmd, timeout_s_));
+          ImportOptions io;
+          io.z_up = false;  // the command answers in the frame it was given
+          io.unit_scale = 1.0;
+          io.up_axis = UpAxis::kZ;
+          io.load_textures = false;
+          Result<Model> closed = load_model(out_path, io);
+          if (!closed.ok()) return closed.status();
+          out.mesh.positions = std::move(closed->mesh.positions);
+          out.mesh.triangles = std::move(closed->mesh.triangles);
+          return Status::Ok();
+        });
     std::error_code ec;
     fs::remove_all(work, ec);
-    for (const CompletedPart& p : result.parts) result.parts_volume_m3 += p.checks.volume_m3;
     return result;
   }
 

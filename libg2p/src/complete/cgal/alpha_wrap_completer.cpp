@@ -150,89 +150,64 @@ class AlphaWrapCompleter final : public Completer {
   }
 
   Result<Completion> complete(const CompletionInput& input) const override {
-    if (input.mesh == nullptr || input.parts == nullptr)
-      return Status::InvalidArgument("alpha-wrap: needs the mesh and the parts");
-    Completion result;
-    for (std::size_t p = 0; p < input.parts->size(); ++p) {
-      const Part& part = (*input.parts)[p];
-      CompletedPart& out = result.parts.emplace_back();
-      out.part = static_cast<int>(p);
-      out.label = part.label;
-      out.backend = "alpha-wrap";
-      const Mesh patch = part_patch(*input.mesh, part);
-      const double diag = patch.num_faces() > 0 ? bounds(patch).diagonal().norm() : 0.0;
-      if (!(diag > 0) || !std::isfinite(diag)) {
-        out.notes.push_back("alpha-wrap: the part has no faces of positive extent");
-        continue;
-      }
-      std::vector<Point> points;
-      points.reserve(patch.positions.size());
-      for (const Eigen::Vector3f& q : patch.positions) points.emplace_back(q.x(), q.y(), q.z());
-      std::vector<std::array<std::size_t, 3>> faces;
-      faces.reserve(patch.triangles.size());
-      for (const Eigen::Vector3i& t : patch.triangles) {
-        const std::array<std::size_t, 3> f{static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]),
-                                           static_cast<std::size_t>(t[2])};
-        // CGAL's oracle skips degenerate triangles, and wrapping nothing crashes: drop them here.
-        if (!CGAL::collinear(points[f[0]], points[f[1]], points[f[2]])) faces.push_back(f);
-      }
-      if (faces.empty()) {
-        out.notes.push_back("alpha-wrap: every triangle of the part is degenerate; nothing to wrap");
-        continue;
-      }
-      const double alpha = relative_alpha_ * diag, offset = relative_offset_ * diag;
-      const auto start = std::chrono::steady_clock::now();
-      SurfaceMesh wrap;
-      try {
-        CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
-        if (!CGAL::is_closed(wrap) || wrap.number_of_faces() == 0) {
-          out.notes.push_back("alpha-wrap: CGAL returned an empty or open wrap");
-          continue;
-        }
-        if (PMP::volume(wrap) < 0) {
-          PMP::reverse_face_orientations(wrap);
-          out.notes.push_back("alpha-wrap: reversed the wrap's faces to point outward");
-        }
-      } catch (const std::exception& e) {
-        out.notes.push_back(std::string("alpha-wrap: CGAL failed: ") + e.what());
-        continue;
-      }
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      out.mesh = to_mesh(wrap);
-      out.notes.push_back("alpha-wrap: wrapped " + std::to_string(faces.size()) + " triangles with alpha " +
-                          number(alpha) + " m and offset " + number(offset) + " m (" + number(relative_alpha_) +
-                          " and " + number(relative_offset_) + " of the " + number(diag) + " m diagonal) into " +
-                          std::to_string(out.mesh.num_faces()) + " triangles in " + number(seconds) + " s");
-      bool shell = false;
-      if (const Holes holes = find_holes(patch); holes.count > 0) {
-        std::string note = "alpha-wrap: the patch is open (" + std::to_string(holes.count) +
-                           " hole(s), the widest spanning " + number(holes.widest / diag) + " of the diagonal)";
-        if (alpha < 0.5 * holes.widest) {
-          // The wrap passes through the hole: a closed but paper-thin shell
-          // around the surface whose volume means nothing. Not ok, so
-          // complete() falls back to a backend that fills the part.
-          shell = true;
-          note +=
-              "; alpha is below half of that, so the wrap passes through the hole and is a thin shell around "
-              "the surface rather than a solid (raise relative_alpha above " +
-              number(0.5 * holes.widest / diag) + " to close over it, or use the fill backend); not used";
-        }
-        out.notes.push_back(note);
-      }
-      out.checks = check_closed_mesh(out.mesh, &patch);
-      const bool near = out.checks.relative_distance <= max_relative_distance_;
-      out.ok = out.checks.watertight() && near && !shell;
-      if (!out.checks.watertight()) out.notes.push_back("alpha-wrap: the wrap failed the watertightness checks");
-      if (!near)
-        out.notes.push_back("alpha-wrap: the wrap lies " + number(out.checks.relative_distance) +
-                            " of the diagonal from the patch (max_relative_distance " + number(max_relative_distance_) +
-                            ")");
-    }
-    for (const CompletedPart& c : result.parts) result.parts_volume_m3 += c.checks.volume_m3;
-    return result;
+    return complete_each_part(input, "alpha-wrap", max_relative_distance_,
+                              [&](int, const Mesh& patch, CompletedPart& out) { return wrap_part(patch, out); });
   }
 
  private:
+  // Wraps one patch into out.mesh. A wrap that went through a hole of the
+  // patch (a thin shell) is kept but rejected.
+  Status wrap_part(const Mesh& patch, CompletedPart& out) const {
+    const double diag = patch.num_faces() > 0 ? bounds(patch).diagonal().norm() : 0.0;
+    if (!(diag > 0) || !std::isfinite(diag))
+      return Status::InvalidArgument("alpha-wrap: the part has no faces of positive extent");
+    std::vector<Point> points;
+    points.reserve(patch.positions.size());
+    for (const Eigen::Vector3f& q : patch.positions) points.emplace_back(q.x(), q.y(), q.z());
+    std::vector<std::array<std::size_t, 3>> faces;
+    faces.reserve(patch.triangles.size());
+    for (const Eigen::Vector3i& t : patch.triangles) {
+      const std::array<std::size_t, 3> f{static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]),
+                                         static_cast<std::size_t>(t[2])};
+      // CGAL's oracle skips degenerate triangles, and wrapping nothing crashes: drop them here.
+      if (!CGAL::collinear(points[f[0]], points[f[1]], points[f[2]])) faces.push_back(f);
+    }
+    if (faces.empty())
+      return Status::InvalidArgument("alpha-wrap: every triangle of the part is degenerate; nothing to wrap");
+    const double alpha = relative_alpha_ * diag, offset = relative_offset_ * diag;
+    const auto start = std::chrono::steady_clock::now();
+    SurfaceMesh wrap;
+    CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
+    if (!CGAL::is_closed(wrap) || wrap.number_of_faces() == 0)
+      return Status::Internal("alpha-wrap: CGAL returned an empty or open wrap");
+    if (PMP::volume(wrap) < 0) {
+      PMP::reverse_face_orientations(wrap);
+      out.notes.push_back("alpha-wrap: reversed the wrap's faces to point outward");
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.mesh = to_mesh(wrap);
+    out.notes.push_back("alpha-wrap: wrapped " + std::to_string(faces.size()) + " triangles with alpha " +
+                        number(alpha) + " m and offset " + number(offset) + " m (" + number(relative_alpha_) + " and " +
+                        number(relative_offset_) + " of the " + number(diag) + " m diagonal) into " +
+                        std::to_string(out.mesh.num_faces()) + " triangles in " + number(seconds) + " s");
+    if (const Holes holes = find_holes(patch); holes.count > 0) {
+      std::string note = "alpha-wrap: the patch is open (" + std::to_string(holes.count) +
+                         " hole(s), the widest spanning " + number(holes.widest / diag) + " of the diagonal)";
+      if (alpha < 0.5 * holes.widest)
+        // The wrap passes through the hole: a closed but paper-thin shell
+        // around the surface whose volume means nothing. Rejected, so
+        // complete() falls back to a backend that fills the part.
+        return Status::Unavailable(note +
+                                   "; alpha is below half of that, so the wrap passes through the hole and is a "
+                                   "thin shell around the surface rather than a solid (raise relative_alpha above " +
+                                   number(0.5 * holes.widest / diag) +
+                                   " to close over it, or use the fill backend); "
+                                   "not used");
+      out.notes.push_back(note);
+    }
+    return Status::Ok();
+  }
+
   double relative_alpha_ = 0.01;
   double relative_offset_ = 0.0005;
   double max_relative_distance_ = 0.25;

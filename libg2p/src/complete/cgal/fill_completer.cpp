@@ -120,41 +120,18 @@ class FillCompleter final : public Completer {
   }
 
   Result<Completion> complete(const CompletionInput& input) const override {
-    if (input.mesh == nullptr || input.parts == nullptr)
-      return Status::InvalidArgument("fill: needs the mesh and the parts");
-    Completion result;
-    for (std::size_t p = 0; p < input.parts->size(); ++p) {
-      const Part& part = (*input.parts)[p];
-      CompletedPart& out = result.parts.emplace_back();
-      out.part = static_cast<int>(p);
-      out.label = part.label;
-      out.backend = "fill";
-      const Mesh patch = part_patch(*input.mesh, part);
-      try {
-        fill_part(patch, out);
-      } catch (const std::exception& e) {
-        out.mesh = Mesh();
-        out.ok = false;
-        out.notes.push_back(std::string("fill: CGAL failed: ") + e.what());
-      }
-    }
-    for (const CompletedPart& c : result.parts) result.parts_volume_m3 += c.checks.volume_m3;
-    return result;
+    return complete_each_part(input, "fill", max_relative_distance_,
+                              [&](int, const Mesh& patch, CompletedPart& out) { return fill_part(patch, out); });
   }
 
  private:
-  // Closes one patch into out.mesh; leaves out.ok false with a note when it cannot.
-  void fill_part(const Mesh& patch, CompletedPart& out) const {
+  // Closes one patch into out.mesh, or says why it cannot.
+  Status fill_part(const Mesh& patch, CompletedPart& out) const {
     const double diag = patch.num_faces() > 0 ? bounds(patch).diagonal().norm() : 0.0;
-    if (!(diag > 0) || !std::isfinite(diag)) {
-      out.notes.push_back("fill: the part has no faces of positive extent");
-      return;
-    }
+    if (!(diag > 0) || !std::isfinite(diag))
+      return Status::InvalidArgument("fill: the part has no faces of positive extent");
     SurfaceMesh sm;
-    if (std::string why = load_patch(patch, sm); !why.empty()) {
-      out.notes.push_back("fill: " + why);
-      return;
-    }
+    if (std::string why = load_patch(patch, sm); !why.empty()) return Status::InvalidArgument("fill: " + why);
     std::vector<Halfedge> holes;
     PMP::extract_boundary_cycles(sm, std::back_inserter(holes));
 
@@ -168,11 +145,10 @@ class FillCompleter final : public Completer {
       }
       widest = std::max(widest, box.diagonal().norm() / diag);
     }
-    if (widest > max_relative_hole_) {
-      out.notes.push_back("fill: the widest of the " + std::to_string(holes.size()) + " holes spans " + number(widest) +
-                          " of the part's diagonal, more than max_relative_hole " + number(max_relative_hole_));
-      return;
-    }
+    if (widest > max_relative_hole_)
+      return Status::Unavailable("fill: the widest of the " + std::to_string(holes.size()) + " holes spans " +
+                                 number(widest) + " of the part's diagonal, more than max_relative_hole " +
+                                 number(max_relative_hole_));
 
     int added_faces = 0, unfaired = 0;
     for (std::size_t i = 0; i < holes.size(); ++i) {
@@ -181,18 +157,13 @@ class FillCompleter final : public Completer {
       const auto r =
           PMP::triangulate_refine_and_fair_hole(sm, holes[i], std::back_inserter(faces), std::back_inserter(vertices),
                                                 CGAL::parameters::fairing_continuity(fairing_continuity_));
-      if (faces.empty()) {
-        out.notes.push_back("fill: CGAL found no triangulation for hole " + std::to_string(i + 1) + " of " +
-                            std::to_string(holes.size()));
-        return;
-      }
+      if (faces.empty())
+        return Status::Unavailable("fill: CGAL found no triangulation for hole " + std::to_string(i + 1) + " of " +
+                                   std::to_string(holes.size()));
       added_faces += static_cast<int>(faces.size());
       if (!std::get<0>(r) && !vertices.empty()) ++unfaired;
     }
-    if (!CGAL::is_closed(sm)) {
-      out.notes.push_back("fill: the patch is still open after filling its holes");
-      return;
-    }
+    if (!CGAL::is_closed(sm)) return Status::Unavailable("fill: the patch is still open after filling its holes");
     bool reversed = false;
     if (PMP::volume(sm) < 0) {
       PMP::reverse_face_orientations(sm);
@@ -210,18 +181,7 @@ class FillCompleter final : public Completer {
       out.notes.push_back("fill: fairing failed for " + std::to_string(unfaired) + " hole(s); they are refined only");
     if (reversed) out.notes.push_back("fill: reversed the faces to point outward");
 
-    out.checks = check_closed_mesh(out.mesh, &patch);
-    const bool near = out.checks.relative_distance <= max_relative_distance_;
-    out.ok = out.checks.watertight() && near;
-    if (!out.checks.watertight())
-      out.notes.push_back(std::string("fill: the filled mesh is not watertight (") +
-                          (out.checks.closed ? "" : "open, ") + (out.checks.manifold ? "" : "non-manifold, ") +
-                          (out.checks.outward ? "" : "not outward, ") +
-                          std::to_string(out.checks.num_self_intersections) + " self-intersections)");
-    if (!near)
-      out.notes.push_back("fill: the fill reaches " + number(out.checks.relative_distance) +
-                          " of the diagonal away from the patch (max_relative_distance " +
-                          number(max_relative_distance_) + ")");
+    return Status::Ok();
   }
 
   double max_relative_hole_ = 0.3;

@@ -24,54 +24,19 @@
 #include <utility>
 #include <vector>
 
+#include "complete/cgal/cgal_mesh.h"
 #include "g2p/complete_cgal.h"
 
 namespace g2p {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using cgal_detail::number;
+using cgal_detail::parse_positive;
+using cgal_detail::Point;
+using cgal_detail::SurfaceMesh;
+using cgal_detail::to_mesh;
+
 namespace PMP = CGAL::Polygon_mesh_processing;
-
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
-
-// A strictly positive, finite number, or an error naming `key`.
-Status parse_positive(const std::string& key, const std::string& value, double& out) {
-  char* end = nullptr;
-  const double v = std::strtod(value.c_str(), &end);
-  if (end == value.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0))
-    return Status::InvalidArgument("alpha-wrap: " + key + " needs a positive number, got '" + value + "'");
-  out = v;
-  return Status::Ok();
-}
-
-// The closed CGAL mesh as a libg2p mesh (positions and triangles only).
-Mesh to_mesh(const SurfaceMesh& sm) {
-  Mesh m;
-  std::vector<int> index(sm.num_vertices(), -1);  // num_vertices() counts removed ones too
-  m.positions.reserve(sm.number_of_vertices());
-  for (SurfaceMesh::Vertex_index v : sm.vertices()) {
-    index[v.idx()] = static_cast<int>(m.positions.size());
-    const Point& p = sm.point(v);
-    m.positions.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-  }
-  m.triangles.reserve(sm.number_of_faces());
-  for (SurfaceMesh::Face_index f : sm.faces()) {
-    std::array<int, 3> t{};
-    int n = 0;
-    for (SurfaceMesh::Vertex_index v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
-      if (n < 3) t[static_cast<std::size_t>(n)] = index[v.idx()];
-      ++n;
-    }
-    if (n == 3) m.triangles.emplace_back(t[0], t[1], t[2]);
-  }
-  return m;
-}
 
 // The holes of a patch: loops of edges with one triangle, after welding
 // vertices at equal positions (imported meshes split vertices at seams).
@@ -133,11 +98,11 @@ class AlphaWrapCompleter final : public Completer {
     double alpha = relative_alpha_, offset = relative_offset_, distance = max_relative_distance_;
     for (const auto& [key, value] : settings) {
       if (key == "relative_alpha") {
-        G2P_RETURN_IF_ERROR(parse_positive(key, value, alpha));
+        G2P_RETURN_IF_ERROR(parse_positive("alpha-wrap", key, value, alpha));
       } else if (key == "relative_offset") {
-        G2P_RETURN_IF_ERROR(parse_positive(key, value, offset));
+        G2P_RETURN_IF_ERROR(parse_positive("alpha-wrap", key, value, offset));
       } else if (key == "max_relative_distance") {
-        G2P_RETURN_IF_ERROR(parse_positive(key, value, distance));
+        G2P_RETURN_IF_ERROR(parse_positive("alpha-wrap", key, value, distance));
       } else {
         return Status::InvalidArgument("alpha-wrap: unknown setting '" + key +
                                        "' (known: relative_alpha, relative_offset, max_relative_distance)");

@@ -10,8 +10,9 @@ namespace g2p::cli {
 // Documented exit codes of every subcommand.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,  // the library reported an error (bad input file, ...)
-  kExitUsage = 2,    // bad command line
+  kExitFailure = 1,      // the library reported an error (bad input file, ...)
+  kExitUsage = 2,        // bad command line
+  kExitCancelled = 130,  // interrupted (Ctrl-C); nothing was written
 };
 
 // Adds a subcommand; the returned function runs it after parsing.
@@ -25,5 +26,6 @@ void add_refine_command(CLI::App& app, Command& run);
 void add_complete_command(CLI::App& app, Command& run);
 void add_properties_command(CLI::App& app, Command& run);
 void add_export_command(CLI::App& app, Command& run);  // export and validate
+void add_run_command(CLI::App& app, Command& run);     // the whole pipeline
 
 }  // namespace g2p::cli

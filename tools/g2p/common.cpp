@@ -16,16 +16,11 @@ void add_import_flags(CLI::App* cmd, ImportArgs& args) {
   cmd->add_flag("--no-textures", args.no_textures, "Do not decode textures");
 }
 
-Result<Model> load_with_flags(const std::string& command, const std::string& path, const ImportArgs& args,
-                              int& exit_code) {
+Result<ImportOptions> import_options(const ImportArgs& args) {
   ImportOptions options;
   if (!args.unit.empty()) {
     Result<double> scale = parse_unit(args.unit);
-    if (!scale.ok()) {
-      std::cerr << "g2p " << command << ": " << scale.status().message() << "\n";
-      exit_code = kExitUsage;
-      return scale.status();
-    }
+    if (!scale.ok()) return scale.status();
     options.unit_scale = *scale;
   }
   static const std::map<std::string, UpAxis> kAxes = {
@@ -34,7 +29,18 @@ Result<Model> load_with_flags(const std::string& command, const std::string& pat
   options.up_axis = axis != kAxes.end() ? axis->second : UpAxis::kAuto;
   options.z_up = !args.keep_axes;
   options.load_textures = !args.no_textures;
-  Result<Model> model = load_model(path, options);
+  return options;
+}
+
+Result<Model> load_with_flags(const std::string& command, const std::string& path, const ImportArgs& args,
+                              int& exit_code) {
+  Result<ImportOptions> options = import_options(args);
+  if (!options.ok()) {
+    std::cerr << "g2p " << command << ": " << options.status().message() << "\n";
+    exit_code = kExitUsage;
+    return options.status();
+  }
+  Result<Model> model = load_model(path, *options);
   if (!model.ok()) {
     std::cerr << "g2p " << command << ": error: " << model.status().to_string() << "\n";
     exit_code = kExitFailure;

@@ -24,6 +24,9 @@ struct ImportArgs {
 
 void add_import_flags(CLI::App* cmd, ImportArgs& args);
 
+// The flags as import options (an unknown --unit is an error).
+Result<ImportOptions> import_options(const ImportArgs& args);
+
 // Loads `path` with the flags; on failure prints "g2p COMMAND: error: ..." and
 // returns the exit code in `exit_code`.
 Result<Model> load_with_flags(const std::string& command, const std::string& path, const ImportArgs& args,

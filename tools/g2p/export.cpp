@@ -81,14 +81,7 @@ int run_export(const ExportArgs& args) {
   }
   Status s = write_asset(args.out, *asset, engine_formats, options);
   if (s.ok() && glb) s = write_glb(args.out + "/" + asset->name + ".glb", object->model, object->faces.parts, *asset);
-  if (s.ok()) {
-    PropertiesReport with_notes = *report;
-    with_notes.notes.push_back(
-        "export: MuJoCo collides each mesh geom as its convex hull, so contacts on concave parts are approximate "
-        "(no convex decomposition yet); the mass properties are exact");
-    for (const std::string& n : asset->notes) with_notes.notes.push_back("export: " + n);
-    s = write_report(args.out + "/report.json", with_notes, object->table);
-  }
+  if (s.ok()) s = write_report(args.out + "/report.json", with_export_notes(*report, *asset), object->table);
   if (!s.ok()) {
     std::cerr << "g2p export: error: " << s.to_string() << "\n";
     return kExitFailure;

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   g2p::cli::Command run;
+  g2p::cli::add_run_command(app, run);
   g2p::cli::add_info_command(app, run);
   g2p::cli::add_render_command(app, run);
   g2p::cli::add_segment_command(app, run);

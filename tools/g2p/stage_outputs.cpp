@@ -57,15 +57,9 @@ int refine_projection(const std::string& command, const RefineArgs& args, const 
     report["error"] = refined.status().to_string();
     return kExitOk;
   }
-  const std::vector<float> voted_confidence = projection.labels.confidence;
-  projection.labels.label = refined->labels;
-  projection.parts = partition(model.mesh, projection.graph, projection.labels.label, projection.face_part,
-                               partition_options, &voted_confidence);
-  for (int f = 0; f < model.mesh.num_faces(); ++f) {
-    const float* h = projection.votes.of(f);
-    const int l = projection.labels.label[static_cast<std::size_t>(f)];
-    const float t = projection.votes.total[static_cast<std::size_t>(f)];
-    projection.labels.confidence[static_cast<std::size_t>(f)] = h != nullptr && t > 0.f && l >= 0 ? h[l] / t : 0.f;
+  if (Status s = apply_refinement(model.mesh, refined->labels, partition_options, projection); !s.ok()) {
+    std::cerr << "g2p " << command << ": error: " << s.to_string() << "\n";
+    return kExitFailure;
   }
   report["notes"] = refined->notes;
   report["changed_faces"] = refined->changes.size();
@@ -81,23 +75,8 @@ int refine_projection(const std::string& command, const RefineArgs& args, const 
 
 Status write_projection(const std::string& out, const Model& model, const std::vector<View>& views,
                         const Projection& projection, const MaterialTable& table, const nlohmann::json& report) {
-  // The labels seen through every view: what the refine stage (and a person) looks at.
-  std::vector<LabelMap> projected;
-  for (const View& v : views) projected.push_back(render_face_labels(v, projection.labels.label));
-  Status s = write_label_maps(out + "/projected", projected, table);
-  if (s.ok()) s = write_faces_csv(out + "/faces.csv", model, projection, table);
-  if (s.ok()) s = write_labelled_ply(out + "/labelled.ply", model.mesh, projection.labels.label, table);
-  nlohmann::json parts = nlohmann::json::array();
-  for (std::size_t i = 0; i < projection.parts.size(); ++i) {
-    const Part& p = projection.parts[i];
-    parts.push_back({{"part", i},
-                     {"label", table.valid_label(p.label) ? table[p.label].name : std::string()},
-                     {"faces", p.faces.size()},
-                     {"area_m2", p.area_m2}});
-  }
-  if (s.ok()) s = write_text_file(out + "/refine.json", report.dump(2) + "\n");
-  if (s.ok()) s = write_text_file(out + "/parts.json", nlohmann::json{{"parts", parts}}.dump(2) + "\n");
-  return s;
+  G2P_RETURN_IF_ERROR(g2p::write_projection(out, model, views, projection, table));
+  return write_text_file(out + "/refine.json", report.dump(2) + "\n");
 }
 
 void print_parts(const Projection& projection, const MaterialTable& table) {

@@ -52,6 +52,11 @@ struct ExportOptions {
   bool use_static_friction = false;
 };
 
+// The properties report as written beside an asset (report.json): the
+// estimate's notes plus the export's (parts left out, the MuJoCo convex-hull
+// caveat for contacts).
+G2P_API PropertiesReport with_export_notes(const PropertiesReport& report, const SimulationAsset& asset);
+
 // The texts of the three formats; meshes are referenced as meshes/NAME.stl
 // (collision) and meshes/NAME_visual.stl.
 G2P_API std::string mjcf_text(const SimulationAsset& asset, const ExportOptions& options = {});

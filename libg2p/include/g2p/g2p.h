@@ -9,6 +9,7 @@
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/model.h"
+#include "g2p/pipeline.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/refine.h"

@@ -51,7 +51,8 @@ G2P_API Result<Model> load_model_from_memory(const void* data, std::size_t size,
 // and renamed, so an existing file is never left half-overwritten.
 G2P_API Status write_mesh(const std::string& path, const Mesh& mesh);
 
-// Metres per unit for a unit name: "m", "cm", "mm", "in", "ft" (and long forms).
+// Metres per unit for a unit name: "m", "cm", "mm", "in", "ft" (and long forms),
+// or a positive number of metres per unit ("0.001").
 G2P_API Result<double> parse_unit(const std::string& unit);
 
 // Reads an image file (PNG, JPEG, ...) as 8-bit RGBA.

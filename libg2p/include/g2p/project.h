@@ -158,4 +158,10 @@ G2P_API Result<FacesFile> read_faces_csv(const std::string& path, const Mesh& me
 G2P_API Status write_labelled_ply(const std::string& path, const Mesh& mesh, const std::vector<int>& face_labels,
                                   const MaterialTable& table);
 
+// The project stage's folder: DIR/faces.csv, DIR/labelled.ply, DIR/parts.json
+// and DIR/projected/ (the face labels seen through every view, the input of
+// the refine stage and of a person checking the result).
+G2P_API Status write_projection(const std::string& dir, const Model& model, const std::vector<View>& views,
+                                const Projection& projection, const MaterialTable& table);
+
 }  // namespace g2p

@@ -59,6 +59,12 @@ class G2P_API Refiner {
 G2P_API Registry<Refiner>& refiner_registry();
 G2P_API Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings = {});
 
+// Puts a refiner's per-face labels into a projection: the parts are
+// partitioned again (small fragments merge unless their votes were confident)
+// and each face's confidence becomes its votes' share for its new label.
+G2P_API Status apply_refinement(const Mesh& mesh, const std::vector<int>& labels, const PartitionOptions& options,
+                                Projection& projection);
+
 // The `vlm` refiner with a client of the caller's (any VlmClient subclass).
 G2P_API std::unique_ptr<Refiner> make_vlm_refiner(std::shared_ptr<const VlmClient> client);
 

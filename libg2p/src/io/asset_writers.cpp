@@ -83,6 +83,15 @@ Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, 
   return a;
 }
 
+PropertiesReport with_export_notes(const PropertiesReport& report, const SimulationAsset& asset) {
+  PropertiesReport out = report;
+  out.notes.push_back(
+      "export: MuJoCo collides each mesh geom as its convex hull, so contacts on concave parts are approximate "
+      "(no convex decomposition yet); the mass properties are exact");
+  for (const std::string& n : asset.notes) out.notes.push_back("export: " + n);
+  return out;
+}
+
 std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
   std::ostringstream x;
   const MassProperties& m = a.total;

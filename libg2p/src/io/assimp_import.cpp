@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -518,7 +519,11 @@ Result<double> parse_unit(const std::string& unit) {
   const std::string u = lower(unit);
   for (const auto& [name, scale] : kUnits)
     if (u == name) return scale;
-  return Status::InvalidArgument("unknown unit '" + unit + "' (use m, cm, mm, km, in or ft)");
+  // Metres per unit as a number ("0.001"), as output manifests record it.
+  char* end = nullptr;
+  const double value = unit.empty() ? 0.0 : std::strtod(unit.c_str(), &end);
+  if (end != nullptr && *end == '\0' && std::isfinite(value) && value > 0.0) return value;
+  return Status::InvalidArgument("unknown unit '" + unit + "' (use m, cm, mm, km, in, ft or metres per unit)");
 }
 
 }  // namespace g2p

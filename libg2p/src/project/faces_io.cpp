@@ -5,8 +5,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
 #include "core/file_util.h"
 #include "g2p/project.h"
+#include "g2p/segment.h"
 
 namespace g2p {
 namespace {
@@ -147,6 +149,25 @@ Status write_labelled_ply(const std::string& path, const Mesh& mesh, const std::
     out.append(reinterpret_cast<const char*>(c.data()), 3);
   }
   return detail::write_file_atomically(path, out);
+}
+
+Status write_projection(const std::string& dir, const Model& model, const std::vector<View>& views,
+                        const Projection& projection, const MaterialTable& table) {
+  std::vector<LabelMap> projected;
+  projected.reserve(views.size());
+  for (const View& v : views) projected.push_back(render_face_labels(v, projection.labels.label));
+  G2P_RETURN_IF_ERROR(write_label_maps(dir + "/projected", projected, table));
+  G2P_RETURN_IF_ERROR(write_faces_csv(dir + "/faces.csv", model, projection, table));
+  G2P_RETURN_IF_ERROR(write_labelled_ply(dir + "/labelled.ply", model.mesh, projection.labels.label, table));
+  nlohmann::json parts = nlohmann::json::array();
+  for (std::size_t i = 0; i < projection.parts.size(); ++i) {
+    const Part& p = projection.parts[i];
+    parts.push_back({{"part", i},
+                     {"label", table.valid_label(p.label) ? table[p.label].name : std::string()},
+                     {"faces", p.faces.size()},
+                     {"area_m2", p.area_m2}});
+  }
+  return detail::write_file_atomically(dir + "/parts.json", nlohmann::json{{"parts", parts}}.dump(2) + "\n");
 }
 
 }  // namespace g2p

@@ -38,6 +38,25 @@ Registry<Refiner>& refiner_registry() {
   return *registry;
 }
 
+Status apply_refinement(const Mesh& mesh, const std::vector<int>& labels, const PartitionOptions& options,
+                        Projection& projection) {
+  const std::size_t n = static_cast<std::size_t>(mesh.num_faces());
+  if (labels.size() != n || projection.labels.label.size() != n || projection.votes.total.size() != n)
+    return Status::InvalidArgument("apply_refinement: " + std::to_string(labels.size()) + " labels for a mesh of " +
+                                   std::to_string(n) + " faces, or a projection of another mesh");
+  const std::vector<float> voted_confidence = projection.labels.confidence;
+  projection.labels.label = labels;
+  projection.parts = partition(mesh, projection.graph, projection.labels.label, projection.face_part, options,
+                               &voted_confidence);
+  for (std::size_t f = 0; f < n; ++f) {
+    const float* h = projection.votes.of(static_cast<int>(f));
+    const int l = projection.labels.label[f];
+    const float t = projection.votes.total[f];
+    projection.labels.confidence[f] = h != nullptr && t > 0.f && l >= 0 ? h[l] / t : 0.f;
+  }
+  return Status::Ok();
+}
+
 Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings) {
   Result<std::unique_ptr<Refiner>> r = refiner_registry().create(name);
   if (!r.ok()) return r.status();

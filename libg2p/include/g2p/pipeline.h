@@ -1,0 +1,215 @@
+// The whole Gen2Physics method in one call: a mesh in, simulation-ready parts
+// out. Pipeline runs the six stages (render, segment, project, refine,
+// complete, properties) and builds the simulation asset; every stage's backend
+// is chosen by name through its registry or given as an object (a user's own
+// Segmenter, say). write_pipeline_output() then writes the output folder
+// atomically (docs/pipeline.md lists what it holds).
+//
+//   g2p::Pipeline pipeline;                       // the offline defaults
+//   g2p::Result<g2p::PipelineResult> r = pipeline.run_file("chair.glb");
+//   if (r.ok()) g2p::write_pipeline_output("out/chair", *r);
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "g2p/complete.h"
+#include "g2p/export.h"
+#include "g2p/exporters.h"
+#include "g2p/io.h"
+#include "g2p/materials.h"
+#include "g2p/model.h"
+#include "g2p/project.h"
+#include "g2p/properties.h"
+#include "g2p/refine.h"
+#include "g2p/render.h"
+#include "g2p/segment.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// The steps of one run, in order. kLoad only runs in Pipeline::run_file.
+enum class Stage { kLoad, kRender, kSegment, kProject, kRefine, kComplete, kProperties, kExport };
+constexpr int kNumStages = 8;
+G2P_API const char* to_string(Stage stage);  // "load", "render", ... "export"
+
+// ---- Progress and cancellation ------------------------------------------------
+
+struct Progress {
+  Stage stage = Stage::kLoad;
+  double stage_fraction = 0.0;  // [0, 1] within the stage
+  double overall = 0.0;         // [0, 1] over the whole run, weighted by typical stage cost
+  std::string message;          // "view 3/11", "closed 12 parts", ...
+};
+
+// One object for a run's progress reports and its cooperative cancellation.
+// cancel() may be called from any thread (a UI's button, a signal handler);
+// the run checks between stages and between views, and returns // StatusCode::kCancelled at the next check, having
+// written nothing.
+class G2P_API RunContext {
+ public:
+  using ProgressCallback = std::function<void(const Progress&)>;
+
+  RunContext() = default;
+  explicit RunContext(ProgressCallback on_progress) : on_progress_(std::move(on_progress)) {}
+
+  void cancel() { cancelled_.store(true); }
+  bool cancelled() const { return cancelled_.load(); }
+
+  // For stages: reports progress (the callback runs on the calling thread)
+  // and returns kCancelled once cancel() was called.
+  Status report(Stage stage, double stage_fraction, const std::string& message = {});
+
+ private:
+  ProgressCallback on_progress_;
+  std::atomic<bool> cancelled_{false};
+  std::mutex mutex_;  // serialises callbacks when stages report from worker threads
+};
+
+// ---- Options ------------------------------------------------------------------
+
+// A backend by registry name plus its KEY=VALUE settings (docs per stage).
+struct BackendChoice {
+  std::string name;
+  BackendSettings settings;
+};
+
+struct PipelineOptions {
+  ImportOptions import;          // run_file only
+  bool anonymize_names = false;  // drop mesh/material/texture names first (as generated meshes have none)
+
+  // 1. render: 11 views at 512 x 512 (the paper's set-up), full buffers.
+  BackendChoice renderer{"embree", {}};
+  ViewOptions views;
+  RenderOptions render;
+
+  // 2. segment: "pbr" (weight-free default), "onnx", "oracle", or a user's.
+  BackendChoice segmenter{"pbr", {}};
+
+  // 3. project: votes, flood fill and parts.
+  ProjectOptions project;
+
+  // 4. refine (optional): "smooth" (offline default), "vlm", "none". A failure
+  //    keeps the projected labels and is reported as a warning.
+  BackendChoice refiner{"smooth", {}};
+
+  // 5. complete: "partition" (default), "external"; "alpha-wrap" and "fill" once
+  //    the GPL component is registered (g2p::cgal::register_cgal_completers).
+  BackendChoice completer{"partition", {}};
+  std::string completion_fallback = "partition";  // for parts the completer fails; "" = none
+
+  // 6. properties: "table" (default) or "vlm" (falls back to the table per part).
+  BackendChoice estimator{"table", {}};
+
+  // Export: the asset's name ("" = the model file's stem, else "object"),
+  // MJCF joint choice, and the formats write_pipeline_output writes.
+  std::string name;
+  ExportOptions export_options;
+  std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
+
+  // Measure each stage's peak resident memory by resetting the process's
+  // high-water mark (Linux /proc/self/clear_refs) before it. Off: the
+  // process's peak so far is reported instead.
+  bool measure_stage_memory = true;
+};
+
+// ---- Results ------------------------------------------------------------------
+
+struct StageReport {
+  Stage stage = Stage::kLoad;
+  std::string backend;             // the backend's registry name, or "custom" for a given object
+  double seconds = 0.0;            // wall time
+  std::size_t peak_rss_bytes = 0;  // peak resident memory during the stage (see measure_stage_memory)
+  bool ok = true;                  // false: an optional stage failed and the run went on without it
+  std::string error;               // why, when !ok
+  std::vector<std::string> notes;
+};
+
+struct PipelineResult {
+  Model model;
+  MaterialTable table;
+  std::vector<View> views;
+  std::vector<LabelMap> label_maps;   // per view, from the segmenter
+  Projection projection;              // after refinement when it ran
+  std::vector<int> projected_labels;  // per face, before refinement (for ablations)
+  RefineResult refinement;            // empty labels when the refiner was "none" or failed
+  Completion completion;
+  PropertiesReport properties;
+  SimulationAsset asset;
+  std::vector<StageReport> stages;    // in run order
+  std::vector<std::string> warnings;  // degraded optional stages, in words
+  double seconds = 0.0;               // whole run
+  std::size_t peak_rss_bytes = 0;     // largest stage peak
+
+  const StageReport* stage(Stage s) const;  // null if it did not run
+};
+
+// ---- The pipeline -------------------------------------------------------------
+
+class G2P_API Pipeline {
+ public:
+  explicit Pipeline(PipelineOptions options = {});
+  ~Pipeline();
+  Pipeline(Pipeline&&) noexcept;
+  Pipeline& operator=(Pipeline&&) noexcept;
+
+  const PipelineOptions& options() const;
+  PipelineOptions& options();  // changes apply to the next run
+
+  // Backend objects replace the named ones; null goes back to the name.
+  // Shared, so a caller (or Python) may keep its own handle.
+  void set_renderer(std::shared_ptr<Renderer> renderer);
+  void set_segmenter(std::shared_ptr<Segmenter> segmenter);
+  void set_refiner(std::shared_ptr<Refiner> refiner);
+  void set_completer(std::shared_ptr<Completer> completer);
+  void set_estimator(std::shared_ptr<PropertyEstimator> estimator);
+  void set_material_table(MaterialTable table);  // default: MaterialTable::paper_default()
+
+  // Creates and configures every named backend now: unknown names or settings
+  // fail here, before any work. run() calls it; calling it first is optional.
+  Status prepare();
+
+  // Runs the stages on a loaded model (moved into the result). Deterministic:
+  // the same model and options give the same labels, parts and masses.
+  Result<PipelineResult> run(Model model, RunContext* context = nullptr);
+  // Loads the file with options().import, then runs.
+  Result<PipelineResult> run_file(const std::string& path, RunContext* context = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// ---- The output folder --------------------------------------------------------
+
+struct OutputOptions {
+  bool overwrite = false;      // replace an existing folder (only once the new one is complete)
+  bool intermediates = false;  // also every view's buffers, per-view probabilities, votes and part patches
+};
+
+// Writes the run into `dir`: views/ (renders, face IDs, contact sheet),
+// segmented/ and projected/ (label maps, contact sheets), faces.csv,
+// labelled.ply, parts.json, refine.json, completed/ (closed parts), the
+// simulation asset (NAME.xml, NAME.urdf, NAME.sdf, NAME.glb, meshes/),
+// report.json, run.json and summary.html; project.json and properties.json
+// make the folder a valid source for `g2p refine/complete/export`. Everything
+// is written to a temporary folder beside `dir` and renamed into place at the
+// end: `dir` never holds a half-written run, and an existing `dir` is only
+// replaced when options.overwrite is set.
+G2P_API Status write_pipeline_output(const std::string& dir, const PipelineResult& result,
+                                     const PipelineOptions& options = {}, const OutputOptions& output = {});
+
+// The machine-readable summary (run.json, `g2p run --json`): stages with
+// time and memory, parts with class, mass and volume, totals, warnings.
+G2P_API std::string pipeline_summary_json(const PipelineResult& result, const PipelineOptions& options = {});
+
+// A self-contained one-page HTML summary: the views, the labels, a table of
+// parts and masses. Images are referenced relative to the output folder.
+G2P_API std::string summary_html(const PipelineResult& result, const PipelineOptions& options = {});
+
+}  // namespace g2p

@@ -1,0 +1,234 @@
+// The pipeline's output folder, written beside its final place and renamed
+// into it, and its machine-readable summary (run.json).
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/file_util.h"
+#include "g2p/io.h"
+#include "g2p/pipeline.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json vec3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+std::string class_name(const MaterialTable& table, int label) {
+  return table.valid_label(label) ? table[label].name : std::string("Unknown");
+}
+
+// project.json and properties.json: what `g2p refine/complete/export DIR`
+// read to rebuild the labelled object from the model file.
+Status write_manifests(const std::string& tmp, const fs::path& final_dir, const PipelineResult& r,
+                       const PipelineOptions& o) {
+  const ImportInfo& info = r.model.info;
+  std::string materials;
+  if (r.table.to_json() != MaterialTable::paper_default().to_json()) {
+    G2P_RETURN_IF_ERROR(r.table.save(tmp + "/materials.json"));
+    materials = (final_dir / "materials.json").string();
+  }
+  const bool rotated = !info.file_to_model.block<3, 3>(0, 0).isApprox(
+      Eigen::Matrix3d::Identity() * info.file_to_model.block<3, 3>(0, 0).col(0).norm());
+  char unit[32];
+  std::snprintf(unit, sizeof unit, "%.17g", info.unit_scale_m);
+  const std::string up(1, static_cast<char>(std::tolower(static_cast<unsigned char>(info.up_axis))));
+  const nlohmann::json project = {
+      {"format", "g2p-project"},
+      {"version", 1},
+      {"model", fs::absolute(info.path).string()},
+      {"import", {{"unit", unit}, {"up", up}, {"keep_axes", !rotated && up != "z"}, {"no_textures", false}}},
+      {"materials", materials},
+      {"anonymize_names", o.anonymize_names},
+      {"views", r.views.size()},
+      {"vote", o.project.vote.mode == VoteMode::kSoft ? "soft" : "hard"},
+      {"weight_angle", o.project.vote.weight_by_angle},
+      {"weight_footprint", o.project.vote.weight_by_footprint},
+      {"weld", o.project.weld_tolerance},
+      {"min_part_area", o.project.partition.min_part_area_fraction},
+      {"written_by", "g2p run"}};
+  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/project.json", project.dump(2) + "\n"));
+  const nlohmann::json properties = {{"format", "g2p-properties"},
+                                     {"version", 1},
+                                     {"source", final_dir.string()},
+                                     {"truth", ""},
+                                     {"key", ""},
+                                     {"materials", materials},
+                                     {"written_by", "g2p run"}};
+  return write_text_file(tmp + "/properties.json", properties.dump(2) + "\n");
+}
+
+// intermediates/: per-view class probabilities, per-face votes, part patches.
+Status write_intermediates(const std::string& dir, const PipelineResult& r) {
+  G2P_RETURN_IF_ERROR(detail::ensure_directory(dir + "/probabilities"));
+  for (std::size_t i = 0; i < r.label_maps.size(); ++i) {
+    const ImageF& p = r.label_maps[i].probabilities;
+    if (p.empty()) continue;
+    char name[64];
+    std::snprintf(name, sizeof name, "/probabilities/view_%02zu.npy", i);
+    G2P_RETURN_IF_ERROR(detail::write_file_atomically(dir + name, detail::npy_float32(p)));
+  }
+  // votes.csv: face, total, then one column per class.
+  std::ostringstream votes;
+  votes << "face,total";
+  for (const MaterialClass& c : r.table.classes()) votes << "," << c.name;
+  votes << "\n";
+  const FaceVotes& v = r.projection.votes;
+  for (int f = 0; f < r.model.mesh.num_faces(); ++f) {
+    votes << f << "," << v.total[static_cast<std::size_t>(f)];
+    const float* h = v.of(f);
+    for (int k = 0; k < v.num_classes; ++k) votes << "," << (h != nullptr ? h[k] : 0.f);
+    votes << "\n";
+  }
+  G2P_RETURN_IF_ERROR(detail::write_file_atomically(dir + "/votes.csv", votes.str()));
+  G2P_RETURN_IF_ERROR(detail::ensure_directory(dir + "/patches"));
+  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) {
+    const Part& part = r.projection.parts[i];
+    G2P_RETURN_IF_ERROR(
+        write_mesh(dir + "/patches/part_" + std::to_string(i) + "_" + class_name(r.table, part.label) + ".obj",
+                   part_patch(r.model.mesh, part)));
+  }
+  return Status::Ok();
+}
+
+Status write_contents(const std::string& tmp, const fs::path& final_dir, const PipelineResult& r,
+                      const PipelineOptions& o, const OutputOptions& out) {
+  ViewFileOptions views;
+  views.buffers = out.intermediates;
+  G2P_RETURN_IF_ERROR(write_views(tmp + "/views", r.views, views));
+  G2P_RETURN_IF_ERROR(write_label_maps(tmp + "/segmented", r.label_maps, r.table));
+  G2P_RETURN_IF_ERROR(write_projection(tmp, r.model, r.views, r.projection, r.table));
+  const StageReport* refine = r.stage(Stage::kRefine);
+  nlohmann::json refine_json = {{"refiner", refine != nullptr ? refine->backend : "none"}};
+  if (refine != nullptr && !refine->ok) refine_json["error"] = refine->error;
+  if (!r.refinement.labels.empty()) {
+    refine_json["notes"] = r.refinement.notes;
+    refine_json["changed_faces"] = r.refinement.changes.size();
+  }
+  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/refine.json", refine_json.dump(2) + "\n"));
+  G2P_RETURN_IF_ERROR(write_completion(tmp + "/completed", r.completion, r.table, {"obj"}));
+  std::vector<std::string> engine_formats;
+  bool glb = false;
+  for (const std::string& f : o.formats) {
+    if (f == "glb")
+      glb = true;
+    else
+      engine_formats.push_back(f);
+  }
+  G2P_RETURN_IF_ERROR(write_asset(tmp, r.asset, engine_formats, o.export_options));
+  if (glb) G2P_RETURN_IF_ERROR(write_glb(tmp + "/" + r.asset.name + ".glb", r.model, r.projection.parts, r.asset));
+  G2P_RETURN_IF_ERROR(write_report(tmp + "/report.json", with_export_notes(r.properties, r.asset), r.table));
+  if (!r.model.info.path.empty()) G2P_RETURN_IF_ERROR(write_manifests(tmp, final_dir, r, o));
+  if (out.intermediates) G2P_RETURN_IF_ERROR(write_intermediates(tmp + "/intermediates", r));
+  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/run.json", pipeline_summary_json(r, o) + "\n"));
+  return write_text_file(tmp + "/summary.html", summary_html(r, o));
+}
+
+}  // namespace
+
+Status write_pipeline_output(const std::string& dir, const PipelineResult& result, const PipelineOptions& options,
+                             const OutputOptions& output) {
+  if (dir.empty()) return Status::InvalidArgument("write_pipeline_output: no output folder given");
+  if (result.views.empty() || result.asset.parts.empty())
+    return Status::InvalidArgument("write_pipeline_output: the result is incomplete (did the run succeed?)");
+  std::error_code ec;
+  const fs::path target = fs::absolute(fs::path(dir).lexically_normal(), ec);
+  const fs::path final_dir = target.filename().empty() ? target.parent_path() : target;
+  if (fs::exists(final_dir, ec) && !output.overwrite)
+    return Status::InvalidArgument(final_dir.string() + ": exists; choose another folder or allow overwriting");
+  if (fs::exists(final_dir, ec) && !fs::is_directory(final_dir, ec))
+    return Status::InvalidArgument(final_dir.string() + ": exists and is not a folder");
+  const fs::path parent = final_dir.parent_path();
+  G2P_RETURN_IF_ERROR(detail::ensure_directory(parent.string()));
+  const std::string tag = "." + final_dir.filename().string() + ".g2p-" + std::to_string(::getpid());
+  const fs::path tmp = parent / (tag + ".tmp");
+  const fs::path old = parent / (tag + ".old");
+  fs::remove_all(tmp, ec);
+  Status s = detail::ensure_directory(tmp.string());
+  if (s.ok()) s = write_contents(tmp.string(), final_dir, result, options, output);
+  if (s.ok() && fs::exists(final_dir)) {
+    fs::rename(final_dir, old, ec);
+    if (ec) s = Status::IoError(final_dir.string() + ": cannot move the previous output aside: " + ec.message());
+  }
+  if (s.ok()) {
+    fs::rename(tmp, final_dir, ec);
+    if (ec) {
+      s = Status::IoError(final_dir.string() + ": cannot move the new output into place: " + ec.message());
+      std::error_code back;
+      if (fs::exists(old)) fs::rename(old, final_dir, back);  // the previous output stays as it was
+    }
+  }
+  if (!s.ok()) {
+    fs::remove_all(tmp, ec);
+    return s;
+  }
+  fs::remove_all(old, ec);
+  return Status::Ok();
+}
+
+std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions& o) {
+  nlohmann::json stages = nlohmann::json::array();
+  nlohmann::json backends = nlohmann::json::object();
+  for (const StageReport& s : r.stages) {
+    backends[to_string(s.stage)] = s.backend;
+    nlohmann::json j = {{"stage", to_string(s.stage)},
+                        {"backend", s.backend},
+                        {"seconds", s.seconds},
+                        {"peak_rss_mib", static_cast<double>(s.peak_rss_bytes) / (1024.0 * 1024.0)},
+                        {"ok", s.ok},
+                        {"notes", s.notes}};
+    if (!s.ok) j["error"] = s.error;
+    stages.push_back(std::move(j));
+  }
+  nlohmann::json parts = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) {
+    const Part& p = r.projection.parts[i];
+    nlohmann::json j = {
+        {"part", i}, {"material", class_name(r.table, p.label)}, {"faces", p.faces.size()}, {"area_m2", p.area_m2}};
+    if (i < r.completion.parts.size()) {
+      j["closed"] = r.completion.parts[i].ok;
+      j["volume_m3"] = r.completion.parts[i].checks.volume_m3;
+    }
+    if (i < r.properties.parts.size()) {
+      const PartReport& pr = r.properties.parts[i];
+      j["density_kg_m3"] = pr.properties.density_kg_m3;
+      j["structure"] = to_string(pr.properties.structure);
+      j["mass_kg"] = pr.mass.mass_kg;
+    }
+    parts.push_back(std::move(j));
+  }
+  const MassProperties& m = r.properties.object;
+  std::vector<std::string> files;
+  for (const std::string& f : o.formats) {
+    if (f == "mjcf") files.push_back(r.asset.name + ".xml");
+    if (f == "urdf") files.push_back(r.asset.name + ".urdf");
+    if (f == "sdf") files.push_back(r.asset.name + ".sdf");
+    if (f == "glb") files.push_back(r.asset.name + ".glb");
+  }
+  const nlohmann::json j = {{"format", "g2p-run"},
+                            {"version", 1},
+                            {"model", r.model.info.path},
+                            {"name", r.asset.name},
+                            {"triangles", r.model.mesh.num_faces()},
+                            {"views", r.views.size()},
+                            {"backends", backends},
+                            {"stages", stages},
+                            {"seconds", r.seconds},
+                            {"peak_rss_mib", static_cast<double>(r.peak_rss_bytes) / (1024.0 * 1024.0)},
+                            {"parts", parts},
+                            {"object",
+                             {{"mass_kg", m.mass_kg},
+                              {"mass_min_kg", r.properties.mass_min_kg},
+                              {"mass_max_kg", r.properties.mass_max_kg},
+                              {"center_of_mass_m", vec3(m.center_of_mass)}}},
+                            {"assets", files},
+                            {"warnings", r.warnings}};
+  return j.dump(2);
+}
+
+}  // namespace g2p

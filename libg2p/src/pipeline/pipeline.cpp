@@ -1,0 +1,286 @@
+// Pipeline: the six stages of Gen2Physics (paper, Method) run in order on one
+// model, each through its backend interface.
+#include <filesystem>
+#include <utility>
+
+#include "g2p/pipeline.h"
+#include "pipeline/stage_clock.h"
+
+namespace g2p {
+
+const StageReport* PipelineResult::stage(Stage s) const {
+  for (const StageReport& r : stages)
+    if (r.stage == s) return &r;
+  return nullptr;
+}
+
+namespace {
+
+// A backend given as an object, or created from its registry name.
+template <typename Interface>
+struct Slot {
+  std::shared_ptr<Interface> custom;
+  std::shared_ptr<Interface> made;  // from the name, by prepare()
+  std::string made_from;            // the name and settings `made` was built with
+
+  Interface* get() const { return custom ? custom.get() : made.get(); }
+  std::string backend(const BackendChoice& choice) const { return custom ? "custom" : choice.name; }
+};
+
+std::string settings_key(const BackendChoice& c) {
+  std::string key = c.name;
+  for (const auto& [k, v] : c.settings) key += "\n" + k + "=" + v;
+  return key;
+}
+
+// Creates `slot.made` from the choice unless a custom object is set or the
+// same choice was built before.
+template <typename Interface, typename Make>
+Status prepare_slot(Slot<Interface>& slot, const BackendChoice& choice, const char* stage, Make make) {
+  if (slot.custom) return Status::Ok();
+  const std::string key = settings_key(choice);
+  if (slot.made && slot.made_from == key) return Status::Ok();
+  Result<std::unique_ptr<Interface>> made = make(choice);
+  if (!made.ok()) return made.status().with_context(std::string(stage) + " backend '" + choice.name + "'");
+  slot.made = std::move(*made);
+  slot.made_from = key;
+  return Status::Ok();
+}
+
+}  // namespace
+
+struct Pipeline::Impl {
+  PipelineOptions options;
+  MaterialTable table = MaterialTable::paper_default();
+  Slot<Renderer> renderer;
+  Slot<Segmenter> segmenter;
+  Slot<Refiner> refiner;
+  Slot<Completer> completer;
+  Slot<Completer> fallback;
+  Slot<PropertyEstimator> estimator;
+
+  Status run_stages(PipelineResult& r, RunContext& context);
+};
+
+Pipeline::Pipeline(PipelineOptions options) : impl_(std::make_unique<Impl>()) { impl_->options = std::move(options); }
+Pipeline::~Pipeline() = default;
+Pipeline::Pipeline(Pipeline&&) noexcept = default;
+Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
+
+const PipelineOptions& Pipeline::options() const { return impl_->options; }
+PipelineOptions& Pipeline::options() { return impl_->options; }
+
+void Pipeline::set_renderer(std::shared_ptr<Renderer> r) { impl_->renderer.custom = std::move(r); }
+void Pipeline::set_segmenter(std::shared_ptr<Segmenter> s) { impl_->segmenter.custom = std::move(s); }
+void Pipeline::set_refiner(std::shared_ptr<Refiner> r) { impl_->refiner.custom = std::move(r); }
+void Pipeline::set_completer(std::shared_ptr<Completer> c) { impl_->completer.custom = std::move(c); }
+void Pipeline::set_estimator(std::shared_ptr<PropertyEstimator> e) { impl_->estimator.custom = std::move(e); }
+void Pipeline::set_material_table(MaterialTable table) { impl_->table = std::move(table); }
+
+Status Pipeline::prepare() {
+  Impl& m = *impl_;
+  const PipelineOptions& o = m.options;
+  if (m.table.size() == 0) return Status::InvalidArgument("pipeline: the material table has no classes");
+  G2P_RETURN_IF_ERROR(prepare_slot(m.renderer, o.renderer, "render", [](const BackendChoice& c) {
+    if (!c.settings.empty())
+      return Result<std::unique_ptr<Renderer>>(
+          Status::InvalidArgument("renderers take no settings (got '" + c.settings.begin()->first + "')"));
+    return renderer_registry().create(c.name);
+  }));
+  G2P_RETURN_IF_ERROR(prepare_slot(m.segmenter, o.segmenter, "segment",
+                                   [](const BackendChoice& c) { return make_segmenter(c.name, c.settings); }));
+  G2P_RETURN_IF_ERROR(prepare_slot(m.refiner, o.refiner, "refine",
+                                   [](const BackendChoice& c) { return make_refiner(c.name, c.settings); }));
+  G2P_RETURN_IF_ERROR(prepare_slot(m.completer, o.completer, "complete",
+                                   [](const BackendChoice& c) { return make_completer(c.name, c.settings); }));
+  if (!o.completion_fallback.empty() && (m.completer.custom || o.completion_fallback != o.completer.name)) {
+    G2P_RETURN_IF_ERROR(prepare_slot(m.fallback, BackendChoice{o.completion_fallback, {}}, "complete fallback",
+                                     [](const BackendChoice& c) { return make_completer(c.name, c.settings); }));
+  } else {
+    m.fallback.made.reset();
+    m.fallback.made_from.clear();
+  }
+  G2P_RETURN_IF_ERROR(prepare_slot(m.estimator, o.estimator, "properties",
+                                   [](const BackendChoice& c) { return make_estimator(c.name, c.settings); }));
+  const ViewOptions& v = o.views;
+  if (v.num_views < 1 || v.width < 8 || v.height < 8)
+    return Status::InvalidArgument("pipeline: views need at least 1 view of 8 x 8 pixels (got " +
+                                   std::to_string(v.num_views) + " of " + std::to_string(v.width) + " x " +
+                                   std::to_string(v.height) + ")");
+  for (const std::string& f : o.formats)
+    if (f != "mjcf" && f != "urdf" && f != "sdf" && f != "glb")
+      return Status::InvalidArgument("pipeline: unknown export format '" + f + "' (mjcf, urdf, sdf, glb)");
+  return Status::Ok();
+}
+
+Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
+  const PipelineOptions& o = options;
+  const Mesh& mesh = r.model.mesh;
+  const bool reset = o.measure_stage_memory;
+  auto finish = [&](detail::StageClock& clock) {
+    r.stages.push_back(clock.finish());
+    r.peak_rss_bytes = std::max(r.peak_rss_bytes, r.stages.back().peak_rss_bytes);
+  };
+
+  // 1. render: the views, each with its face-ID and material buffers.
+  {
+    detail::StageClock clock(Stage::kRender, renderer.backend(o.renderer), reset);
+    G2P_RETURN_IF_ERROR(context.report(Stage::kRender, 0.0, "cameras"));
+    Result<std::vector<Camera>> cameras = make_views(mesh, o.views);
+    if (!cameras.ok()) return cameras.status().with_context("render");
+    G2P_RETURN_IF_ERROR(renderer.get()->set_model(r.model).with_context("render"));
+    const std::size_t n = cameras->size();
+    r.views.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      G2P_RETURN_IF_ERROR(renderer.get()
+                              ->render_into((*cameras)[i], o.render, r.views[i])
+                              .with_context("render: view " + std::to_string(i)));
+      G2P_RETURN_IF_ERROR(context.report(Stage::kRender, double(i + 1) / double(n),
+                                         "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
+    }
+    finish(clock);
+  }
+
+  // 2. segment: a material class per pixel.
+  {
+    detail::StageClock clock(Stage::kSegment, segmenter.backend(o.segmenter), reset);
+    G2P_RETURN_IF_ERROR(segmenter.get()->set_model(r.model, r.table).with_context("segment"));
+    const std::size_t n = r.views.size();
+    r.label_maps.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      G2P_RETURN_IF_ERROR(segmenter.get()
+                              ->segment_into(r.views[i], r.label_maps[i])
+                              .with_context("segment: view " + std::to_string(i)));
+      G2P_RETURN_IF_ERROR(context.report(Stage::kSegment, double(i + 1) / double(n),
+                                         "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
+    }
+    finish(clock);
+  }
+
+  // 3. project: votes over all views, flood fill, connected parts.
+  {
+    detail::StageClock clock(Stage::kProject, "vote", reset);
+    Result<Projection> projection = project(mesh, r.views, r.label_maps, r.table.size(), o.project);
+    if (!projection.ok()) return projection.status().with_context("project");
+    r.projection = std::move(*projection);
+    r.projected_labels = r.projection.labels.label;
+    std::size_t seen = 0;
+    for (std::uint8_t s : r.projection.labels.seen) seen += s;
+    clock.report().notes.push_back(std::to_string(seen) + " of " + std::to_string(mesh.num_faces()) + " faces seen, " +
+                                   std::to_string(r.projection.parts.size()) + " parts");
+    G2P_RETURN_IF_ERROR(context.report(Stage::kProject, 1.0, std::to_string(r.projection.parts.size()) + " parts"));
+    finish(clock);
+  }
+
+  // 4. refine (optional): a failure keeps the projected labels.
+  if (refiner.custom || o.refiner.name != "none") {
+    detail::StageClock clock(Stage::kRefine, refiner.backend(o.refiner), reset);
+    RefineInput in{&mesh, &r.projection.graph, &r.projection.votes, &r.projection.labels, &r.views, &r.table};
+    Result<RefineResult> refined = refiner.get()->refine(in);
+    const StatusCode code = refined.ok() ? StatusCode::kOk : refined.status().code();
+    if (code == StatusCode::kInvalidArgument || code == StatusCode::kNotFound)
+      return refined.status().with_context("refine");  // its settings are wrong: the caller must fix them
+    Status applied =
+        refined.ok() ? apply_refinement(mesh, refined->labels, o.project.partition, r.projection) : refined.status();
+    StageReport& report = clock.report();
+    if (!applied.ok()) {
+      report.ok = false;
+      report.error = applied.to_string();
+      r.warnings.push_back("refine (" + report.backend + ") failed; the projected labels stand: " + report.error);
+    } else {
+      report.notes = refined->notes;
+      report.notes.push_back(std::to_string(refined->changes.size()) + " faces changed, " +
+                             std::to_string(r.projection.parts.size()) + " parts");
+      r.refinement = std::move(*refined);
+    }
+    G2P_RETURN_IF_ERROR(context.report(Stage::kRefine, 1.0, report.ok ? "done" : "failed, skipped"));
+    finish(clock);
+  }
+
+  // 5. complete: every part closed into a watertight volume.
+  {
+    detail::StageClock clock(Stage::kComplete, completer.backend(o.completer), reset);
+    G2P_RETURN_IF_ERROR(context.report(Stage::kComplete, 0.0, std::to_string(r.projection.parts.size()) + " parts"));
+    CompletionInput input{&mesh, &r.projection.parts, &r.table};
+    Result<Completion> done = complete(input, *completer.get(), fallback.get());
+    if (!done.ok()) return done.status().with_context("complete");
+    r.completion = std::move(*done);
+    int closed = 0;
+    for (const CompletedPart& p : r.completion.parts) closed += p.ok ? 1 : 0;
+    clock.report().notes = r.completion.notes;
+    clock.report().notes.push_back(std::to_string(closed) + " of " + std::to_string(r.completion.parts.size()) +
+                                   " parts closed and checked");
+    G2P_RETURN_IF_ERROR(context.report(Stage::kComplete, 1.0, std::to_string(closed) + " parts closed"));
+    finish(clock);
+  }
+
+  // 6. properties: density, solid or hollow, mass properties.
+  {
+    detail::StageClock clock(Stage::kProperties, estimator.backend(o.estimator), reset);
+    Result<PropertiesReport> report =
+        estimate_properties(mesh, r.projection.parts, r.completion, r.table, *estimator.get(), &r.views);
+    if (!report.ok()) return report.status().with_context("properties");
+    r.properties = std::move(*report);
+    clock.report().notes = r.properties.notes;
+    G2P_RETURN_IF_ERROR(context.report(Stage::kProperties, 1.0, "done"));
+    finish(clock);
+  }
+
+  // The simulation asset (written by write_pipeline_output).
+  {
+    detail::StageClock clock(Stage::kExport, "asset", reset);
+    std::string name = o.name;
+    if (name.empty()) name = std::filesystem::path(r.model.info.path).stem().string();
+    if (name.empty()) name = "object";
+    Result<SimulationAsset> asset = make_asset(name, mesh, r.projection.parts, r.completion, r.properties, r.table);
+    if (!asset.ok()) return asset.status().with_context("export");
+    r.asset = std::move(*asset);
+    clock.report().notes = r.asset.notes;
+    G2P_RETURN_IF_ERROR(context.report(Stage::kExport, 1.0, r.asset.name));
+    finish(clock);
+  }
+  return Status::Ok();
+}
+
+Result<PipelineResult> Pipeline::run(Model model, RunContext* context) {
+  const auto start = std::chrono::steady_clock::now();
+  RunContext local;
+  RunContext& ctx = context != nullptr ? *context : local;
+  G2P_RETURN_IF_ERROR(prepare());
+  if (model.mesh.num_faces() == 0)
+    return Status::InvalidArgument(
+        "pipeline: " + (model.info.path.empty() ? std::string("the model") : model.info.path) + " has no triangles");
+  G2P_RETURN_IF_ERROR(ctx.report(Stage::kRender, 0.0, "starting"));
+  PipelineResult r;
+  r.model = std::move(model);
+  if (impl_->options.anonymize_names) anonymize_names(r.model);
+  r.table = impl_->table;
+  Status s = impl_->run_stages(r, ctx);
+  if (!s.ok()) {
+    const std::string& path = r.model.info.path;
+    return path.empty() ? s : s.with_context(path);
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+Result<PipelineResult> Pipeline::run_file(const std::string& path, RunContext* context) {
+  RunContext local;
+  RunContext& ctx = context != nullptr ? *context : local;
+  G2P_RETURN_IF_ERROR(prepare());  // bad names fail before a long load
+  const auto start = std::chrono::steady_clock::now();
+  detail::StageClock clock(Stage::kLoad, "assimp", impl_->options.measure_stage_memory);
+  G2P_RETURN_IF_ERROR(ctx.report(Stage::kLoad, 0.0, path));
+  Result<Model> model = load_model(path, impl_->options.import);
+  if (!model.ok()) return model.status();
+  G2P_RETURN_IF_ERROR(ctx.report(Stage::kLoad, 1.0, std::to_string(model->mesh.num_faces()) + " triangles"));
+  const StageReport load = clock.finish();
+  Result<PipelineResult> r = run(std::move(*model), &ctx);
+  if (!r.ok()) return r;
+  r->stages.insert(r->stages.begin(), load);
+  r->peak_rss_bytes = std::max(r->peak_rss_bytes, load.peak_rss_bytes);
+  r->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace g2p

@@ -1,0 +1,274 @@
+// g2p::Pipeline: the whole method on the hammer (a wooden handle and a steel
+// head, examples/data/hammer.obj) and on a shared asset; swapped backends,
+// progress, cancellation, degraded optional stages and the output folder.
+#include "g2p/pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "g2p/io.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Fewer, smaller views than the paper's 11 at 512 px keep the tests quick;
+// the hammer's two materials stay visible.
+PipelineOptions quick_options() {
+  PipelineOptions o;
+  o.views.num_views = 6;
+  o.views.width = o.views.height = 160;
+  return o;
+}
+
+std::string hammer() { return test::source_path("examples/data/hammer.obj"); }
+
+int label_of(const std::string& name) { return MaterialTable::paper_default().find(name); }
+
+TEST(Pipeline, TurnsTheHammerIntoAWoodenHandleAndASteelHead) {
+  Pipeline pipeline(quick_options());
+  std::vector<Progress> seen;
+  RunContext context([&](const Progress& p) { seen.push_back(p); });
+  Result<PipelineResult> r = pipeline.run_file(hammer(), &context);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+
+  ASSERT_EQ(r->projection.parts.size(), 2u);
+  std::vector<int> labels;
+  for (const Part& p : r->projection.parts) labels.push_back(p.label);
+  std::sort(labels.begin(), labels.end());
+  std::vector<int> expected{label_of("Wood"), label_of("Metal")};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(labels, expected);
+  for (const CompletedPart& c : r->completion.parts) EXPECT_TRUE(c.ok) << c.part;
+  // The steel head outweighs the handle: the centre of mass sits high on the handle (head at z ~ 0.3 m).
+  EXPECT_GT(r->properties.object.mass_kg, 0.5);
+  EXPECT_LT(r->properties.object.mass_kg, 3.0);
+  EXPECT_GT(r->properties.object.center_of_mass.z(), 0.25);
+  EXPECT_EQ(r->asset.name, "hammer");
+  EXPECT_EQ(r->asset.parts.size(), 2u);
+  EXPECT_NEAR(r->asset.total.mass_kg, r->properties.object.mass_kg, 1e-9);
+
+  // Every stage ran, in order, and was timed and measured.
+  const Stage order[] = {Stage::kLoad,   Stage::kRender,   Stage::kSegment,    Stage::kProject,
+                         Stage::kRefine, Stage::kComplete, Stage::kProperties, Stage::kExport};
+  ASSERT_EQ(r->stages.size(), 8u);
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(r->stages[i].stage, order[i]);
+    EXPECT_TRUE(r->stages[i].ok);
+    EXPECT_GE(r->stages[i].seconds, 0.0);
+    EXPECT_GT(r->stages[i].peak_rss_bytes, 0u);
+  }
+  EXPECT_EQ(r->stage(Stage::kSegment)->backend, "pbr");
+  EXPECT_EQ(r->stage(Stage::kRefine)->backend, "smooth");
+  EXPECT_TRUE(r->warnings.empty());
+  EXPECT_GT(r->seconds, 0.0);
+
+  // Progress: every stage reported, the overall fraction never goes back and ends at 1.
+  ASSERT_FALSE(seen.empty());
+  for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i].overall, seen[i - 1].overall - 1e-12) << i;
+  EXPECT_NEAR(seen.back().overall, 1.0, 1e-9);
+  for (Stage s : order)
+    EXPECT_TRUE(std::any_of(seen.begin(), seen.end(), [&](const Progress& p) { return p.stage == s; })) << to_string(s);
+}
+
+TEST(Pipeline, IsDeterministic) {
+  Pipeline pipeline(quick_options());
+  Result<PipelineResult> a = pipeline.run_file(hammer());
+  Result<PipelineResult> b = pipeline.run_file(hammer());
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->projection.labels.label, b->projection.labels.label);
+  EXPECT_EQ(a->projection.face_part, b->projection.face_part);
+  ASSERT_EQ(a->properties.parts.size(), b->properties.parts.size());
+  for (std::size_t i = 0; i < a->properties.parts.size(); ++i)
+    EXPECT_EQ(a->properties.parts[i].mass.mass_kg, b->properties.parts[i].mass.mass_kg);
+  EXPECT_EQ(a->properties.object.inertia, b->properties.object.inertia);
+}
+
+TEST(Pipeline, CancelStopsAtTheNextCheck) {
+  Pipeline pipeline(quick_options());
+  RunContext* self = nullptr;
+  int segment_reports = 0;
+  RunContext context([&](const Progress& p) {
+    if (p.stage == Stage::kSegment && ++segment_reports == 2) self->cancel();
+  });
+  self = &context;
+  Result<PipelineResult> r = pipeline.run_file(hammer(), &context);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+  EXPECT_NE(r.status().message().find("segment"), std::string::npos) << r.status().message();
+  EXPECT_EQ(segment_reports, 2);  // nothing ran after the check that saw the cancellation
+}
+
+// A user's segmenter: every surface pixel is plastic.
+class AllPlastic final : public Segmenter {
+ public:
+  Status set_model(const Model&, const MaterialTable& table) override {
+    label_ = table.find("Plastic");
+    ++models_;
+    return Status::Ok();
+  }
+  Status segment_into(const View& view, LabelMap& out) const override {
+    out.labels.reset(view.face_id.width(), view.face_id.height(), 1, kUnknownLabel);
+    for (int y = 0; y < view.face_id.height(); ++y)
+      for (int x = 0; x < view.face_id.width(); ++x)
+        if (view.face_id.at(x, y) >= 0) out.labels.at(x, y) = label_;
+    out.probabilities.clear();
+    return Status::Ok();
+  }
+  int models_ = 0;
+
+ private:
+  int label_ = kUnknownLabel;
+};
+
+TEST(Pipeline, RunsAUsersSegmenter) {
+  Pipeline pipeline(quick_options());
+  auto mine = std::make_shared<AllPlastic>();
+  pipeline.set_segmenter(mine);
+  Result<PipelineResult> r = pipeline.run_file(hammer());
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(mine->models_, 1);
+  ASSERT_EQ(r->projection.parts.size(), 1u);
+  EXPECT_EQ(r->projection.parts[0].label, label_of("Plastic"));
+  EXPECT_EQ(r->stage(Stage::kSegment)->backend, "custom");
+  // Plastic all through: 377 cm^3 of the closed hammer at the table's plastic density.
+  const double density = MaterialTable::paper_default()[label_of("Plastic")].density_kg_m3;
+  EXPECT_NEAR(r->properties.object.mass_kg, density * r->completion.parts[0].checks.volume_m3, 1e-6);
+}
+
+// A refiner whose service is down.
+class Unreachable final : public Refiner {
+ public:
+  Result<RefineResult> refine(const RefineInput&) const override {
+    return Status::Unavailable("http://127.0.0.1:9/v1: connection refused");
+  }
+};
+
+TEST(Pipeline, AFailingRefinerKeepsTheProjectedLabelsAndSaysSo) {
+  Pipeline pipeline(quick_options());
+  pipeline.set_refiner(std::make_shared<Unreachable>());
+  Result<PipelineResult> r = pipeline.run_file(hammer());
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  const StageReport* refine = r->stage(Stage::kRefine);
+  ASSERT_NE(refine, nullptr);
+  EXPECT_FALSE(refine->ok);
+  EXPECT_NE(refine->error.find("connection refused"), std::string::npos) << refine->error;
+  ASSERT_EQ(r->warnings.size(), 1u);
+  EXPECT_NE(r->warnings[0].find("projected labels stand"), std::string::npos);
+  EXPECT_EQ(r->projection.labels.label, r->projected_labels);
+  EXPECT_EQ(r->projection.parts.size(), 2u);
+}
+
+TEST(Pipeline, BadBackendsAndOptionsFailBeforeAnyWork) {
+  PipelineOptions o = quick_options();
+  o.segmenter.name = "no-such-segmenter";
+  Status s = Pipeline(o).prepare();
+  EXPECT_EQ(s.code(), StatusCode::kNotFound);
+  EXPECT_NE(s.message().find("segment backend 'no-such-segmenter'"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("pbr"), std::string::npos);  // the known names are listed
+
+  o = quick_options();
+  o.completer.settings["resolution"] = "-4";
+  EXPECT_EQ(Pipeline(o).prepare().code(), StatusCode::kInvalidArgument);
+  o = quick_options();
+  o.formats = {"mjcf", "usd"};
+  s = Pipeline(o).prepare();
+  EXPECT_NE(s.message().find("usd"), std::string::npos);
+  o = quick_options();
+  o.views.num_views = 0;
+  EXPECT_EQ(Pipeline(o).prepare().code(), StatusCode::kInvalidArgument);
+
+  Result<PipelineResult> r = Pipeline(quick_options()).run(Model{});
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  r = Pipeline(quick_options()).run_file(test::source_path("examples/data/no-such-file.obj"));
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("no-such-file.obj"), std::string::npos);
+}
+
+TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
+  Pipeline pipeline(quick_options());
+  Result<PipelineResult> r = pipeline.run_file(hammer());
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  const std::string dir = test::scratch_dir("PipelineOutput") + "/hammer";
+  OutputOptions out;
+  out.intermediates = true;
+  ASSERT_TRUE(write_pipeline_output(dir, *r, pipeline.options(), out).ok());
+  for (const char* f :
+       {"faces.csv", "labelled.ply", "parts.json", "refine.json", "report.json", "run.json", "summary.html",
+        "project.json", "properties.json", "hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb",
+        "views/contact_sheet.png", "segmented/contact_sheet.png", "projected/contact_sheet.png",
+        "completed/completion.json", "intermediates/votes.csv", "views/view_00_depth.npy"})
+    EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/intermediates/patches"), fs::directory_iterator{}), 2);
+
+  // The folder is a project folder: faces.csv reads back onto the model with the run's parts.
+  Result<Model> model = load_model(hammer());
+  ASSERT_TRUE(model.ok());
+  Result<FacesFile> faces = read_faces_csv(dir + "/faces.csv", model->mesh, MaterialTable::paper_default());
+  ASSERT_TRUE(faces.ok()) << faces.status().to_string();
+  EXPECT_EQ(faces->labels, r->projection.labels.label);
+
+  // run.json and summary.html carry the parts and the mass.
+  const nlohmann::json run = nlohmann::json::parse(test::read_file(dir + "/run.json"));
+  EXPECT_EQ(run["format"], "g2p-run");
+  EXPECT_EQ(run["parts"].size(), 2u);
+  EXPECT_NEAR(run["object"]["mass_kg"].get<double>(), r->properties.object.mass_kg, 1e-9);
+  EXPECT_EQ(run["stages"].size(), 8u);
+  const std::string html = test::read_file(dir + "/summary.html");
+  EXPECT_NE(html.find("Metal"), std::string::npos);
+  EXPECT_NE(html.find("Wood"), std::string::npos);
+  EXPECT_NE(html.find("projected/contact_sheet.png"), std::string::npos);
+
+  // An existing folder is kept unless overwriting is asked for; then it is replaced whole.
+  test::write_file(dir + "/mine.txt", "the user's file");
+  Status s = write_pipeline_output(dir, *r, pipeline.options());
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_TRUE(fs::exists(dir + "/mine.txt"));
+  out = OutputOptions{};
+  out.overwrite = true;
+  ASSERT_TRUE(write_pipeline_output(dir, *r, pipeline.options(), out).ok());
+  EXPECT_FALSE(fs::exists(dir + "/mine.txt"));
+  EXPECT_FALSE(fs::exists(dir + "/intermediates"));
+  EXPECT_TRUE(fs::exists(dir + "/hammer.xml"));
+
+  // A folder that cannot be made fails cleanly and leaves no temporary folder behind.
+  const std::string blocked = test::scratch_dir("PipelineOutputBlocked");
+  test::write_file(blocked + "/file", "x");
+  s = write_pipeline_output(blocked + "/file/out", *r, pipeline.options());
+  EXPECT_FALSE(s.ok());
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(blocked)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"file"});
+  // Nor is an incomplete result written.
+  EXPECT_FALSE(write_pipeline_output(blocked + "/empty", PipelineResult{}).ok());
+  EXPECT_FALSE(fs::exists(blocked + "/empty"));
+}
+
+// A real textured asset end to end with the paper's 11 views at 512 px: every
+// part closed, a mass inside the sofa's plausible range (labels.json: 40-90 kg).
+TEST(Pipeline, TheSofaEndToEnd) {
+  Pipeline pipeline;
+  Result<PipelineResult> r = pipeline.run_file(test::asset_path("GlamVelvetSofa"));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->views.size(), 11u);
+  EXPECT_EQ(r->views[0].rgb.width(), 512);
+  int closed = 0;
+  for (const CompletedPart& c : r->completion.parts) closed += c.ok ? 1 : 0;
+  EXPECT_EQ(closed, static_cast<int>(r->completion.parts.size()));
+  EXPECT_GT(r->properties.object.mass_kg, 40.0);
+  EXPECT_LT(r->properties.object.mass_kg, 90.0);
+  const int fabric = label_of("Fabric");
+  double fabric_area = 0, area = 0;
+  for (const Part& p : r->projection.parts) {
+    area += p.area_m2;
+    if (p.label == fabric) fabric_area += p.area_m2;
+  }
+  EXPECT_GT(fabric_area, 0.5 * area);  // a velvet sofa is mostly fabric
+}
+
+}  // namespace
+}  // namespace g2p

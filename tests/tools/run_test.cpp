@@ -1,0 +1,98 @@
+// `g2p run` as a user runs it: the whole pipeline, its exit codes, its JSON
+// summary, degraded optional stages, and a folder the other commands accept.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "support/test_data.h"
+#include "support/tool_run.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kQuick = " --views 6 --resolution 160";
+
+std::string hammer() { return test::quote(test::source_path("examples/data/hammer.obj")); }
+
+TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
+  const std::string dir = test::scratch_dir("ToolRun");
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);  // stdout is the JSON alone
+  EXPECT_EQ(j["format"], "g2p-run");
+  EXPECT_EQ(j["parts"].size(), 2u);
+  EXPECT_GT(j["object"]["center_of_mass_m"][2].get<double>(), 0.25);
+  EXPECT_EQ(j["assets"].size(), 4u);
+  for (const auto& f : j["assets"]) EXPECT_TRUE(fs::exists(dir + "/out/" + f.get<std::string>())) << f;
+  EXPECT_TRUE(fs::exists(dir + "/out/summary.html"));
+  EXPECT_EQ(r.err.find("\r"), std::string::npos);  // not a terminal: plain progress lines
+  EXPECT_NE(r.err.find("g2p run: complete done"), std::string::npos) << r.err;
+
+  // The folder is a source for the single-stage commands: export reuses its parts and properties.
+  r = test::run_tool("export " + test::quote(dir + "/out") + " -o " + test::quote(dir + "/again") + " --format mjcf");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("using the closed parts and properties"), std::string::npos) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(test::read_file(dir + "/again/report.json"))["object"]["mass_kg"],
+            j["object"]["mass_kg"]);
+
+  // An existing output is a usage error and stays untouched; --overwrite replaces it.
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick +
+                     " --overwrite --format urdf --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/out/hammer.urdf"));
+  EXPECT_FALSE(fs::exists(dir + "/out/hammer.xml"));
+}
+
+TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
+  const std::string dir = test::scratch_dir("ToolRunBad");
+  struct Case {
+    std::string flags, message;
+  };
+  for (const Case& c :
+       {Case{"--segmenter nope", "no backend named 'nope'"}, Case{"--complete-set resolution", "--complete-set"},
+        Case{"--vlm-url http://127.0.0.1:9/v1", "--vlm-url"}, Case{"--format obj", "obj"}}) {
+    test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + " " + c.flags);
+    EXPECT_EQ(r.exit_code, 2) << c.flags << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.flags << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/out")) << c.flags;
+  }
+  test::ToolRun r = test::run_tool("run " + test::quote(dir + "/missing.glb") + " -o " + test::quote(dir + "/out"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("missing.glb"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
+TEST(ToolRun, AnUnreachableVlmRefinerDegradesToTheProjectedLabels) {
+  const std::string dir = test::scratch_dir("ToolRunVlm");
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick +
+                                   " --refiner vlm --vlm-url http://127.0.0.1:9/v1 --vlm-model test"
+                                   " --refine-set retries=0 --refine-set timeout=5");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.err.find("warning: refine (vlm) failed"), std::string::npos) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(dir + "/out/run.json"));
+  EXPECT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["parts"].size(), 2u);
+  const nlohmann::json refine = nlohmann::json::parse(test::read_file(dir + "/out/refine.json"));
+  EXPECT_TRUE(refine.contains("error"));
+  // The key's value never reaches a file.
+  EXPECT_EQ(test::read_file(dir + "/out/run.json").find("Bearer"), std::string::npos);
+}
+
+TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {
+  test::ToolRun r = test::run_tool("run --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* flag : {"--segmenter", "--refiner", "--completer", "--estimator", "--views", "--resolution",
+                           "--materials", "--vlm-url", "--vlm-model", "--format", "--json", "--save-intermediates"})
+    EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+  EXPECT_NE(r.out.find("130 cancelled"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace g2p

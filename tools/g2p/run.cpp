@@ -1,0 +1,210 @@
+// g2p run MODEL -o DIR: the whole method in one call (g2p::Pipeline), from a
+// mesh file to the simulation assets, a report and summary.html.
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "common.h"
+#include "g2p/pipeline.h"
+#include "stage_inputs.h"
+#include "stage_outputs.h"
+#if defined(G2P_CLI_WITH_CGAL)
+#include "g2p/complete_cgal.h"
+#endif
+
+namespace g2p::cli {
+namespace {
+
+struct RunArgs {
+  std::string model, out, materials, name;
+  ImportArgs import;
+  ViewArgs views;
+  SegmenterArgs segmenter;
+  RefineArgs refiner;
+  CompleterArgs completer;
+  EstimatorArgs estimator;
+  std::string vlm_url, vlm_model;
+  std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
+  bool fixed = false, anonymize = false, overwrite = false, intermediates = false, json = false, quiet = false;
+};
+
+// The run's context, reachable from the SIGINT handler (cancel() is a
+// lock-free atomic store).
+RunContext* g_context = nullptr;
+extern "C" void on_interrupt(int) {
+  if (g_context != nullptr) g_context->cancel();
+}
+
+// Progress on stderr: a redrawn bar on a terminal, one line per stage otherwise.
+class ProgressPrinter {
+ public:
+  explicit ProgressPrinter(bool quiet) : quiet_(quiet), tty_(::isatty(STDERR_FILENO) == 1) {}
+  void operator()(const Progress& p) {
+    if (quiet_) return;
+    if (tty_) {
+      const int width = 30, filled = static_cast<int>(p.overall * width + 0.5);
+      std::fprintf(stderr, "\r[%-*s] %3d%% %-10s %-28.28s", width, std::string(filled, '#').c_str(),
+                   static_cast<int>(p.overall * 100 + 0.5), to_string(p.stage), p.message.c_str());
+      if (p.stage == Stage::kExport && p.stage_fraction >= 1.0) std::fputc('\n', stderr);
+      std::fflush(stderr);
+    } else if (p.stage != last_ || p.stage_fraction >= 1.0) {
+      std::fprintf(stderr, "g2p run: %s %s%s\n", to_string(p.stage), p.stage_fraction >= 1.0 ? "done: " : "",
+                   p.message.c_str());
+    }
+    last_ = p.stage;
+  }
+  void end_line() {
+    if (!quiet_ && tty_) std::fputc('\n', stderr);
+  }
+
+ private:
+  bool quiet_, tty_;
+  Stage last_ = Stage::kLoad;
+};
+
+int usage(const std::string& message) {
+  std::cerr << "g2p run: " << message << "\n";
+  return kExitUsage;
+}
+
+int run_pipeline(const RunArgs& args) {
+  namespace fs = std::filesystem;
+#if defined(G2P_CLI_WITH_CGAL)
+  (void)register_cgal_completers();
+#endif
+  if (fs::exists(args.out) && !args.overwrite)
+    return usage(args.out + " exists; choose another folder or pass --overwrite (replaced only once the run succeeds)");
+
+  PipelineOptions o;
+  Result<ImportOptions> import = import_options(args.import);
+  if (!import.ok()) return usage(import.status().message());
+  o.import = *import;
+  o.anonymize_names = args.anonymize;
+  Result<ViewOptions> views = view_options(args.views);
+  if (!views.ok()) return usage(views.status().message());
+  o.views = *views;
+  o.renderer.name = args.views.renderer;
+  struct StageFlags {
+    BackendChoice* choice;
+    const std::string* name;
+    const std::vector<std::string>* settings;
+    const char* flag;
+  };
+  const StageFlags stages[] = {{&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
+                               {&o.refiner, &args.refiner.name, &args.refiner.settings, "--refine-set"},
+                               {&o.completer, &args.completer.name, &args.completer.settings, "--complete-set"},
+                               {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"}};
+  for (const StageFlags& s : stages) {
+    Result<BackendSettings> settings = parse_settings(*s.settings);
+    if (!settings.ok()) return usage(std::string(s.flag) + ": " + settings.status().message());
+    *s.choice = BackendChoice{*s.name, *settings};
+  }
+  // --vlm-url/--vlm-model go to every stage that asks a vision-language model.
+  if (!args.vlm_url.empty() || !args.vlm_model.empty()) {
+    bool used = false;
+    for (BackendChoice* c : {&o.refiner, &o.estimator}) {
+      if (c->name != "vlm") continue;
+      used = true;
+      if (!args.vlm_url.empty()) c->settings.emplace("url", args.vlm_url);
+      if (!args.vlm_model.empty()) c->settings.emplace("model", args.vlm_model);
+    }
+    if (!used) return usage("--vlm-url and --vlm-model need --refiner vlm or --estimator vlm");
+  }
+  o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
+  o.formats = args.formats;
+  o.name = args.name;
+  o.export_options.free_joint = !args.fixed;
+
+  Pipeline pipeline(o);
+  if (!args.materials.empty()) {
+    Result<MaterialTable> table = MaterialTable::load(args.materials);
+    if (!table.ok()) return usage(table.status().to_string());
+    pipeline.set_material_table(std::move(*table));
+  }
+  if (Status s = pipeline.prepare(); !s.ok()) {
+    if (s.code() == StatusCode::kInvalidArgument || s.code() == StatusCode::kNotFound) return usage(s.message());
+    std::cerr << "g2p run: error: " << s.to_string() << "\n";
+    return kExitFailure;
+  }
+
+  ProgressPrinter printer(args.quiet || args.json);
+  RunContext context([&printer](const Progress& p) { printer(p); });
+  g_context = &context;
+  auto previous = std::signal(SIGINT, on_interrupt);
+  Result<PipelineResult> result = pipeline.run_file(args.model, &context);
+  Status written = result.ok() ? Status::Ok() : result.status();
+  if (result.ok() && !context.cancelled()) {
+    OutputOptions out;
+    out.overwrite = args.overwrite;
+    out.intermediates = args.intermediates;
+    written = write_pipeline_output(args.out, *result, o, out);
+  }
+  std::signal(SIGINT, previous);
+  g_context = nullptr;
+  if (context.cancelled()) {
+    printer.end_line();
+    std::cerr << "g2p run: cancelled; nothing was written\n";
+    return kExitCancelled;
+  }
+  if (!written.ok()) {
+    printer.end_line();
+    std::cerr << "g2p run: error: " << written.to_string() << "\n";
+    return kExitFailure;
+  }
+  const PipelineResult& r = *result;
+  for (const std::string& w : r.warnings) std::cerr << "g2p run: warning: " << w << "\n";
+  if (args.json) {
+    std::cout << pipeline_summary_json(r, o) << "\n";
+    return kExitOk;
+  }
+  std::printf("%s: %d triangles -> %zu parts, %.4g kg (range %.3g-%.3g kg) in %.2f s -> %s\n", args.model.c_str(),
+              r.model.mesh.num_faces(), r.projection.parts.size(), r.properties.object.mass_kg,
+              r.properties.mass_min_kg, r.properties.mass_max_kg, r.seconds, args.out.c_str());
+  for (const StageReport& s : r.stages)
+    std::printf("  %-10s %-10s %6.2f s %7.0f MiB%s\n", to_string(s.stage), s.backend.c_str(), s.seconds,
+                static_cast<double>(s.peak_rss_bytes) / 1048576.0, s.ok ? "" : "  FAILED (skipped)");
+  std::printf("  open %s/summary.html\n", args.out.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, Command& run) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "The whole pipeline: render, segment, project, refine, complete, properties and export in one call");
+  cmd->add_option("model", args->model, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, ...)")->required();
+  cmd->add_option("-o,--output", args->out, "Output folder (must not exist unless --overwrite)")->required();
+  cmd->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
+  cmd->add_option("--name", args->name, "Asset name (default: the model file's stem)");
+  cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
+  cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
+  cmd->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one first");
+  cmd->add_option("--vlm-url", args->vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
+  cmd->add_option("--vlm-model", args->vlm_model, "Model name for the vlm refiner/estimator");
+  cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output folder (after the run succeeded)");
+  cmd->add_flag("--save-intermediates", args->intermediates,
+                "Also write every view's buffers, per-view probabilities, per-face votes and part patches");
+  cmd->add_flag("--json", args->json, "Print the run's summary (run.json) on stdout instead of text");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+  add_import_flags(cmd, args->import);
+  add_view_flags(cmd, args->views);
+  add_segmenter_flags(cmd, args->segmenter);
+  add_refiner_flags(cmd, args->refiner, "smooth");
+  add_completer_flags(cmd, args->completer);
+  add_estimator_flags(cmd, args->estimator);
+  cmd->footer(
+      "Exit codes: 0 success, 1 the run failed (bad input file, a stage error), 2 bad command line, 130 cancelled "
+      "(Ctrl-C). Nothing is written unless the run succeeds.");
+  cmd->callback([args, &run] { run = [args] { return run_pipeline(*args); }; });
+}
+
+}  // namespace g2p::cli

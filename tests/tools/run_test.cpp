@@ -2,6 +2,7 @@
 // summary, degraded optional stages, and a folder the other commands accept.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -71,9 +72,12 @@ TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
 
 TEST(ToolRun, AnUnreachableVlmRefinerDegradesToTheProjectedLabels) {
   const std::string dir = test::scratch_dir("ToolRunVlm");
+  const std::string secret = "sk-test-secret-4711";
+  ::setenv("G2P_TEST_VLM_KEY", secret.c_str(), 1);
   test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick +
                                    " --refiner vlm --vlm-url http://127.0.0.1:9/v1 --vlm-model test"
-                                   " --refine-set retries=0 --refine-set timeout=5");
+                                   " --refine-set retries=0 --refine-set timeout=5"
+                                   " --refine-set api_key_env=G2P_TEST_VLM_KEY");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.err.find("warning: refine (vlm) failed"), std::string::npos) << r.err;
   const nlohmann::json j = nlohmann::json::parse(test::read_file(dir + "/out/run.json"));
@@ -81,8 +85,11 @@ TEST(ToolRun, AnUnreachableVlmRefinerDegradesToTheProjectedLabels) {
   EXPECT_EQ(j["parts"].size(), 2u);
   const nlohmann::json refine = nlohmann::json::parse(test::read_file(dir + "/out/refine.json"));
   EXPECT_TRUE(refine.contains("error"));
-  // The key's value never reaches a file.
-  EXPECT_EQ(test::read_file(dir + "/out/run.json").find("Bearer"), std::string::npos);
+  // The key's value never reaches the output or any file.
+  EXPECT_EQ(r.out.find(secret), std::string::npos);
+  EXPECT_EQ(r.err.find(secret), std::string::npos);
+  for (const auto& e : fs::recursive_directory_iterator(dir + "/out"))
+    if (e.is_regular_file()) EXPECT_EQ(test::read_file(e.path().string()).find(secret), std::string::npos) << e.path();
 }
 
 TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {

@@ -133,7 +133,7 @@ int run_pipeline(const RunArgs& args) {
     return kExitFailure;
   }
 
-  ProgressPrinter printer(args.quiet || args.json);
+  ProgressPrinter printer(args.quiet);
   RunContext context([&printer](const Progress& p) { printer(p); });
   g_context = &context;
   auto previous = std::signal(SIGINT, on_interrupt);

@@ -130,7 +130,7 @@ struct StageReport {
   std::vector<std::string> notes;
 };
 
-struct PipelineResult {
+struct G2P_API PipelineResult {
   Model model;
   MaterialTable table;
   std::vector<View> views;

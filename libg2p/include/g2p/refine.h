@@ -43,6 +43,10 @@ struct RefineResult {
   std::vector<int> labels;           // per face
   std::vector<LabelChange> changes;  // every face whose label differs from the input
   std::vector<std::string> notes;    // what the refiner did or could not do, for the report
+  // The backend could not do its work (a model server down, an unusable
+  // answer) and returned the input labels; `notes` says why. The pipeline
+  // reports this as a degraded stage.
+  bool fell_back = false;
 };
 
 class G2P_API Refiner {

@@ -183,7 +183,12 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     Status applied =
         refined.ok() ? apply_refinement(mesh, refined->labels, o.project.partition, r.projection) : refined.status();
     StageReport& report = clock.report();
-    if (!applied.ok()) {
+    if (applied.ok() && refined->fell_back) {
+      report.ok = false;
+      report.error = refined->notes.empty() ? "the backend kept the input labels" : refined->notes.back();
+      r.warnings.push_back("refine (" + report.backend + ") failed; the projected labels stand: " + report.error);
+      r.refinement = std::move(*refined);
+    } else if (!applied.ok()) {
       report.ok = false;
       report.error = applied.to_string();
       r.warnings.push_back("refine (" + report.backend + ") failed; the projected labels stand: " + report.error);

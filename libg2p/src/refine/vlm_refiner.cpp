@@ -90,6 +90,7 @@ class VlmRefiner final : public Refiner {
     Result<std::string> answer = client_->complete(request);
     if (!answer.ok()) {
       result.notes.push_back("vlm: no correction applied, the labels stand: " + answer.status().to_string());
+      result.fell_back = true;
       return result;
     }
     Result<std::string> text = extract_json_object(*answer);
@@ -99,6 +100,7 @@ class VlmRefiner final : public Refiner {
       result.notes.push_back(
           "vlm: rejected the answer (no valid JSON object with a 'corrections' array); "
           "the labels stand");
+      result.fell_back = true;
       return result;
     }
     if (doc.contains("object") && doc["object"].is_string())

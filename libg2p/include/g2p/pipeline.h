@@ -112,6 +112,11 @@ struct PipelineOptions {
   ExportOptions export_options;
   std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
 
+  // Stop after this stage: ablations of the labelling stages (segment,
+  // project, refine) need no closed volumes. A result that stops before
+  // kExport has no asset and cannot be written as an output folder.
+  Stage last_stage = Stage::kExport;
+
   // Measure each stage's peak resident memory by resetting the process's
   // high-water mark (Linux /proc/self/clear_refs) before it. Off: the
   // process's peak so far is reported instead.

@@ -141,6 +141,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     finish(clock);
   }
 
+  if (o.last_stage == Stage::kRender) return Status::Ok();
+
   // 2. segment: a material class per pixel.
   {
     detail::StageClock clock(Stage::kSegment, segmenter.backend(o.segmenter), reset);
@@ -157,6 +159,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     finish(clock);
   }
 
+  if (o.last_stage == Stage::kSegment) return Status::Ok();
+
   // 3. project: votes over all views, flood fill, connected parts.
   {
     detail::StageClock clock(Stage::kProject, "vote", reset);
@@ -171,6 +175,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     G2P_RETURN_IF_ERROR(context.report(Stage::kProject, 1.0, std::to_string(r.projection.parts.size()) + " parts"));
     finish(clock);
   }
+
+  if (o.last_stage == Stage::kProject) return Status::Ok();
 
   // 4. refine (optional): a failure keeps the projected labels.
   if (refiner.custom || o.refiner.name != "none") {
@@ -202,6 +208,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     finish(clock);
   }
 
+  if (o.last_stage == Stage::kRefine) return Status::Ok();
+
   // 5. complete: every part closed into a watertight volume.
   {
     detail::StageClock clock(Stage::kComplete, completer.backend(o.completer), reset);
@@ -219,6 +227,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     finish(clock);
   }
 
+  if (o.last_stage == Stage::kComplete) return Status::Ok();
+
   // 6. properties: density, solid or hollow, mass properties.
   {
     detail::StageClock clock(Stage::kProperties, estimator.backend(o.estimator), reset);
@@ -230,6 +240,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     G2P_RETURN_IF_ERROR(context.report(Stage::kProperties, 1.0, "done"));
     finish(clock);
   }
+
+  if (o.last_stage == Stage::kProperties) return Status::Ok();
 
   // The simulation asset (written by write_pipeline_output).
   {

@@ -75,6 +75,30 @@ struct WallMeasurement {
 G2P_API Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, const Mesh& closed,
                                               int max_rays = 2000, double surface_tolerance_m = 0.0);
 
+// Ray queries against one surface (an Embree BVH), built once and shared:
+// every part's wall measurement casts rays at the same object, and building
+// the structure for a million-triangle object takes a few tenths of a second.
+class G2P_API SurfaceRays {
+ public:
+  static Result<std::shared_ptr<const SurfaceRays>> build(const Mesh& mesh);
+  ~SurfaceRays();
+  SurfaceRays(const SurfaceRays&) = delete;
+  SurfaceRays& operator=(const SurfaceRays&) = delete;
+  int num_faces() const { return num_faces_; }  // of the mesh it was built from
+
+ private:
+  SurfaceRays() = default;
+  friend Result<WallMeasurement> measure_walls(const SurfaceRays&, const Mesh&, const Part&, const Mesh&, int, double);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int num_faces_ = 0;
+};
+
+// The same with `object_rays` built from `object` beforehand.
+G2P_API Result<WallMeasurement> measure_walls(const SurfaceRays& object_rays, const Mesh& object, const Part& part,
+                                              const Mesh& closed, int max_rays = 2000,
+                                              double surface_tolerance_m = 0.0);
+
 // ---- Estimating properties ----------------------------------------------------
 
 // Where a value came from.
@@ -118,6 +142,8 @@ struct PropertyInput {
   // Optional object context: all parts and their closed volumes (same order).
   const std::vector<Part>* all_parts = nullptr;
   const Completion* all_completed = nullptr;
+  // Optional: rays against `object`, built once by estimate_properties for all parts.
+  const SurfaceRays* object_rays = nullptr;
 };
 
 class G2P_API PropertyEstimator {

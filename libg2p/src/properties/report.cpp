@@ -14,12 +14,15 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
                                    std::to_string(parts.size()) + " parts");
   PropertiesReport report;
   std::vector<MassProperties> masses;
+  // One ray structure of the object for every part's wall measurement.
+  Result<std::shared_ptr<const SurfaceRays>> object_rays = SurfaceRays::build(object);
+  if (!object_rays.ok()) return object_rays.status().with_context("properties");
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const CompletedPart& completed = completion.parts[i];
     PartReport r;
     r.part = static_cast<int>(i);
     r.completed_ok = completed.ok;
-    PropertyInput in{&object, &parts[i], &completed, &table, views, &parts, &completion};
+    PropertyInput in{&object, &parts[i], &completed, &table, views, &parts, &completion, object_rays->get()};
     Result<PartProperties> p = estimator.estimate(in);
     if (!p.ok()) return p.status().with_context("part " + std::to_string(i));
     r.properties = std::move(*p);

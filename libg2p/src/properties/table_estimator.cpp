@@ -113,8 +113,11 @@ Result<PartProperties> table_properties(const PropertyInput& in, const TableRule
   p.friction_dynamic = c.friction_dynamic;
   p.restitution = c.restitution;
   if (in.completed->mesh.num_faces() > 0) {
-    Result<WallMeasurement> w = measure_walls(*in.object, *in.part, in.completed->mesh, rule.rays,
-                                              in.all_completed != nullptr ? in.all_completed->grid_spacing_m : 0.0);
+    const double tolerance = in.all_completed != nullptr ? in.all_completed->grid_spacing_m : 0.0;
+    Result<WallMeasurement> w =
+        in.object_rays != nullptr
+            ? measure_walls(*in.object_rays, *in.object, *in.part, in.completed->mesh, rule.rays, tolerance)
+            : measure_walls(*in.object, *in.part, in.completed->mesh, rule.rays, tolerance);
     if (!w.ok()) return w.status();
     p.walls = *w;
   }

@@ -20,11 +20,38 @@ constexpr double kMinWall = 1e-4;  // metres
 
 }  // namespace
 
+struct SurfaceRays::Impl {
+  std::unique_ptr<detail::SegmentTester> tester;
+};
+
+SurfaceRays::~SurfaceRays() = default;
+
+Result<std::shared_ptr<const SurfaceRays>> SurfaceRays::build(const Mesh& mesh) {
+  Result<std::unique_ptr<detail::SegmentTester>> tester = detail::SegmentTester::create(mesh);
+  if (!tester.ok()) return tester.status();
+  std::shared_ptr<SurfaceRays> rays(new SurfaceRays());
+  rays->impl_ = std::make_unique<Impl>();
+  rays->impl_->tester = std::move(*tester);
+  rays->num_faces_ = mesh.num_faces();
+  return std::shared_ptr<const SurfaceRays>(std::move(rays));
+}
+
 Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, const Mesh& closed, int max_rays,
                                       double surface_tolerance_m) {
   if (part.faces.empty() || closed.num_faces() == 0 || max_rays <= 0) return WallMeasurement{};
-  Result<std::unique_ptr<detail::SegmentTester>> in_object = detail::SegmentTester::create(object);
-  if (!in_object.ok()) return in_object.status();
+  Result<std::shared_ptr<const SurfaceRays>> rays = SurfaceRays::build(object);
+  if (!rays.ok()) return rays.status();
+  return measure_walls(**rays, object, part, closed, max_rays, surface_tolerance_m);
+}
+
+Result<WallMeasurement> measure_walls(const SurfaceRays& object_rays, const Mesh& object, const Part& part,
+                                      const Mesh& closed, int max_rays, double surface_tolerance_m) {
+  if (part.faces.empty() || closed.num_faces() == 0 || max_rays <= 0) return WallMeasurement{};
+  if (object_rays.num_faces() != object.num_faces())
+    return Status::InvalidArgument("measure_walls: the rays were built for a mesh of " +
+                                   std::to_string(object_rays.num_faces()) + " faces, the object has " +
+                                   std::to_string(object.num_faces()));
+  const detail::SegmentTester* in_object = object_rays.impl_->tester.get();
   Result<std::unique_ptr<detail::SegmentTester>> in_closed = detail::SegmentTester::create(closed);
   if (!in_closed.ok()) return in_closed.status();
 
@@ -91,7 +118,7 @@ Result<WallMeasurement> measure_walls(const Mesh& object, const Part& part, cons
       const double skip = std::max({eps, kMinWall, 1e-3 * exit_t});
       ++w.rays;
       thickness.push_back(exit_t);
-      if ((*in_object)->first_hit(p, d, skip, 0.9 * exit_t, hit_t, hit_tri)) {
+      if (in_object->first_hit(p, d, skip, 0.9 * exit_t, hit_t, hit_tri)) {
         ++w.inner_hits;
         inner.push_back(hit_t);
       }

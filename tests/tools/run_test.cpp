@@ -70,18 +70,22 @@ TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
-TEST(ToolRun, AnUnreachableVlmRefinerDegradesToTheProjectedLabels) {
+TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
   const std::string dir = test::scratch_dir("ToolRunVlm");
   const std::string secret = "sk-test-secret-4711";
   ::setenv("G2P_TEST_VLM_KEY", secret.c_str(), 1);
   test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick +
                                    " --refiner vlm --vlm-url http://127.0.0.1:9/v1 --vlm-model test"
                                    " --refine-set retries=0 --refine-set timeout=5"
-                                   " --refine-set api_key_env=G2P_TEST_VLM_KEY");
+                                   " --refine-set api_key_env=G2P_TEST_VLM_KEY --estimator vlm"
+                                   " --estimate-set retries=0 --estimate-set api_key_env=G2P_TEST_VLM_KEY");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.err.find("warning: refine (vlm) failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("warning: properties (vlm): 2 of 2 parts fell back"), std::string::npos) << r.err;
   const nlohmann::json j = nlohmann::json::parse(test::read_file(dir + "/out/run.json"));
-  EXPECT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["warnings"].size(), 2u);
+  // The table's values stand: the steel head still makes the centre of mass high.
+  EXPECT_GT(j["object"]["center_of_mass_m"][2].get<double>(), 0.25);
   EXPECT_EQ(j["parts"].size(), 2u);
   const nlohmann::json refine = nlohmann::json::parse(test::read_file(dir + "/out/refine.json"));
   EXPECT_TRUE(refine.contains("error"));

@@ -237,6 +237,28 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     if (!report.ok()) return report.status().with_context("properties");
     r.properties = std::move(*report);
     clock.report().notes = r.properties.notes;
+    // The vlm estimator never fails a part: it falls back to the table, which
+    // is a degraded optional stage the caller should hear about.
+    if (!estimator.custom && o.estimator.name == "vlm") {
+      int fell_back = 0, weighed = 0;
+      std::string why;
+      for (const PartReport& p : r.properties.parts) {
+        if (p.mass.mass_kg <= 0) continue;
+        ++weighed;
+        if (p.properties.density_source == ValueSource::kVlm) continue;
+        ++fell_back;
+        if (why.empty() && !p.properties.notes.empty()) why = p.properties.notes.back();
+      }
+      if (fell_back > 0) {
+        const std::string what = std::to_string(fell_back) + " of " + std::to_string(weighed) +
+                                 " parts fell back to the table's values" + (why.empty() ? "" : " (" + why + ")");
+        r.warnings.push_back("properties (vlm): " + what);
+        if (fell_back == weighed) {
+          clock.report().ok = false;
+          clock.report().error = what;
+        }
+      }
+    }
     G2P_RETURN_IF_ERROR(context.report(Stage::kProperties, 1.0, "done"));
     finish(clock);
   }

@@ -207,7 +207,7 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
        {"faces.csv", "labelled.ply", "parts.json", "refine.json", "report.json", "run.json", "summary.html",
         "project.json", "properties.json", "hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb",
         "views/contact_sheet.png", "segmented/contact_sheet.png", "projected/contact_sheet.png",
-        "completed/completion.json", "intermediates/votes.csv", "views/view_00_depth.npy"})
+        "completed/completion.json", "intermediates/votes.csv", "views/view_00_depth.npy", "segmented/view_00_probs.npy"})
     EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/intermediates/patches"), fs::directory_iterator{}), 2);
 
@@ -239,6 +239,8 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
   ASSERT_TRUE(write_pipeline_output(dir, *r, pipeline.options(), out).ok());
   EXPECT_FALSE(fs::exists(dir + "/mine.txt"));
   EXPECT_FALSE(fs::exists(dir + "/intermediates"));
+  EXPECT_FALSE(fs::exists(dir + "/segmented/view_00_probs.npy"));  // probabilities are intermediates
+  EXPECT_TRUE(fs::exists(dir + "/segmented/view_00_labels_index.png"));
   EXPECT_TRUE(fs::exists(dir + "/hammer.xml"));
 
   // A folder that cannot be made fails cleanly and leaves no temporary folder behind.

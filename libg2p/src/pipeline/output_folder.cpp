@@ -63,16 +63,10 @@ Status write_manifests(const std::string& tmp, const fs::path& final_dir, const 
   return write_text_file(tmp + "/properties.json", properties.dump(2) + "\n");
 }
 
-// intermediates/: per-view class probabilities, per-face votes, part patches.
+// intermediates/: per-face votes and part patches (the per-view class
+// probabilities go beside the label maps, segmented/view_XX_probs.npy).
 Status write_intermediates(const std::string& dir, const PipelineResult& r) {
-  G2P_RETURN_IF_ERROR(detail::ensure_directory(dir + "/probabilities"));
-  for (std::size_t i = 0; i < r.label_maps.size(); ++i) {
-    const ImageF& p = r.label_maps[i].probabilities;
-    if (p.empty()) continue;
-    char name[64];
-    std::snprintf(name, sizeof name, "/probabilities/view_%02zu.npy", i);
-    G2P_RETURN_IF_ERROR(detail::write_file_atomically(dir + name, detail::npy_float32(p)));
-  }
+  G2P_RETURN_IF_ERROR(detail::ensure_directory(dir));
   // votes.csv: face, total, then one column per class.
   std::ostringstream votes;
   votes << "face,total";
@@ -101,7 +95,14 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
   ViewFileOptions views;
   views.buffers = out.intermediates;
   G2P_RETURN_IF_ERROR(write_views(tmp + "/views", r.views, views));
-  G2P_RETURN_IF_ERROR(write_label_maps(tmp + "/segmented", r.label_maps, r.table));
+  if (out.intermediates) {
+    G2P_RETURN_IF_ERROR(write_label_maps(tmp + "/segmented", r.label_maps, r.table));  // with view_XX_probs.npy
+  } else {
+    // The class probabilities (12 floats a pixel, 138 MB for 11 views at 512 px) are intermediates.
+    std::vector<LabelMap> labels_only(r.label_maps.size());
+    for (std::size_t i = 0; i < r.label_maps.size(); ++i) labels_only[i].labels = r.label_maps[i].labels;
+    G2P_RETURN_IF_ERROR(write_label_maps(tmp + "/segmented", labels_only, r.table));
+  }
   G2P_RETURN_IF_ERROR(write_projection(tmp, r.model, r.views, r.projection, r.table));
   const StageReport* refine = r.stage(Stage::kRefine);
   nlohmann::json refine_json = {{"refiner", refine != nullptr ? refine->backend : "none"}};

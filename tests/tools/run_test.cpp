@@ -2,9 +2,17 @@
 // summary, degraded optional stages, and a folder the other commands accept.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "support/test_data.h"
 #include "support/tool_run.h"
@@ -94,6 +102,38 @@ TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
   EXPECT_EQ(r.err.find(secret), std::string::npos);
   for (const auto& e : fs::recursive_directory_iterator(dir + "/out"))
     if (e.is_regular_file()) EXPECT_EQ(test::read_file(e.path().string()).find(secret), std::string::npos) << e.path();
+}
+
+// Ctrl-C during a run: exit code 130, nothing written, no temporary folder left.
+TEST(ToolRun, InterruptCancelsAndWritesNothing) {
+  const std::string dir = test::scratch_dir("ToolRunInterrupt");
+  const std::string out = dir + "/out", err = dir + "/err.txt";
+  const std::string model = test::asset_path("SheenChair");  // several seconds: time to interrupt it
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  std::vector<std::string> args{G2P_TEST_TOOL, "run", model, "-o", out};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, G2P_TEST_TOOL, &files, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&files);
+  // Interrupt once rendering has begun (progress lines on stderr).
+  const auto start = std::chrono::steady_clock::now();
+  while (test::read_file(err).find("render") == std::string::npos &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << test::read_file(err);
+  EXPECT_EQ(WEXITSTATUS(status), 130) << test::read_file(err);
+  EXPECT_NE(test::read_file(err).find("cancelled; nothing was written"), std::string::npos) << test::read_file(err);
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"err.txt"});
 }
 
 TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {

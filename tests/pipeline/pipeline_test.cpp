@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "g2p/io.h"
 #include "support/test_data.h"
@@ -103,6 +104,28 @@ TEST(Pipeline, CancelStopsAtTheNextCheck) {
   EXPECT_EQ(segment_reports, 2);  // nothing ran after the check that saw the cancellation
 }
 
+TEST(Pipeline, AThrowingProgressCallbackCancelsWithoutAnException) {
+  Pipeline pipeline(quick_options());
+  RunContext context([](const Progress& p) {
+    if (p.stage == Stage::kProject) throw std::runtime_error("the UI went away");
+  });
+  Result<PipelineResult> r = pipeline.run_file(hammer(), &context);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+  EXPECT_NE(r.status().message().find("the UI went away"), std::string::npos) << r.status().message();
+}
+
+TEST(Pipeline, StopsAfterTheLastStageAskedFor) {
+  PipelineOptions o = quick_options();
+  o.last_stage = Stage::kRefine;
+  Result<PipelineResult> r = Pipeline(o).run_file(hammer());
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->stages.back().stage, Stage::kRefine);
+  EXPECT_EQ(r->projection.parts.size(), 2u);
+  EXPECT_TRUE(r->completion.parts.empty());
+  EXPECT_FALSE(write_pipeline_output(test::scratch_dir("PipelineStops") + "/out", *r, o).ok());
+}
+
 // A user's segmenter: every surface pixel is plastic.
 class AllPlastic final : public Segmenter {
  public:
@@ -185,6 +208,9 @@ TEST(Pipeline, BadBackendsAndOptionsFailBeforeAnyWork) {
   s = Pipeline(o).prepare();
   EXPECT_NE(s.message().find("usd"), std::string::npos);
   o = quick_options();
+  o.last_stage = Stage::kLoad;
+  EXPECT_EQ(Pipeline(o).prepare().code(), StatusCode::kInvalidArgument);
+  o = quick_options();
   o.views.num_views = 0;
   EXPECT_EQ(Pipeline(o).prepare().code(), StatusCode::kInvalidArgument);
 
@@ -203,11 +229,26 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
   OutputOptions out;
   out.intermediates = true;
   ASSERT_TRUE(write_pipeline_output(dir, *r, pipeline.options(), out).ok());
-  for (const char* f :
-       {"faces.csv", "labelled.ply", "parts.json", "refine.json", "report.json", "run.json", "summary.html",
-        "project.json", "properties.json", "hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb",
-        "views/contact_sheet.png", "segmented/contact_sheet.png", "projected/contact_sheet.png",
-        "completed/completion.json", "intermediates/votes.csv", "views/view_00_depth.npy", "segmented/view_00_probs.npy"})
+  for (const char* f : {"faces.csv",
+                        "labelled.ply",
+                        "parts.json",
+                        "refine.json",
+                        "report.json",
+                        "run.json",
+                        "summary.html",
+                        "project.json",
+                        "properties.json",
+                        "hammer.xml",
+                        "hammer.urdf",
+                        "hammer.sdf",
+                        "hammer.glb",
+                        "views/contact_sheet.png",
+                        "segmented/contact_sheet.png",
+                        "projected/contact_sheet.png",
+                        "completed/completion.json",
+                        "intermediates/votes.csv",
+                        "views/view_00_depth.npy",
+                        "segmented/view_00_probs.npy"})
     EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/intermediates/patches"), fs::directory_iterator{}), 2);
 

@@ -47,6 +47,13 @@ TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   EXPECT_EQ(nlohmann::json::parse(test::read_file(dir + "/again/report.json"))["object"]["mass_kg"],
             j["object"]["mass_kg"]);
 
+  // ...and refine reruns stage 4 on it.
+  r = test::run_tool("refine " + test::quote(dir + "/out") + " -o " + test::quote(dir + "/refined") +
+                     " --refiner none");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("2 parts"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir + "/refined/faces.csv"));
+
   // An existing output is a usage error and stays untouched; --overwrite replaces it.
   r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick);
   EXPECT_EQ(r.exit_code, 2);

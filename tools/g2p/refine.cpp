@@ -62,19 +62,24 @@ int run_refine(const RefineCommandArgs& args) {
   Result<MaterialTable> table = load_table_flag("refine", manifest.value("materials", ""), exit_code);
   if (!table.ok()) return exit_code;
 
-  // The views and the segmenter's labels, as written by `g2p project`.
-  Result<std::string> cameras_text = read_text(args.dir + "/cameras.json");
+  // The views and the segmenter's labels, as written by `g2p project` (views
+  // at the top of the folder) or `g2p run` (views/).
+  const std::string view_dir =
+      std::filesystem::exists(args.dir + "/cameras.json") || !std::filesystem::exists(args.dir + "/views/cameras.json")
+          ? args.dir
+          : args.dir + "/views";
+  Result<std::string> cameras_text = read_text(view_dir + "/cameras.json");
   if (!cameras_text.ok()) return fail(cameras_text.status());
   Result<std::vector<Camera>> cameras = cameras_from_json(*cameras_text);
-  if (!cameras.ok()) return fail(cameras.status().with_context(args.dir + "/cameras.json"));
+  if (!cameras.ok()) return fail(cameras.status().with_context(view_dir + "/cameras.json"));
   std::vector<View> views(cameras->size());
   std::vector<LabelMap> maps(cameras->size());
   for (std::size_t i = 0; i < cameras->size(); ++i) {
     View& v = views[i];
     v.camera = (*cameras)[i];
-    Result<ImageU8> ids = read_image(view_file(args.dir, i, "faceid"));
+    Result<ImageU8> ids = read_image(view_file(view_dir, i, "faceid"));
     Result<ImageI32> face_id = ids.ok() ? decode_face_ids(*ids) : Result<ImageI32>(ids.status());
-    Result<ImageU8> rgba = read_image(view_file(args.dir, i, "rgb"));
+    Result<ImageU8> rgba = read_image(view_file(view_dir, i, "rgb"));
     Result<ImageU8> index = read_image(view_file(args.dir + "/segmented", i, "labels_index"));
     for (const Status& s : {face_id.status(), rgba.status(), index.status()})
       if (!s.ok()) return fail(s);
@@ -91,7 +96,7 @@ int run_refine(const RefineCommandArgs& args) {
       }
     for (int f : v.face_id.storage())
       if (f >= model->mesh.num_faces())
-        return fail(Status::InvalidArgument(view_file(args.dir, i, "faceid") +
+        return fail(Status::InvalidArgument(view_file(view_dir, i, "faceid") +
                                             ": face IDs do not belong to the model named in project.json"));
   }
   if (manifest.value("vote", "hard") != "hard")
@@ -130,7 +135,7 @@ int run_refine(const RefineCommandArgs& args) {
 void add_refine_command(CLI::App& app, Command& run) {
   auto args = std::make_shared<RefineCommandArgs>();
   CLI::App* cmd = app.add_subcommand("refine", "Refine the face labels of a `g2p project` output folder");
-  cmd->add_option("dir", args->dir, "Output folder of g2p project")->required();
+  cmd->add_option("dir", args->dir, "Output folder of g2p project or g2p run")->required();
   cmd->add_option("-o,--output", args->out, "Where to write the refined results (default DIR/refined)");
   add_refiner_flags(cmd, args->refine, "smooth");
   cmd->callback([args, &run] { run = [args] { return run_refine(*args); }; });

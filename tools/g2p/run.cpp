@@ -147,11 +147,13 @@ int run_pipeline(const RunArgs& args) {
   }
   std::signal(SIGINT, previous);
   g_context = nullptr;
-  if (context.cancelled()) {
+  if (context.cancelled() && !(result.ok() && written.ok())) {
     printer.end_line();
     std::cerr << "g2p run: cancelled; nothing was written\n";
     return kExitCancelled;
   }
+  if (context.cancelled())  // the interrupt came while the folder was being written: it is complete
+    std::cerr << "g2p run: interrupted after the run; the output is complete\n";
   if (!written.ok()) {
     printer.end_line();
     std::cerr << "g2p run: error: " << written.to_string() << "\n";

@@ -62,7 +62,8 @@ class G2P_API RunContext {
   bool cancelled() const { return cancelled_.load(); }
 
   // For stages: reports progress (the callback runs on the calling thread)
-  // and returns kCancelled once cancel() was called.
+  // and returns kCancelled once cancel() was called. A callback that throws
+  // cancels the run (kCancelled, with the exception's message).
   Status report(Stage stage, double stage_fraction, const std::string& message = {});
 
  private:
@@ -115,7 +116,7 @@ struct PipelineOptions {
   // Stop after this stage: ablations of the labelling stages (segment,
   // project, refine) need no closed volumes. A result that stops before
   // kExport has no asset and cannot be written as an output folder.
-  Stage last_stage = Stage::kExport;
+  Stage last_stage = Stage::kExport;  // kRender ... kExport
 
   // Measure each stage's peak resident memory by resetting the process's
   // high-water mark (Linux /proc/self/clear_refs) before it. Off: the
@@ -127,7 +128,9 @@ struct PipelineOptions {
 
 struct StageReport {
   Stage stage = Stage::kLoad;
-  std::string backend;             // the backend's registry name, or "custom" for a given object
+  // The backend's registry name, "custom" for a given object; load, project
+  // and export have one implementation each: "assimp", "vote", "asset".
+  std::string backend;
   double seconds = 0.0;            // wall time
   std::size_t peak_rss_bytes = 0;  // peak resident memory during the stage (see measure_stage_memory)
   bool ok = true;                  // false: an optional stage failed and the run went on without it
@@ -142,7 +145,8 @@ struct G2P_API PipelineResult {
   std::vector<LabelMap> label_maps;   // per view, from the segmenter
   Projection projection;              // after refinement when it ran
   std::vector<int> projected_labels;  // per face, before refinement (for ablations)
-  RefineResult refinement;            // empty labels when the refiner was "none" or failed
+  RefineResult refinement;            // empty when the refiner was "none" or returned an error; when it
+                                      // fell back (fell_back) its labels are the projected ones
   Completion completion;
   PropertiesReport properties;
   SimulationAsset asset;

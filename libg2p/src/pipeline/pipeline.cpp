@@ -102,6 +102,8 @@ Status Pipeline::prepare() {
   }
   G2P_RETURN_IF_ERROR(prepare_slot(m.estimator, o.estimator, "properties",
                                    [](const BackendChoice& c) { return make_estimator(c.name, c.settings); }));
+  if (o.last_stage == Stage::kLoad)
+    return Status::InvalidArgument("pipeline: last_stage must be render or a later stage (load is not a stage of run)");
   const ViewOptions& v = o.views;
   if (v.num_views < 1 || v.width < 8 || v.height < 8)
     return Status::InvalidArgument("pipeline: views need at least 1 view of 8 x 8 pixels (got " +

@@ -46,7 +46,15 @@ Status RunContext::report(Stage stage, double stage_fraction, const std::string&
     p.overall = (before + p.stage_fraction * kStageWeight[static_cast<int>(stage)]) / total;
     p.message = message;
     std::lock_guard<std::mutex> lock(mutex_);
-    on_progress_(p);
+    try {
+      on_progress_(p);
+    } catch (const std::exception& e) {  // no exception crosses the API: a throwing callback cancels
+      cancel();
+      return Status::Cancelled(std::string("the progress callback threw: ") + e.what());
+    } catch (...) {
+      cancel();
+      return Status::Cancelled("the progress callback threw");
+    }
   }
   if (cancelled()) return Status::Cancelled(std::string("cancelled during ") + to_string(stage));
   return Status::Ok();

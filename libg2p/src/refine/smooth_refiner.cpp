@@ -105,20 +105,21 @@ class SmoothRefiner final : public Refiner {
       return result;
     }
     std::vector<float> cost(static_cast<std::size_t>(k));
-    // Sweeps visit, in index order, only the faces whose neighbourhood changed
-    // since their last visit (all of them in the first): any other face is
-    // still at its minimum, so the result equals full sweeps, at a fraction of
-    // the cost on large meshes where few labels move after the first sweep.
-    std::vector<int> visit(static_cast<std::size_t>(nf));
-    for (int f = 0; f < nf; ++f) visit[static_cast<std::size_t>(f)] = f;
-    std::vector<char> queued(static_cast<std::size_t>(nf), 0);
-    std::vector<int> next;
+    // A face needs a visit only when a neighbour changed since its last one
+    // (else it is still at its minimum). Each sweep goes through the faces in
+    // index order as a full sweep would, skipping the others: a move marks the
+    // neighbours after the face for this sweep and those before it for the
+    // next, so the moves, and the labels, are those of full sweeps, at a
+    // fraction of the cost on large meshes where few labels move after the
+    // first sweep.
+    std::vector<char> now(static_cast<std::size_t>(nf), 1), next(static_cast<std::size_t>(nf), 0);
     int sweeps_done = 0, moved_total = 0;
-    for (int sweep = 0; sweep < sweeps_ && !visit.empty(); ++sweep) {
+    for (int sweep = 0; sweep < sweeps_; ++sweep) {
       ++sweeps_done;
       int moved = 0;
-      next.clear();
-      for (int f : visit) {
+      for (int f = 0; f < nf; ++f) {
+        if (!now[static_cast<std::size_t>(f)]) continue;
+        now[static_cast<std::size_t>(f)] = 0;
         for (int c = 0; c < k; ++c) cost[c] = unary(f, c);
         for (int i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) {
           const int l = label[static_cast<std::size_t>(graph.neighbors[static_cast<std::size_t>(i)])];
@@ -134,14 +135,13 @@ class SmoothRefiner final : public Refiner {
           ++moved;
           for (int i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) {
             const int g = graph.neighbors[static_cast<std::size_t>(i)];
-            if (!queued[static_cast<std::size_t>(g)]) queued[static_cast<std::size_t>(g)] = 1, next.push_back(g);
+            (g > f ? now : next)[static_cast<std::size_t>(g)] = 1;
           }
         }
       }
       moved_total += moved;
-      std::sort(next.begin(), next.end());
-      for (int g : next) queued[static_cast<std::size_t>(g)] = 0;
-      visit.swap(next);
+      if (moved == 0) break;
+      now.swap(next);  // `now` is all zero after the sweep
     }
     std::vector<int> after_smoothing = label;
 

@@ -26,12 +26,26 @@ struct EvalArgs {
   SegmenterArgs segmenter;
   std::string materials;
   bool anonymize = false;
+  bool base_color_only = false;
+  std::string truth;  // labels.json elsewhere than in `assets`
+  std::string split;  // only models whose entry has this "split"
   std::string json_out;
 };
 
+// What image-to-3D generators emit: base colour only. Metallic and roughness
+// go to glTF's defaults (1, 1), their texture and transmission are dropped.
+void reduce_to_base_color(Model& model) {
+  for (SourceMaterial& m : model.materials) {
+    m.metallic = 1.f;
+    m.roughness = 1.f;
+    m.transmission = 0.f;
+    m.metallic_roughness_texture = Texture{};
+  }
+}
+
 int run_eval_seg(const EvalArgs& args) {
   namespace fs = std::filesystem;
-  const std::string labels_path = (fs::path(args.assets) / "labels.json").string();
+  const std::string labels_path = args.truth.empty() ? (fs::path(args.assets) / "labels.json").string() : args.truth;
   std::ifstream in(labels_path, std::ios::binary);
   if (!in) {
     std::cerr << "g2p eval seg: error: " << labels_path << ": cannot open (use --assets DIR)\n";
@@ -46,7 +60,14 @@ int run_eval_seg(const EvalArgs& args) {
   }
   std::vector<std::string> keys = args.models;
   if (keys.empty())
-    for (const auto& item : labels["models"].items()) keys.push_back(item.key());
+    for (const auto& item : labels["models"].items())
+      if (args.split.empty() || (item.value().is_object() && item.value().value("split", "") == args.split))
+        keys.push_back(item.key());
+  if (keys.empty()) {
+    std::cerr << "g2p eval seg: error: " << labels_path << ": no model"
+              << (args.split.empty() ? "" : " of split '" + args.split + "'") << "\n";
+    return kExitFailure;
+  }
 
   int exit_code = kExitOk;
   Result<MaterialTable> table = load_table_flag("eval seg", args.materials, exit_code);
@@ -58,7 +79,11 @@ int run_eval_seg(const EvalArgs& args) {
   CalibrationBins calibration;
   nlohmann::json per_model = nlohmann::json::object();
   for (const std::string& key : keys) {
-    const std::string path = (fs::path(args.assets) / key / (key + ".glb")).string();
+    // A key that is a model file's path relative to `assets` (a generated
+    // dataset's labels.json), else the shared assets' NAME/NAME.glb.
+    const fs::path as_file = fs::path(args.assets) / key;
+    const std::string path =
+        fs::is_regular_file(as_file) ? as_file.string() : (fs::path(args.assets) / key / (key + ".glb")).string();
     Result<Model> model = load_model(path);
     if (!model.ok()) {
       std::cerr << "g2p eval seg: error: " << model.status().to_string() << "\n";
@@ -71,6 +96,7 @@ int run_eval_seg(const EvalArgs& args) {
       return kExitFailure;
     }
     if (args.anonymize) anonymize_names(*model);  // after the oracle: it reads indices, not names
+    if (args.base_color_only) reduce_to_base_color(*model);
     Result<std::vector<View>> views = render_with_flags("eval seg", *model, args.views, exit_code);
     if (!views.ok()) return exit_code;
     if (s = (*predictor)->set_model(*model, *table); !s.ok()) {
@@ -133,6 +159,7 @@ int run_eval_seg(const EvalArgs& args) {
   if (!args.json_out.empty()) {
     const nlohmann::json doc = {{"segmenter", args.segmenter.name},
                                 {"anonymized_names", args.anonymize},
+                                {"base_color_only", args.base_color_only},
                                 {"views", args.views.views},
                                 {"resolution", args.views.resolution},
                                 {"total", nlohmann::json::parse(total.to_json(*table))},
@@ -223,6 +250,11 @@ void add_eval_command(CLI::App& app, Command& run) {
   seg->add_option("--models", args->models, "Only these models (keys of labels.json)")->delimiter(',');
   seg->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
   seg->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one before segmenting");
+  seg->add_flag("--base-color-only", args->base_color_only,
+                "Reduce every material to its base colour (metallic and roughness at glTF's defaults), as "
+                "image-to-3D meshes are");
+  seg->add_option("--truth", args->truth, "labels.json (default: ASSETS/labels.json); keys may be model paths");
+  seg->add_option("--split", args->split, "Only the models whose labels.json entry has this \"split\"");
   seg->add_option("--json", args->json_out, "Also write the results as JSON to this file");
   add_view_flags(seg, args->views);
   add_segmenter_flags(seg, args->segmenter);

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "g2p/export.h"
@@ -65,6 +66,13 @@ G2P_API Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& nam
 // without an entry map to kUnknownLabel; a class name not in `table` is an error.
 G2P_API Result<std::vector<int>> material_labels_from_json(const std::string& json_text, const std::string& key,
                                                            const MaterialTable& table, int num_materials);
+
+// How strongly a name (of a material, texture file or mesh) says what the
+// surface is made of, per class of `table`: 0 (not at all) to 1 (a material
+// word such as "oak", "Stahl", "velours"). The multilingual lexicon of the
+// `pbr` backend (docs/segment.md); also the labelling rule of the training
+// data (docs/training.md).
+G2P_API std::vector<float> material_name_evidence(std::string_view name, const MaterialTable& table);
 
 // ---- Output -----------------------------------------------------------------
 

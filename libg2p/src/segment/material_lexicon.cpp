@@ -11,6 +11,8 @@
 // (a country as often as porcelain), "board" (wood, paper or circuit).
 #include "segment/material_lexicon.h"
 
+#include "g2p/segment.h"
+
 #include <algorithm>
 #include <cctype>
 
@@ -171,3 +173,11 @@ std::vector<float> name_evidence(std::string_view text, const MaterialTable& tab
 }
 
 }  // namespace g2p::detail
+
+namespace g2p {
+
+std::vector<float> material_name_evidence(std::string_view name, const MaterialTable& table) {
+  return detail::name_evidence(name, table);
+}
+
+}  // namespace g2p

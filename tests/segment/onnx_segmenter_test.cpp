@@ -87,3 +87,44 @@ TEST(OnnxSegmenter, ModelCardErrors) {
 
 }  // namespace
 }  // namespace g2p
+
+namespace g2p {
+namespace {
+
+// `learned`: names where they name a material, the network elsewhere. The blue
+// box is called "oak" (the tiny network says Glass for blue), the red one "a".
+TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
+  const std::string dir = make_model_dir();
+  const Model model =
+      test::boxes({{"a", {1, 0, 0, 1}, 0.f, 1.f}, {"b", {0, 1, 0, 1}, 0.f, 1.f}, {"oak", {0, 0, 1, 1}, 0.f, 1.f}},
+                  "LearnedSegmenter.boxes");
+  const std::vector<View> views = test::render(model, 2, 96);
+  const MaterialTable& table = MaterialTable::paper_default();
+  auto labels = [&](const BackendSettings& settings) {
+    Result<std::unique_ptr<Segmenter>> s = make_segmenter("learned", settings);
+    EXPECT_TRUE(s.ok()) << s.status().to_string();
+    std::vector<LabelMap> maps(views.size());
+    if (!s.ok() || !(*s)->set_model(model, table).ok()) return std::vector<int>{};
+    for (std::size_t i = 0; i < views.size(); ++i) EXPECT_TRUE((*s)->segment_into(views[i], maps[i]).ok());
+    return std::vector<int>{test::majority_label(model, views, maps, 0), test::majority_label(model, views, maps, 1),
+                            test::majority_label(model, views, maps, 2)};
+  };
+  const std::string card = dir + "/card_rgb.json";
+  EXPECT_EQ(labels({{"model_card", card}}),
+            (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Wood")}));
+  // names=off: the network alone calls the blue box Glass.
+  EXPECT_EQ(labels({{"model_card", card}, {"names", "off"}}),
+            (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Glass")}));
+
+  // Without a card it cannot run, and says why; bad settings fail at once.
+  Result<std::unique_ptr<Segmenter>> bare = make_segmenter("learned");
+  ASSERT_TRUE(bare.ok());
+  Status s = (*bare)->set_model(model, table);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("model_card"), std::string::npos) << s.message();
+  EXPECT_FALSE(make_segmenter("learned", {{"model_card", card}, {"names", "2"}}).ok());
+  EXPECT_FALSE(make_segmenter("learned", {{"colour", "blue"}}).ok());
+}
+
+}  // namespace
+}  // namespace g2p

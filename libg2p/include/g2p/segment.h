@@ -51,7 +51,8 @@ class G2P_API Segmenter {
   Result<LabelMap> segment(const View& view) const;
 };
 
-// Backends by name: "pbr" (the default), "onnx", "oracle".
+// Backends by name: "pbr" (the default), "onnx", "oracle", "learned" (a
+// network where names say nothing, names where they do; docs/training.md).
 G2P_API Registry<Segmenter>& segmenter_registry();
 
 // Creates a backend and applies its settings.

@@ -11,5 +11,6 @@ namespace g2p {
 std::unique_ptr<Segmenter> make_pbr_segmenter();
 std::unique_ptr<Segmenter> make_onnx_segmenter();
 std::unique_ptr<Segmenter> make_oracle_segmenter();
+std::unique_ptr<Segmenter> make_learned_segmenter();
 
 }  // namespace g2p

@@ -23,6 +23,7 @@ Registry<Segmenter>& segmenter_registry() {
     (void)r->add("pbr", &make_pbr_segmenter);
     (void)r->add("onnx", &make_onnx_segmenter);
     (void)r->add("oracle", &make_oracle_segmenter);
+    (void)r->add("learned", &make_learned_segmenter);
     return r;
   }();
   return *registry;

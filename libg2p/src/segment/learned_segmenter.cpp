@@ -1,0 +1,101 @@
+// The `learned` segmenter: a trained network (the `onnx` backend) where the
+// model's names say nothing, the `pbr` backend where they do. Rule, per pixel:
+// the face seen there has a source material; when that material's name (or
+// its base-colour texture's file name) names a material class outright
+// (material_name_evidence >= `names` threshold for one class, none other above
+// 0.5), the pixel takes `pbr`'s labels and probabilities, which follow the
+// name; otherwise it takes the network's. Names, where authors wrote them, are
+// right far more often than any image model (docs/accuracy.md); generated
+// meshes have none, and then the network decides everything.
+//
+// Settings: model_card = FILE (required: the network's card, docs/segment.md);
+// names = threshold in (0, 1] (default 0.9) or "off" (the network alone).
+#include <algorithm>
+
+#include "core/settings.h"
+#include "segment/backends.h"
+
+namespace g2p {
+namespace {
+
+class LearnedSegmenter final : public Segmenter {
+ public:
+  Status configure(const BackendSettings& settings) override {
+    BackendSettings network;
+    for (const auto& [key, value] : settings) {
+      if (key == "model_card") {
+        network[key] = value;
+      } else if (key == "names") {
+        double v = 0;
+        if (value == "off")
+          threshold_ = 2.0;  // never reached
+        else if (detail::parse_double(value, v) && v > 0 && v <= 1)
+          threshold_ = v;
+        else
+          return Status::InvalidArgument("learned: names needs a threshold in (0, 1] or 'off', got '" + value + "'");
+      } else {
+        return Status::InvalidArgument("learned: unknown setting '" + key + "' (known: model_card, names)");
+      }
+    }
+    if (network.empty()) return Status::Ok();  // checked in set_model: the registry creates unconfigured backends
+    network_ = make_onnx_segmenter();
+    G2P_RETURN_IF_ERROR(network_->configure(network));
+    configured_ = true;
+    return Status::Ok();
+  }
+
+  Status set_model(const Model& model, const MaterialTable& table) override {
+    if (!configured_)
+      return Status::InvalidArgument("learned: needs the network's model card (setting model_card=FILE)");
+    G2P_RETURN_IF_ERROR(network_->set_model(model, table));
+    G2P_RETURN_IF_ERROR(names_->set_model(model, table));
+    model_ = &model;
+    named_.assign(model.materials.size(), 0);
+    for (std::size_t m = 0; m < model.materials.size(); ++m) {
+      const SourceMaterial& mat = model.materials[m];
+      std::string text = mat.name;
+      if (!mat.base_color_texture.uri.empty()) text += " " + mat.base_color_texture.uri;
+      std::vector<float> e = material_name_evidence(text, table);
+      std::sort(e.begin(), e.end(), std::greater<float>());
+      named_[m] = !e.empty() && e[0] >= threshold_ && (e.size() < 2 || e[1] <= 0.5f);
+    }
+    return Status::Ok();
+  }
+
+  Status segment_into(const View& view, LabelMap& out) const override {
+    if (model_ == nullptr) return Status::InvalidArgument("learned: set_model first");
+    G2P_RETURN_IF_ERROR(network_->segment_into(view, out));
+    if (std::none_of(named_.begin(), named_.end(), [](char n) { return n != 0; })) return Status::Ok();
+    LabelMap by_name;
+    G2P_RETURN_IF_ERROR(names_->segment_into(view, by_name));
+    const Mesh& mesh = model_->mesh;
+    const bool probabilities = !out.probabilities.empty() && !by_name.probabilities.empty() &&
+                               out.probabilities.channels() == by_name.probabilities.channels();
+    for (int y = 0; y < view.face_id.height(); ++y)
+      for (int x = 0; x < view.face_id.width(); ++x) {
+        const int f = view.face_id.at(x, y);
+        if (f < 0 || mesh.face_source.empty()) continue;
+        const int m = mesh.face_source[static_cast<std::size_t>(f)].material;
+        if (m < 0 || m >= static_cast<int>(named_.size()) || !named_[static_cast<std::size_t>(m)]) continue;
+        out.labels.at(x, y) = by_name.labels.at(x, y);
+        if (probabilities)
+          std::copy_n(by_name.probabilities.pixel(x, y), by_name.probabilities.channels(),
+                      out.probabilities.pixel(x, y));
+      }
+    return Status::Ok();
+  }
+
+ private:
+  std::unique_ptr<Segmenter> network_;
+  std::unique_ptr<Segmenter> names_ = make_pbr_segmenter();
+  bool configured_ = false;
+  double threshold_ = 0.9;
+  const Model* model_ = nullptr;
+  std::vector<char> named_;  // per source material: its name names a class
+};
+
+}  // namespace
+
+std::unique_ptr<Segmenter> make_learned_segmenter() { return std::make_unique<LearnedSegmenter>(); }
+
+}  // namespace g2p

@@ -11,6 +11,9 @@ install(FILES ${PROJECT_BINARY_DIR}/libg2p/generated/include/g2p/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/g2p)
 install(FILES ${PROJECT_SOURCE_DIR}/libg2p/data/materials.json ${PROJECT_SOURCE_DIR}/libg2p/data/refine_prompt.txt
         DESTINATION ${CMAKE_INSTALL_DATADIR}/g2p)
+if(EXISTS ${PROJECT_SOURCE_DIR}/libg2p/data/models)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/libg2p/data/models DESTINATION ${CMAKE_INSTALL_DATADIR}/g2p)
+endif()
 
 install(TARGETS g2p EXPORT g2pTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT development

@@ -116,8 +116,8 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
   EXPECT_EQ(labels({{"model_card", card}, {"names", "off"}}),
             (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Glass")}));
 
-  // Without a card it cannot run, and says why; bad settings fail at once.
-  Result<std::unique_ptr<Segmenter>> bare = make_segmenter("learned");
+  // Unconfigured it has no network and says how to give it one; bad settings fail at once.
+  Result<std::unique_ptr<Segmenter>> bare = segmenter_registry().create("learned");
   ASSERT_TRUE(bare.ok());
   Status s = (*bare)->set_model(model, table);
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);

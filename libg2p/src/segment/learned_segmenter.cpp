@@ -8,15 +8,39 @@
 // right far more often than any image model (docs/accuracy.md); generated
 // meshes have none, and then the network decides everything.
 //
-// Settings: model_card = FILE (required: the network's card, docs/segment.md);
-// names = threshold in (0, 1] (default 0.9) or "off" (the network alone).
+// Settings: model_card = FILE (default: the network libg2p ships, found in
+// $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
+// share/g2p/models); names = threshold in (0, 1] (default 0.9) or "off" (the
+// network alone).
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 
 #include "core/settings.h"
 #include "segment/backends.h"
 
 namespace g2p {
 namespace {
+
+constexpr const char* kShippedCard = "g2p-materials.json";
+
+// The shipped network's card, or "" when none is found.
+std::string shipped_model_card() {
+  std::vector<std::string> dirs;
+  if (const char* env = std::getenv("G2P_MODEL_DIR"); env != nullptr && *env != '\0') dirs.emplace_back(env);
+#ifdef G2P_SOURCE_MODEL_DIR
+  dirs.emplace_back(G2P_SOURCE_MODEL_DIR);
+#endif
+#ifdef G2P_INSTALL_MODEL_DIR
+  dirs.emplace_back(G2P_INSTALL_MODEL_DIR);
+#endif
+  for (const std::string& d : dirs) {
+    std::error_code ec;
+    const std::filesystem::path card = std::filesystem::path(d) / kShippedCard;
+    if (std::filesystem::is_regular_file(card, ec)) return card.string();
+  }
+  return {};
+}
 
 class LearnedSegmenter final : public Segmenter {
  public:
@@ -37,7 +61,11 @@ class LearnedSegmenter final : public Segmenter {
         return Status::InvalidArgument("learned: unknown setting '" + key + "' (known: model_card, names)");
       }
     }
-    if (network.empty()) return Status::Ok();  // checked in set_model: the registry creates unconfigured backends
+    if (network.empty()) {
+      const std::string card = shipped_model_card();
+      if (card.empty()) return Status::Ok();  // set_model says what is missing
+      network["model_card"] = card;
+    }
     network_ = make_onnx_segmenter();
     G2P_RETURN_IF_ERROR(network_->configure(network));
     configured_ = true;
@@ -46,7 +74,9 @@ class LearnedSegmenter final : public Segmenter {
 
   Status set_model(const Model& model, const MaterialTable& table) override {
     if (!configured_)
-      return Status::InvalidArgument("learned: needs the network's model card (setting model_card=FILE)");
+      return Status::InvalidArgument(
+          "learned: no network: give its card (setting model_card=FILE) or put the shipped g2p-materials.json in "
+          "$G2P_MODEL_DIR");
     G2P_RETURN_IF_ERROR(network_->set_model(model, table));
     G2P_RETURN_IF_ERROR(names_->set_model(model, table));
     model_ = &model;

@@ -1,0 +1,72 @@
+// Segmentation time per 512 x 512 view: the `onnx` backend running a network
+// (the card named by $G2P_BENCH_MODEL_CARD, e.g. the one tools/training/train.py
+// writes; skipped without it) and the `learned` backend with the same network,
+// against the weight-free `pbr` backend on the same views in the same run.
+// SheenChair as shipped, its 11 default views. docs/performance.md and
+// docs/training.md record the figures:
+//
+//   G2P_BENCH_MODEL_CARD=data/model/g2p-materials.json build/bin/g2p_segment_benchmark --benchmark_min_time=2
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include "g2p/io.h"
+#include "g2p/render.h"
+#include "g2p/segment.h"
+
+namespace {
+
+struct Scene {
+  g2p::Model model;
+  std::vector<g2p::View> views;
+};
+
+const Scene& scene() {
+  static const Scene s = [] {
+    Scene sc;
+    g2p::Result<g2p::Model> m = g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/SheenChair/SheenChair.glb");
+    if (!m.ok()) throw std::runtime_error(m.status().to_string());
+    sc.model = std::move(*m);
+    auto renderer = g2p::renderer_registry().create("embree");
+    sc.views = *g2p::render_views(**renderer, sc.model, *g2p::make_views(sc.model.mesh));
+    return sc;
+  }();
+  return s;
+}
+
+void BM_Segment(benchmark::State& state, const std::string& backend, bool needs_card) {
+  g2p::BackendSettings settings;
+  if (needs_card) {
+    const char* card = std::getenv("G2P_BENCH_MODEL_CARD");
+    if (card == nullptr || *card == '\0') {
+      state.SkipWithError("set G2P_BENCH_MODEL_CARD to a network's model card");
+      return;
+    }
+    settings["model_card"] = card;
+  }
+  const Scene& s = scene();
+  auto segmenter = g2p::make_segmenter(backend, settings);
+  if (!segmenter.ok() || !(*segmenter)->set_model(s.model, g2p::MaterialTable::paper_default()).ok()) {
+    state.SkipWithError(segmenter.ok() ? "set_model failed" : segmenter.status().to_string().c_str());
+    return;
+  }
+  g2p::LabelMap out;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    if (!(*segmenter)->segment_into(s.views[i++ % s.views.size()], out).ok()) {
+      state.SkipWithError("segment_into failed");
+      return;
+    }
+  }
+  state.counters["views_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+BENCHMARK_CAPTURE(BM_Segment, pbr, std::string("pbr"), false)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Segment, onnx, std::string("onnx"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Segment, learned, std::string("learned"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -100,8 +100,8 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
                   "LearnedSegmenter.boxes");
   const std::vector<View> views = test::render(model, 2, 96);
   const MaterialTable& table = MaterialTable::paper_default();
-  auto labels = [&](const BackendSettings& settings) {
-    Result<std::unique_ptr<Segmenter>> s = make_segmenter("learned", settings);
+  auto labels = [&](const std::string& backend, const BackendSettings& settings) {
+    Result<std::unique_ptr<Segmenter>> s = make_segmenter(backend, settings);
     EXPECT_TRUE(s.ok()) << s.status().to_string();
     std::vector<LabelMap> maps(views.size());
     if (!s.ok() || !(*s)->set_model(model, table).ok()) return std::vector<int>{};
@@ -110,11 +110,15 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
                             test::majority_label(model, views, maps, 2)};
   };
   const std::string card = dir + "/card_rgb.json";
-  EXPECT_EQ(labels({{"model_card", card}}),
+  // Names only (pbr=off): "oak" is Wood whatever the network says; the others are the network's.
+  EXPECT_EQ(labels("learned", {{"model_card", card}, {"pbr", "off"}}),
             (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Wood")}));
-  // names=off: the network alone calls the blue box Glass.
-  EXPECT_EQ(labels({{"model_card", card}, {"names", "off"}}),
+  // names=off too: the network alone calls the blue box Glass.
+  EXPECT_EQ(labels("learned", {{"model_card", card}, {"names", "off"}, {"pbr", "off"}}),
             (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Glass")}));
+  // By default authored PBR counts: these boxes are dielectric (metallic 0, not glTF's default 1),
+  // so every pixel follows pbr.
+  EXPECT_EQ(labels("learned", {{"model_card", card}}), labels("pbr", {}));
 
   // Unconfigured it has no network and says how to give it one; bad settings fail at once.
   Result<std::unique_ptr<Segmenter>> bare = segmenter_registry().create("learned");

@@ -1,17 +1,19 @@
 // The `learned` segmenter: a trained network (the `onnx` backend) where the
-// model's names say nothing, the `pbr` backend where they do. Rule, per pixel:
-// the face seen there has a source material; when that material's name (or
-// its base-colour texture's file name) names a material class outright
-// (material_name_evidence >= `names` threshold for one class, none other above
-// 0.5), the pixel takes `pbr`'s labels and probabilities, which follow the
-// name; otherwise it takes the network's. Names, where authors wrote them, are
-// right far more often than any image model (docs/accuracy.md); generated
-// meshes have none, and then the network decides everything.
+// model's names and PBR channels say nothing, the `pbr` backend where they
+// do. Rule, per pixel: the face seen there has a source material; when that
+// material's name (or its base-colour texture's file name) names a material
+// class outright (material_name_evidence >= `names` threshold for one class,
+// none other above 0.5), or its PBR values were authored (a metallic-roughness
+// texture, transmission, or metallic/roughness other than glTF's defaults of
+// 1), the pixel takes `pbr`'s labels and probabilities; otherwise the
+// network's. Names and authored PBR, where present, are right far more often
+// than the network (docs/accuracy.md); image-to-3D meshes carry neither, and
+// then the network decides everything.
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
 // $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
 // share/g2p/models); names = threshold in (0, 1] (default 0.9) or "off" (the
-// network alone).
+// network alone); pbr = on (default) or off (authored PBR values do not count).
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -57,8 +59,11 @@ class LearnedSegmenter final : public Segmenter {
           threshold_ = v;
         else
           return Status::InvalidArgument("learned: names needs a threshold in (0, 1] or 'off', got '" + value + "'");
+      } else if (key == "pbr" && (value == "on" || value == "off")) {
+        trust_pbr_ = value == "on";
       } else {
-        return Status::InvalidArgument("learned: unknown setting '" + key + "' (known: model_card, names)");
+        return Status::InvalidArgument("learned: bad setting " + key + "=" + value +
+                                       " (known: model_card=FILE, names=THRESHOLD|off, pbr=on|off)");
       }
     }
     if (network.empty()) {
@@ -87,7 +92,12 @@ class LearnedSegmenter final : public Segmenter {
       if (!mat.base_color_texture.uri.empty()) text += " " + mat.base_color_texture.uri;
       std::vector<float> e = material_name_evidence(text, table);
       std::sort(e.begin(), e.end(), std::greater<float>());
-      named_[m] = !e.empty() && e[0] >= threshold_ && (e.size() < 2 || e[1] <= 0.5f);
+      const bool named = !e.empty() && e[0] >= threshold_ && (e.size() < 2 || e[1] <= 0.5f);
+      // PBR values an author set (not glTF's defaults): a metallic-roughness
+      // texture, transmission, or metallic/roughness other than (1, 1).
+      const bool authored_pbr = trust_pbr_ && (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f ||
+                                               mat.metallic < 1.f || mat.roughness < 1.f);
+      named_[m] = named || authored_pbr;
     }
     return Status::Ok();
   }
@@ -120,6 +130,7 @@ class LearnedSegmenter final : public Segmenter {
   std::unique_ptr<Segmenter> names_ = make_pbr_segmenter();
   bool configured_ = false;
   double threshold_ = 0.9;
+  bool trust_pbr_ = true;
   const Model* model_ = nullptr;
   std::vector<char> named_;  // per source material: its name names a class
 };

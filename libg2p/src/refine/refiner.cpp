@@ -46,8 +46,8 @@ Status apply_refinement(const Mesh& mesh, const std::vector<int>& labels, const 
                                    std::to_string(n) + " faces, or a projection of another mesh");
   const std::vector<float> voted_confidence = projection.labels.confidence;
   projection.labels.label = labels;
-  projection.parts = partition(mesh, projection.graph, projection.labels.label, projection.face_part, options,
-                               &voted_confidence);
+  projection.parts =
+      partition(mesh, projection.graph, projection.labels.label, projection.face_part, options, &voted_confidence);
   for (std::size_t f = 0; f < n; ++f) {
     const float* h = projection.votes.of(static_cast<int>(f));
     const int l = projection.labels.label[f];

@@ -133,6 +133,7 @@ def main():
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--max-minutes", type=float, default=0, help="stop after this long (0 = no limit)")
+    ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
     a = ap.parse_args()
 
     random.seed(a.seed)
@@ -149,7 +150,10 @@ def main():
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)
     data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True), batch_size=a.batch, shuffle=True,
                                        num_workers=0, drop_last=True)
-    model = UNet().to(a.device)
+    model = UNet()
+    if a.init:
+        model.load_state_dict(torch.load(a.init, map_location="cpu"))
+    model = model.to(a.device)
     params = sum(p.numel() for p in model.parameters())
     opt = torch.optim.AdamW(model.parameters(), lr=a.lr, weight_decay=1e-4)
     steps = a.epochs * len(data)

@@ -16,7 +16,16 @@ std::string assimp_model(const std::string& relative) { return std::string(G2P_T
 std::string source_path(const std::string& relative) { return std::string(G2P_TEST_SOURCE_DIR) + "/" + relative; }
 
 std::string scratch_dir(const std::string& test_name) {
-  const std::filesystem::path dir = std::filesystem::path(G2P_TEST_BINARY_DIR) / "scratch" / test_name;
+  // ctest runs tests in parallel, and several tests may ask for the same name
+  // (a shared fixture): the running test's own name keeps their folders apart.
+  std::filesystem::path dir = std::filesystem::path(G2P_TEST_BINARY_DIR) / "scratch";
+  if (const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    std::string running = std::string(info->test_suite_name()) + "." + info->name();
+    for (char& c : running)
+      if (c == '/') c = '_';
+    dir /= running;
+  }
+  dir /= test_name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

@@ -13,7 +13,8 @@ std::string assimp_model(const std::string& relative);
 // A file of the source tree, e.g. source_path("examples/data/hammer.obj").
 std::string source_path(const std::string& relative);
 
-// A fresh, empty folder for one test under the build tree.
+// A fresh, empty folder under the build tree, kept apart per running test
+// (build/tests/scratch/Suite.Test/NAME), so tests that share a name can run in parallel.
 std::string scratch_dir(const std::string& test_name);
 
 std::string read_file(const std::string& path);

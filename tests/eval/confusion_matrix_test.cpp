@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 namespace g2p {
@@ -60,6 +61,16 @@ TEST(ConfusionMatrix, ImagesFacesAndMerging) {
   sum.merge(m);
   sum.merge(faces);
   EXPECT_DOUBLE_EQ(sum.count(0, 0), 3.0);
+
+  // Normalised merges: each matrix counts the same, whatever its units.
+  ConfusionMatrix equal(2);
+  equal.merge(faces, 1.0 / faces.total());
+  equal.merge(m, 1.0 / m.total());
+  EXPECT_DOUBLE_EQ(equal.total(), 2.0);
+  EXPECT_DOUBLE_EQ(equal.count(0, 0), 2.0 / 2.5 + 0.5);
+  EXPECT_DOUBLE_EQ(equal.count(1, 0), 0.5 / 2.5 + 0.5);
+  equal.merge(faces, std::numeric_limits<double>::infinity());  // an empty matrix's 1 / 0 adds nothing
+  EXPECT_DOUBLE_EQ(equal.total(), 2.0);
 }
 
 TEST(ConfusionMatrix, TableAndJson) {

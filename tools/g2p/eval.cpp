@@ -75,7 +75,10 @@ int run_eval_seg(const EvalArgs& args) {
   Result<std::unique_ptr<Segmenter>> predictor = make_segmenter_flag("eval seg", args.segmenter, exit_code);
   if (!predictor.ok()) return exit_code;
 
-  ConfusionMatrix total(table->size()), total_3d(table->size());
+  // total_3d pools every face by its area; per_model_3d scales each model's
+  // matrix to one first, so that no model dominates by its size or units
+  // (sweethome3d models range from millimetres to metres).
+  ConfusionMatrix total(table->size()), total_3d(table->size()), per_model_3d(table->size());
   CalibrationBins calibration;
   nlohmann::json per_model = nlohmann::json::object();
   for (const std::string& key : keys) {
@@ -143,6 +146,7 @@ int run_eval_seg(const EvalArgs& args) {
     }
     total.merge(matrix);
     total_3d.merge(matrix_3d);
+    if (matrix_3d.total() > 0) per_model_3d.merge(matrix_3d, 1.0 / matrix_3d.total());
     std::printf(
         "%-28s 2D: %9.0f px, accuracy %6.2f %%, mIoU %6.2f %% | 3D: %8.4f m^2, accuracy %6.2f %%, mIoU %6.2f %%\n",
         key.c_str(), matrix.total(), 100.0 * matrix.accuracy(), 100.0 * matrix.mean_iou(), matrix_3d.total(),
@@ -152,7 +156,8 @@ int run_eval_seg(const EvalArgs& args) {
   }
   std::printf("\nAll %zu models, one confusion matrix (%.0f labelled pixels), IoU %%:\n", keys.size(), total.total());
   std::cout << total.table(*table) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
-            << total_3d.table(*table);
+            << total_3d.table(*table) << "\nPer face (3D, after voting), each model weighing the same, IoU %:\n"
+            << per_model_3d.table(*table);
   if (calibration.accuracy() == calibration.accuracy())  // has probabilities
     std::printf("calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n", calibration.mean_confidence(),
                 calibration.accuracy(), calibration.expected_calibration_error());
@@ -164,6 +169,7 @@ int run_eval_seg(const EvalArgs& args) {
                                 {"resolution", args.views.resolution},
                                 {"total", nlohmann::json::parse(total.to_json(*table))},
                                 {"total_3d", nlohmann::json::parse(total_3d.to_json(*table))},
+                                {"total_3d_per_model", nlohmann::json::parse(per_model_3d.to_json(*table))},
                                 {"calibration",
                                  {{"ece", calibration.expected_calibration_error()},
                                   {"mean_confidence", calibration.mean_confidence()},

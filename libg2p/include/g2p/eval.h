@@ -30,7 +30,9 @@ class G2P_API ConfusionMatrix {
   Status add(const ImageI32& truth, const ImageI32& predicted);
   // Every face, weighted by its area in m^2.
   Status add_faces(const Mesh& mesh, const std::vector<int>& truth, const std::vector<int>& predicted);
-  void merge(const ConfusionMatrix& other);
+  // Adds `other`'s counts, each times `weight`: merge(m, 1 / m.total()) makes
+  // every merged matrix count the same (models in different units, say).
+  void merge(const ConfusionMatrix& other, double weight = 1.0);
 
   // Weight with ground truth `truth` predicted as `predicted` (kUnknownLabel allowed).
   double count(int truth, int predicted) const;

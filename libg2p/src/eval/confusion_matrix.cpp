@@ -40,9 +40,9 @@ Status ConfusionMatrix::add_faces(const Mesh& mesh, const std::vector<int>& trut
   return Status::Ok();
 }
 
-void ConfusionMatrix::merge(const ConfusionMatrix& other) {
-  if (other.num_classes_ != num_classes_) return;
-  for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += other.counts_[i];
+void ConfusionMatrix::merge(const ConfusionMatrix& other, double weight) {
+  if (other.num_classes_ != num_classes_ || !std::isfinite(weight)) return;
+  for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += weight * other.counts_[i];
 }
 
 double ConfusionMatrix::count(int truth, int predicted) const {

@@ -102,12 +102,29 @@ TEST(ToolEval, ReproducesAHandComputedMeanIoU) {
 }
 
 TEST(ToolEval, SharedAssetsWithAndWithoutNames) {
+  const std::string json = test::scratch_dir("ToolEval.Shared") + "/eval.json";
   for (const char* flag : {"", " --anonymize-names"}) {
     test::ToolRun r = run_tool(std::string("eval seg --assets ") + quote(test::source_path("../shared/assets")) +
-                               " --views 2 --resolution 48 --models Avocado,SheenChair" + flag);
+                               " --views 2 --resolution 48 --models Avocado,SheenChair --json " + quote(json) + flag);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("SheenChair"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("mIoU"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("each model weighing the same"), std::string::npos) << r.out;
+
+    // total_3d_per_model is the sum of each model's 3D matrix scaled to one: the tiny avocado
+    // (0.006 m^2) counts as much as the chair (1.7 m^2).
+    const nlohmann::json j = nlohmann::json::parse(test::read_file(json));
+    const nlohmann::json& equal = j["total_3d_per_model"];
+    EXPECT_NEAR(equal["total_weight"].get<double>(), 2.0, 1e-9);
+    const std::string key = "matrix_rows_truth_columns_predicted_then_unknown";
+    for (std::size_t row = 0; row < equal[key].size(); ++row)
+      for (std::size_t col = 0; col < equal[key][row].size(); ++col) {
+        double expected = 0;
+        for (const char* model : {"Avocado", "SheenChair"}) {
+          const nlohmann::json& m = j["models"][model]["3d"];
+          expected += m[key][row][col].get<double>() / m["total_weight"].get<double>();
+        }
+        EXPECT_NEAR(equal[key][row][col].get<double>(), expected, 1e-9) << row << " " << col;
+      }
   }
   EXPECT_EQ(run_tool("eval seg --assets /nonexistent").exit_code, 1);
 }

@@ -3,6 +3,7 @@
 //
 //   g2p_make_dataset OUT LIBRARY_DIR... [--views 8] [--size 160] [--seed 1]
 //                    [--overrides tools/training/overrides.json] [--test KatorLegaz,Reallusion]
+//                    [--pbr-defaults 0.5]
 //
 // Each LIBRARY_DIR is an unpacked furniture library (Sweet Home 3D's .sh3f
 // zip files hold OBJ/MTL models); its folder name names the library. Every
@@ -95,6 +96,7 @@ struct Args {
   std::string overrides, test = "KatorLegaz,Reallusion";
   double min_labelled = 0.2;
   int max_models = 0;
+  double pbr_defaults = 0.5;  // share of models given glTF's default metallic and roughness
 };
 
 int run(const Args& a) {
@@ -185,10 +187,10 @@ int run(const Args& a) {
       ++models_used;
 
       // Appearance as generated meshes have it: glTF's default metallic and
-      // roughness on half the models, textures dropped on a quarter, colours
-      // whitened (shape only) on a tenth.
+      // roughness on a share of models (--pbr-defaults), textures dropped on a
+      // quarter, colours whitened (shape only) on a tenth.
       std::uniform_real_distribution<double> u(0.0, 1.0);
-      const bool defaults = u(rng) < 0.5, no_textures = u(rng) < 0.25, white = u(rng) < 0.1;
+      const bool defaults = u(rng) < a.pbr_defaults, no_textures = u(rng) < 0.25, white = u(rng) < 0.1;
       for (g2p::SourceMaterial& m : model.materials) {
         if (defaults) m.metallic = 1.f, m.roughness = 1.f, m.metallic_roughness_texture = g2p::Texture{};
         if (no_textures || white) m.base_color_texture = g2p::Texture{};
@@ -268,6 +270,9 @@ int main(int argc, char** argv) {
   app.add_option("--overrides", a.overrides, "Reviewed label overrides (JSON)");
   app.add_option("--test", a.test, "Libraries held out as the test split (default KatorLegaz,Reallusion)");
   app.add_option("--min-labelled", a.min_labelled, "Skip models with less labelled area (default 0.2)");
+  app.add_option("--pbr-defaults", a.pbr_defaults,
+                 "Share of models rendered with glTF's default metallic and roughness (default 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--max-models", a.max_models, "At most this many models per library (0 = all)");
   CLI11_PARSE(app, argc, argv);
   return run(a);

@@ -43,17 +43,19 @@ def read_png(path):
 
 
 class Dataset(torch.utils.data.Dataset):
+    """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image)."""
+
     def __init__(self, root, rows, size, train):
-        self.root, self.rows, self.size, self.train = root, rows, size, train
+        self.size, self.train = size, train
+        self.rgb = torch.from_numpy(np.stack([read_png(os.path.join(root, "images", r["image"])) for r in rows]))
+        self.label = torch.from_numpy(np.stack([read_png(os.path.join(root, "labels", r["image"])) for r in rows]))
 
     def __len__(self):
-        return len(self.rows)
+        return len(self.label)
 
     def __getitem__(self, i):
-        name = self.rows[i]["image"]
-        rgb = torch.from_numpy(np.array(read_png(os.path.join(self.root, "images", name)))).float() / 255
-        label = torch.from_numpy(read_png(os.path.join(self.root, "labels", name)).astype(np.int64))
-        rgb = rgb.permute(2, 0, 1)
+        rgb = self.rgb[i].permute(2, 0, 1).float() / 255
+        label = self.label[i].long()
         if self.train:
             rgb, label = augment(rgb, label, self.size)
         rgb = (rgb - torch.tensor(MEAN)[:, None, None]) / torch.tensor(STD)[:, None, None]
@@ -61,11 +63,18 @@ class Dataset(torch.utils.data.Dataset):
 
 
 def augment(rgb, label, size):
-    # Random resized crop (scale 0.6-1 of the side), flip.
+    # Random resized crop (0.6-1 of the side) centred near a labelled pixel, so that crops hold the object
+    # rather than the background; flip.
     h, w = label.shape
     s = random.uniform(0.6, 1.0)
     ch, cw = int(h * s), int(w * s)
-    y, x = random.randint(0, h - ch), random.randint(0, w - cw)
+    ys, xs = torch.nonzero(label != 255, as_tuple=True)
+    if len(ys):
+        k = random.randrange(len(ys))
+        y = min(max(int(ys[k]) - ch // 2, 0), h - ch)
+        x = min(max(int(xs[k]) - cw // 2, 0), w - cw)
+    else:
+        y, x = random.randint(0, h - ch), random.randint(0, w - cw)
     rgb = F.interpolate(rgb[None, :, y:y + ch, x:x + cw], size=(size, size), mode="bilinear", align_corners=False)[0]
     label = F.interpolate(label[None, None, y:y + ch, x:x + cw].float(), size=(size, size), mode="nearest")[0, 0].long()
     if random.random() < 0.5:
@@ -111,13 +120,47 @@ class UNet(nn.Module):
         return self.head(x)
 
 
-def class_weights(rows):
+def class_weights(rows, balance):
     counts = np.array([sum(int(r[c]) for r in rows) for c in CLASSES], dtype=np.float64)
     present = counts > 0
     freq = counts / counts.sum()
     w = np.zeros(len(CLASSES))
-    w[present] = np.sqrt(np.median(freq[present]) / freq[present])  # square-root median-frequency balancing
+    w[present] = (np.median(freq[present]) / freq[present]) ** balance  # median-frequency balancing (Eigen & Fergus 2015)
     return torch.tensor(np.clip(w, 0.0, 5.0), dtype=torch.float32), counts
+
+
+def validation_split(rows, share, seed):
+    """Whole models of the training libraries held out for validation (never images of one model on both sides)."""
+    models = sorted({r["model"] for r in rows})
+    held = set(random.Random(seed).sample(models, int(round(share * len(models))))) if share > 0 else set()
+    return [r for r in rows if r["model"] not in held], [r for r in rows if r["model"] in held]
+
+
+def confusion(model, data, size, adjust, device):
+    """Pixel confusion matrices (one per logit adjustment) of the validation images, seen as at inference: the
+    whole image resized to the export size, the logits resized back."""
+    matrices = torch.zeros(len(adjust), len(CLASSES), len(CLASSES), dtype=torch.float64)
+    model.eval()
+    with torch.no_grad():
+        for rgb, label in data:
+            h, w = label.shape[-2:]
+            logits = model(F.interpolate(rgb.to(device), size=(size, size), mode="area"))
+            logits = F.interpolate(logits, size=(h, w), mode="bilinear", align_corners=False).cpu()
+            valid = label != 255
+            truth = label[valid]
+            for i, a in enumerate(adjust):
+                predicted = (logits + a[None, :, None, None]).argmax(1)[valid]
+                matrices[i] += torch.bincount(truth * len(CLASSES) + predicted,
+                                              minlength=len(CLASSES) ** 2).view(len(CLASSES), -1).double()
+    model.train()
+    return matrices
+
+
+def mean_iou(matrix):
+    tp = matrix.diag()
+    present = matrix.sum(1) > 0
+    iou = tp / (matrix.sum(0) + matrix.sum(1) - tp).clamp(min=1e-9)
+    return float(iou[present].mean()) if present.any() else float("nan")
 
 
 def main():
@@ -134,6 +177,10 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--max-minutes", type=float, default=0, help="stop after this long (0 = no limit)")
     ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
+    ap.add_argument("--val-share", type=float, default=0.1,
+                    help="share of the training libraries' models held out to pick the epoch and the logit adjustment")
+    ap.add_argument("--balance", type=float, default=0.5,
+                    help="class weights (median frequency / frequency)^balance: 0 none, 0.5 square root, 1 full")
     a = ap.parse_args()
 
     random.seed(a.seed)
@@ -143,13 +190,23 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.dataset, "manifest.csv")) as f:
         rows = [r for r in csv.DictReader(f) if r["split"] == "train"]
+    rows, val_rows = validation_split(rows, a.val_share, a.seed)
+    val_rows = val_rows[::max(1, len(val_rows) // 256)]  # at most ~256 images: validation stays cheap per epoch
     with open(os.path.join(a.dataset, "manifest.csv"), "rb") as f:
         manifest_sha = hashlib.sha256(f.read()).hexdigest()
-    weights, counts = class_weights(rows)
-    print(f"{len(rows)} training images; labelled pixels per class:",
+    weights, counts = class_weights(rows, a.balance)
+    print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)
     data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True), batch_size=a.batch, shuffle=True,
                                        num_workers=0, drop_last=True)
+    val_data = torch.utils.data.DataLoader(Dataset(a.dataset, val_rows, a.size, False), batch_size=32) \
+        if val_rows else None
+    # Post-hoc logit adjustment (Menon et al. 2021, "Long-tail learning via logit adjustment"): logits minus
+    # tau * log(class prior), tau picked on the validation models; it moves predictions towards rare classes.
+    prior = torch.tensor(counts / max(counts.sum(), 1), dtype=torch.float32)
+    taus = [0.0, 0.25, 0.5, 0.75, 1.0]
+    adjust = [torch.where(prior > 0, -t * torch.log(prior.clamp(min=1e-12)), torch.full_like(prior, -30.0))
+              for t in taus]
     model = UNet()
     if a.init:
         model.load_state_dict(torch.load(a.init, map_location="cpu"))
@@ -162,6 +219,7 @@ def main():
     log = []
     start = time.time()
     stopped_early = False
+    best = None  # {"epoch", "tau", "val_miou"} of the best validated epoch
     for epoch in range(a.epochs):
         model.train()
         total, n = 0.0, 0
@@ -177,12 +235,27 @@ def main():
             if a.max_minutes and time.time() - start > 60 * a.max_minutes:
                 stopped_early = True
                 break
-        log.append({"epoch": epoch + 1, "steps": n, "loss": total / max(n, 1), "seconds": time.time() - start})
-        print(f"epoch {epoch + 1}: {n} steps, loss {total / max(n, 1):.4f} ({time.time() - start:.0f} s)", flush=True)
+        entry = {"epoch": epoch + 1, "steps": n, "loss": total / max(n, 1), "seconds": time.time() - start}
         torch.save(model.state_dict(), os.path.join(a.out, "checkpoint.pt"))
+        if val_data is not None:
+            scores = [mean_iou(m) for m in confusion(model, val_data, a.export_size, adjust, a.device)]
+            entry["val_miou"] = dict(zip(map(str, taus), scores))
+            k = int(np.nanargmax(scores))
+            if best is None or scores[k] > best["val_miou"]:
+                best = {"epoch": epoch + 1, "tau": taus[k], "val_miou": scores[k]}
+                torch.save(model.state_dict(), os.path.join(a.out, "best.pt"))
+        log.append(entry)
+        print(f"epoch {epoch + 1}: {n} steps, loss {entry['loss']:.4f}, validation mIoU by tau "
+              f"{entry.get('val_miou', {})} ({time.time() - start:.0f} s)", flush=True)
         if stopped_early:
             break
 
+    if best is not None:
+        model.load_state_dict(torch.load(os.path.join(a.out, "best.pt"), map_location=a.device))
+        with torch.no_grad():
+            model.head.bias += adjust[taus.index(best["tau"])].to(a.device)
+        print(f"exporting epoch {best['epoch']} with tau {best['tau']} (validation mIoU {best['val_miou']:.3f})",
+              flush=True)
     model.eval().cpu()
     onnx_path = os.path.join(a.out, "g2p-materials.onnx")
     torch.onnx.export(model, torch.zeros(1, 3, a.export_size, a.export_size), onnx_path, input_names=["pixels"],
@@ -197,7 +270,8 @@ def main():
         json.dump(card, f, indent=2)
         f.write("\n")
     with open(os.path.join(a.out, "training.json"), "w") as f:
-        json.dump({"settings": vars(a), "parameters": params, "images": len(rows), "manifest_sha256": manifest_sha,
+        json.dump({"settings": vars(a), "parameters": params, "images": len(rows), "validation_images": len(val_rows),
+                   "exported": best, "manifest_sha256": manifest_sha,
                    "class_weights": dict(zip(CLASSES, weights.tolist())), "epochs": log,
                    "stopped_early": stopped_early, "torch": torch.__version__}, f, indent=2)
         f.write("\n")

@@ -4,7 +4,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
+#include "g2p/io.h"
 #include "g2p/segment.h"
 #include "segment/segment_fixtures.h"
 #include "support/test_data.h"
@@ -120,14 +122,62 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
   // so every pixel follows pbr.
   EXPECT_EQ(labels("learned", {{"model_card", card}}), labels("pbr", {}));
 
-  // Unconfigured it has no network and says how to give it one; bad settings fail at once.
-  Result<std::unique_ptr<Segmenter>> bare = segmenter_registry().create("learned");
-  ASSERT_TRUE(bare.ok());
-  Status s = (*bare)->set_model(model, table);
-  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
-  EXPECT_NE(s.message().find("model_card"), std::string::npos) << s.message();
+  // Unconfigured it runs the network libg2p ships (libg2p/data/models); bad settings fail at once.
+  Result<std::unique_ptr<Segmenter>> shipped = make_segmenter("learned");
+  ASSERT_TRUE(shipped.ok()) << shipped.status().to_string();
+  ASSERT_TRUE((*shipped)->set_model(model, table).ok());
+  Result<LabelMap> map = (*shipped)->segment(views[0]);
+  ASSERT_TRUE(map.ok()) << map.status().to_string();
   EXPECT_FALSE(make_segmenter("learned", {{"model_card", card}, {"names", "2"}}).ok());
   EXPECT_FALSE(make_segmenter("learned", {{"colour", "blue"}}).ok());
+}
+
+}  // namespace
+}  // namespace g2p
+
+namespace g2p {
+namespace {
+
+// The network libg2p ships: small, documented, in the table's class order,
+// and loadable by OpenCV's dnn module (through the `onnx` backend) on a real
+// asset stripped of names and PBR, as image-to-3D meshes arrive.
+TEST(ShippedNetwork, IsSmallDocumentedAndRunsOnAStrippedAsset) {
+  const std::string dir = test::source_path("libg2p/data/models");
+  const nlohmann::json card = nlohmann::json::parse(test::read_file(dir + "/g2p-materials.json"));
+  const MaterialTable& table = MaterialTable::paper_default();
+  ASSERT_EQ(card["classes"].size(), static_cast<std::size_t>(table.size()));
+  for (int c = 0; c < table.size(); ++c) EXPECT_EQ(card["classes"][c].get<std::string>(), table[c].name);
+  EXPECT_LE(std::filesystem::file_size(dir + "/" + card["model"].get<std::string>()), 20u << 20);
+  const nlohmann::json training = nlohmann::json::parse(test::read_file(dir + "/training.json"));
+  EXPECT_EQ(training["manifest_sha256"].get<std::string>().size(), 64u);
+  const std::string attribution = test::read_file(dir + "/ATTRIBUTION.md");
+  for (const char* library : {"BlendSwap-CC-0", "BlendSwap-CC-BY", "Scopia"})
+    EXPECT_NE(attribution.find(library), std::string::npos) << library;
+
+  Result<Model> model = load_model(test::asset_path("SheenChair"));
+  ASSERT_TRUE(model.ok()) << model.status().to_string();
+  anonymize_names(*model);
+  for (SourceMaterial& m : model->materials) {
+    m.metallic = m.roughness = 1.f;
+    m.transmission = 0.f;
+    m.metallic_roughness_texture = Texture{};
+  }
+  const std::vector<View> views = test::render(*model, 2, 128);
+  auto onnx = make_segmenter("onnx", {{"model_card", dir + "/g2p-materials.json"}});
+  ASSERT_TRUE(onnx.ok()) << onnx.status().to_string();
+  ASSERT_TRUE((*onnx)->set_model(*model, table).ok());
+  Result<LabelMap> map = (*onnx)->segment(views[0]);
+  ASSERT_TRUE(map.ok()) << map.status().to_string();
+  std::size_t object = 0;
+  for (std::size_t i = 0; i < views[0].face_id.size(); ++i) {
+    if (views[0].face_id.data()[i] < 0) continue;
+    ++object;
+    ASSERT_TRUE(table.valid_label(map->labels.data()[i])) << i;
+    float sum = 0;
+    for (int c = 0; c < table.size(); ++c) sum += map->probabilities.data()[table.size() * i + c];
+    ASSERT_NEAR(sum, 1.f, 1e-4f);
+  }
+  EXPECT_GT(object, 1000u);
 }
 
 }  // namespace

@@ -45,8 +45,8 @@ def read_png(path):
 class Dataset(torch.utils.data.Dataset):
     """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image)."""
 
-    def __init__(self, root, rows, size, train):
-        self.size, self.train = size, train
+    def __init__(self, root, rows, size, train, colour=1.0):
+        self.size, self.train, self.colour = size, train, colour
         self.rgb = torch.from_numpy(np.stack([read_png(os.path.join(root, "images", r["image"])) for r in rows]))
         self.label = torch.from_numpy(np.stack([read_png(os.path.join(root, "labels", r["image"])) for r in rows]))
 
@@ -57,12 +57,12 @@ class Dataset(torch.utils.data.Dataset):
         rgb = self.rgb[i].permute(2, 0, 1).float() / 255
         label = self.label[i].long()
         if self.train:
-            rgb, label = augment(rgb, label, self.size)
+            rgb, label = augment(rgb, label, self.size, self.colour)
         rgb = (rgb - torch.tensor(MEAN)[:, None, None]) / torch.tensor(STD)[:, None, None]
         return rgb, label
 
 
-def augment(rgb, label, size):
+def augment(rgb, label, size, colour=1.0):
     # Random resized crop (0.6-1 of the side) centred near a labelled pixel, so that crops hold the object
     # rather than the background; flip.
     h, w = label.shape
@@ -79,16 +79,17 @@ def augment(rgb, label, size):
     label = F.interpolate(label[None, None, y:y + ch, x:x + cw].float(), size=(size, size), mode="nearest")[0, 0].long()
     if random.random() < 0.5:
         rgb, label = rgb.flip(-1), label.flip(-1)
-    # Colour: brightness, contrast, saturation, a small hue shift (channel mixing), grey-scale.
-    rgb = rgb * random.uniform(0.7, 1.3)
+    # Colour (strength `colour`, 0 = none): brightness, contrast, saturation, a small hue shift (channel
+    # mixing), grey-scale. Colour is the strongest cue the renders carry, so strong jitter costs accuracy.
+    rgb = rgb * random.uniform(1 - 0.3 * colour, 1 + 0.3 * colour)
     mean = rgb.mean()
-    rgb = (rgb - mean) * random.uniform(0.7, 1.3) + mean
+    rgb = (rgb - mean) * random.uniform(1 - 0.3 * colour, 1 + 0.3 * colour) + mean
     grey = rgb.mean(0, keepdim=True)
-    rgb = (rgb - grey) * random.uniform(0.6, 1.4) + grey
-    if random.random() < 0.3:
+    rgb = (rgb - grey) * random.uniform(1 - 0.4 * colour, 1 + 0.4 * colour) + grey
+    if random.random() < 0.3 * colour:
         mix = torch.eye(3) + 0.08 * torch.randn(3, 3)
         rgb = torch.einsum("ij,jhw->ihw", mix, rgb)
-    if random.random() < 0.1:
+    if random.random() < 0.1 * colour:
         rgb = rgb.mean(0, keepdim=True).expand(3, -1, -1).clone()
     # Blur: baked, low-resolution textures.
     if random.random() < 0.3:
@@ -179,6 +180,8 @@ def main():
     ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
     ap.add_argument("--val-share", type=float, default=0.1,
                     help="share of the training libraries' models held out to pick the epoch and the logit adjustment")
+    ap.add_argument("--colour-jitter", type=float, default=1.0,
+                    help="strength of the colour augmentations (0 none, 1 the full ranges of the docstring)")
     ap.add_argument("--balance", type=float, default=0.5,
                     help="class weights (median frequency / frequency)^balance: 0 none, 0.5 square root, 1 full")
     a = ap.parse_args()
@@ -197,7 +200,7 @@ def main():
     weights, counts = class_weights(rows, a.balance)
     print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)
-    data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True), batch_size=a.batch, shuffle=True,
+    data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True, a.colour_jitter), batch_size=a.batch, shuffle=True,
                                        num_workers=0, drop_last=True)
     val_data = torch.utils.data.DataLoader(Dataset(a.dataset, val_rows, a.size, False), batch_size=32) \
         if val_rows else None

@@ -3,11 +3,24 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 
+#include "g2p/io.h"
 #include "g2p/mesh.h"
 
 namespace g2p::bench {
+
+#ifdef G2P_BENCH_SHARED_ASSETS
+// A shared asset (../shared/assets/NAME/NAME.glb); throws with the importer's
+// message when it cannot be read, so a missing asset stops the benchmark clearly.
+inline Model load_shared_asset(const std::string& name, const ImportOptions& options = {}) {
+  Result<Model> m = load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/" + name + "/" + name + ".glb", options);
+  if (!m.ok()) throw std::runtime_error(m.status().to_string());
+  return std::move(*m);
+}
+#endif
 
 // Splits every triangle into four at its edge midpoints (shared between
 // neighbours), keeping UVs and provenance; the large meshes of the benchmarks.

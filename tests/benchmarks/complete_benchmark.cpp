@@ -29,7 +29,7 @@ const Object& object(int level) {
     std::vector<Object> levels(4);
     g2p::ImportOptions io;
     io.load_textures = false;
-    g2p::Model model = *g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/SheenChair/SheenChair.glb", io);
+    g2p::Model model = g2p::bench::load_shared_asset("SheenChair", io);
     for (int l = 0; l < 4; ++l) {
       if (l > 0) model.mesh = g2p::bench::subdivide(model.mesh);
       Object& o = levels[static_cast<std::size_t>(l)];

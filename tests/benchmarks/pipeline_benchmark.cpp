@@ -25,7 +25,7 @@ const g2p::Model& model(const std::string& name, int levels) {
   static g2p::Model cached;
   if (key == std::make_pair(name, levels) && cached.mesh.num_faces() > 0) return cached;
   cached = g2p::Model{};
-  cached = *g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/" + name + "/" + name + ".glb");
+  cached = g2p::bench::load_shared_asset(name);
   for (int l = 0; l < levels; ++l) cached.mesh = g2p::bench::subdivide(cached.mesh);
   key = {name, levels};
   return cached;

@@ -29,9 +29,7 @@ struct Scene {
 const Scene& scene() {
   static const Scene s = [] {
     Scene sc;
-    g2p::Result<g2p::Model> m = g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/SheenChair/SheenChair.glb");
-    if (!m.ok()) throw std::runtime_error(m.status().to_string());
-    sc.model = std::move(*m);
+    sc.model = g2p::bench::load_shared_asset("SheenChair");
     for (int i = 0; i < 3; ++i) sc.model.mesh = g2p::bench::subdivide(sc.model.mesh);
     sc.cameras = *g2p::make_views(sc.model.mesh);
     for (const g2p::Camera& c : sc.cameras) sc.rays += static_cast<double>(c.width) * c.height;

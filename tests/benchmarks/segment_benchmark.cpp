@@ -10,8 +10,8 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
-#include <stdexcept>
 
+#include "benchmarks/bench_support.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
@@ -26,9 +26,7 @@ struct Scene {
 const Scene& scene() {
   static const Scene s = [] {
     Scene sc;
-    g2p::Result<g2p::Model> m = g2p::load_model(std::string(G2P_BENCH_SHARED_ASSETS) + "/SheenChair/SheenChair.glb");
-    if (!m.ok()) throw std::runtime_error(m.status().to_string());
-    sc.model = std::move(*m);
+    sc.model = g2p::bench::load_shared_asset("SheenChair");
     auto renderer = g2p::renderer_registry().create("embree");
     sc.views = *g2p::render_views(**renderer, sc.model, *g2p::make_views(sc.model.mesh));
     return sc;

@@ -8,6 +8,11 @@ pixels are Wood, green ones Metal and blue ones Glass when the channel order
 is RGB. The 2x2 average pool halves the output size, so the segmenter has to
 resize the output back to the view.
 
+A second network, tiny_normals.onnx (card card_normals.json, input channels
+["rgb", "normal"]), ignores colour and reads the camera-space normal n:
+logits (10 n_x, -10 n_x, 1), so surfaces facing right (n_x > 0.1) are Wood,
+those facing left Metal and the rest, or a view without normals, Glass.
+
 usage: make_tiny_onnx.py OUT_DIR
 """
 import json
@@ -43,6 +48,25 @@ def main(out_dir):
         }
         with open(os.path.join(out_dir, "card_%s.json" % order.lower()), "w") as f:
             json.dump(card, f, indent=2)
+
+    w = np.zeros((3, 6, 1, 1), dtype=np.float32)
+    w[0, 3], w[1, 3] = 10.0, -10.0  # input channel 3 is the normal's x
+    conv = helper.make_node("Conv", ["input", "w", "b"], ["logits"], kernel_shape=[1, 1])
+    graph = helper.make_graph(
+        [conv], "tiny_normals",
+        [helper.make_tensor_value_info("input", TensorProto.FLOAT, [1, 6, 32, 32])],
+        [helper.make_tensor_value_info("logits", TensorProto.FLOAT, [1, 3, 32, 32])],
+        initializer=[numpy_helper.from_array(w, name="w"),
+                     numpy_helper.from_array(np.array([0.0, 0.0, 1.0], dtype=np.float32), name="b")])
+    model = helper.make_model(graph, producer_name="libg2p-tests", opset_imports=[helper.make_opsetid("", 11)])
+    model.ir_version = 7
+    onnx.checker.check_model(model)
+    onnx.save(model, os.path.join(out_dir, "tiny_normals.onnx"))
+    card = {"format": "g2p-onnx-model-card", "version": 1, "model": "tiny_normals.onnx",
+            "input": {"width": 32, "height": 32, "name": "input", "channels": ["rgb", "normal"]},
+            "output": {"kind": "logits", "name": "logits"}, "classes": ["Wood", "Metal", "Glass"]}
+    with open(os.path.join(out_dir, "card_normals.json"), "w") as f:
+        json.dump(card, f, indent=2)
 
 
 if __name__ == "__main__":

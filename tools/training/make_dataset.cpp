@@ -3,7 +3,7 @@
 //
 //   g2p_make_dataset OUT LIBRARY_DIR... [--views 8] [--size 160] [--seed 1]
 //                    [--overrides tools/training/overrides.json] [--test KatorLegaz,Reallusion]
-//                    [--pbr-defaults 0.5]
+//                    [--pbr-defaults 0.5] [--normals]
 //
 // Each LIBRARY_DIR is an unpacked furniture library (Sweet Home 3D's .sh3f
 // zip files hold OBJ/MTL models); its folder name names the library. Every
@@ -16,6 +16,8 @@
 // to glTF's defaults, its textures dropped or its colours whitened on a share
 // of models, as image-to-3D meshes arrive. Writes OUT/images/*.png (RGB),
 // OUT/labels/*.png (class index, 255 = unlabelled or background),
+// with --normals OUT/normals/*.png (camera-space unit normal n as 8-bit
+// 127.5 * (n + 1), background 128: the encoding segment/onnx reads),
 // OUT/manifest.csv (one row per image, with its library and split),
 // OUT/labels.json (per model and material, the ground truth `g2p eval seg`
 // reads) and OUT/stats.json (labelled faces and area per class and split).
@@ -97,7 +99,25 @@ struct Args {
   double min_labelled = 0.2;
   int max_models = 0;
   double pbr_defaults = 0.5;  // share of models given glTF's default metallic and roughness
+  bool normals = false;       // also write OUT/normals (camera-space normals)
 };
+
+// The view's normals in its camera's frame (x right, y down, z away from the
+// viewer), 8-bit: round(127.5 * (n + 1)); background pixels hold 128 (n = 0).
+g2p::ImageU8 camera_normals(const g2p::View& view) {
+  const int w = view.face_id.width(), h = view.face_id.height();
+  g2p::ImageU8 out(w, h, 3, 128);
+  const Eigen::Matrix3f to_camera = view.camera.rotation.transpose().cast<float>();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (view.face_id.at(x, y) < 0) continue;
+      const Eigen::Vector3f n =
+          to_camera * Eigen::Vector3f(view.normal.at(x, y, 0), view.normal.at(x, y, 1), view.normal.at(x, y, 2));
+      for (int c = 0; c < 3; ++c)
+        out.at(x, y, c) = static_cast<std::uint8_t>(std::lround(std::clamp(127.5f * (n[c] + 1.f), 0.f, 255.f)));
+    }
+  return out;
+}
 
 int run(const Args& a) {
   const g2p::MaterialTable& table = g2p::MaterialTable::paper_default();
@@ -121,6 +141,7 @@ int run(const Args& a) {
   }
   fs::create_directories(a.out + "/images");
   fs::create_directories(a.out + "/labels");
+  if (a.normals) fs::create_directories(a.out + "/normals");
   std::ofstream manifest(a.out + "/manifest.csv");
   manifest << "image,library,model,split,view,labelled_pixels";
   for (const g2p::MaterialClass& c : table.classes()) manifest << "," << c.name;
@@ -212,7 +233,7 @@ int run(const Args& a) {
       for (std::size_t v = 0; v < chosen.size(); ++v) {
         g2p::RenderOptions ro;
         ro.material_buffers = false;
-        ro.geometry_buffers = false;
+        ro.geometry_buffers = a.normals;
         for (auto& c : ro.background) c = static_cast<std::uint8_t>(255 * u(rng));
         g2p::Result<g2p::View> view = (*renderer)->render(chosen[v], ro);
         if (!view.ok()) continue;
@@ -232,7 +253,8 @@ int run(const Args& a) {
         char name[64];
         std::snprintf(name, sizeof name, "%06d.png", image_count++);
         if (!g2p::write_image(a.out + "/images/" + name, view->rgb).ok() ||
-            !g2p::write_image(a.out + "/labels/" + name, label).ok()) {
+            !g2p::write_image(a.out + "/labels/" + name, label).ok() ||
+            (a.normals && !g2p::write_image(a.out + "/normals/" + name, camera_normals(*view)).ok())) {
           std::cerr << "g2p_make_dataset: cannot write " << a.out << "/images/" << name << "\n";
           return 1;
         }
@@ -273,6 +295,7 @@ int main(int argc, char** argv) {
   app.add_option("--pbr-defaults", a.pbr_defaults,
                  "Share of models rendered with glTF's default metallic and roughness (default 0.5)")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_flag("--normals", a.normals, "Also write OUT/normals: camera-space normals for networks that take them");
   app.add_option("--max-models", a.max_models, "At most this many models per library (0 = all)");
   CLI11_PARSE(app, argc, argv);
   return run(a);

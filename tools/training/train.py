@@ -43,12 +43,16 @@ def read_png(path):
 
 
 class Dataset(torch.utils.data.Dataset):
-    """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image)."""
+    """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image). With
+    `normals`, each sample has 6 channels: the normalised RGB and the camera-space normal (components in -1..1,
+    0 on the background), as the `onnx` backend feeds a card whose input.channels is ["rgb", "normal"]."""
 
-    def __init__(self, root, rows, size, train, colour=1.0):
-        self.size, self.train, self.colour = size, train, colour
+    def __init__(self, root, rows, size, train, colour=1.0, normals=False, normal_dropout=0.0):
+        self.size, self.train, self.colour, self.normal_dropout = size, train, colour, normal_dropout
         self.rgb = torch.from_numpy(np.stack([read_png(os.path.join(root, "images", r["image"])) for r in rows]))
         self.label = torch.from_numpy(np.stack([read_png(os.path.join(root, "labels", r["image"])) for r in rows]))
+        self.normal = torch.from_numpy(np.stack([read_png(os.path.join(root, "normals", r["image"])) for r in rows])) \
+            if normals else None
 
     def __len__(self):
         return len(self.label)
@@ -56,13 +60,16 @@ class Dataset(torch.utils.data.Dataset):
     def __getitem__(self, i):
         rgb = self.rgb[i].permute(2, 0, 1).float() / 255
         label = self.label[i].long()
+        normal = self.normal[i].permute(2, 0, 1).float() / 127.5 - 1 if self.normal is not None else None
         if self.train:
-            rgb, label = augment(rgb, label, self.size, self.colour)
+            rgb, label, normal = augment(rgb, label, self.size, self.colour, normal)
+            if normal is not None and random.random() < self.normal_dropout:
+                normal = torch.zeros_like(normal)  # a renderer without normals: the network must cope
         rgb = (rgb - torch.tensor(MEAN)[:, None, None]) / torch.tensor(STD)[:, None, None]
-        return rgb, label
+        return (rgb if normal is None else torch.cat([rgb, normal])), label
 
 
-def augment(rgb, label, size, colour=1.0):
+def augment(rgb, label, size, colour=1.0, normal=None):
     # Random resized crop (0.6-1 of the side) centred near a labelled pixel, so that crops hold the object
     # rather than the background; flip.
     h, w = label.shape
@@ -77,8 +84,13 @@ def augment(rgb, label, size, colour=1.0):
         y, x = random.randint(0, h - ch), random.randint(0, w - cw)
     rgb = F.interpolate(rgb[None, :, y:y + ch, x:x + cw], size=(size, size), mode="bilinear", align_corners=False)[0]
     label = F.interpolate(label[None, None, y:y + ch, x:x + cw].float(), size=(size, size), mode="nearest")[0, 0].long()
+    if normal is not None:
+        normal = F.interpolate(normal[None, :, y:y + ch, x:x + cw], size=(size, size), mode="bilinear",
+                               align_corners=False)[0]
     if random.random() < 0.5:
         rgb, label = rgb.flip(-1), label.flip(-1)
+        if normal is not None:
+            normal = normal.flip(-1) * torch.tensor([-1.0, 1.0, 1.0])[:, None, None]  # the mirror turns x
     # Colour (strength `colour`, 0 = none): brightness, contrast, saturation, a small hue shift (channel
     # mixing), grey-scale. Colour is the strongest cue the renders carry, so strong jitter costs accuracy.
     rgb = rgb * random.uniform(1 - 0.3 * colour, 1 + 0.3 * colour)
@@ -95,7 +107,7 @@ def augment(rgb, label, size, colour=1.0):
     if random.random() < 0.3:
         k = random.choice([3, 5])
         rgb = F.avg_pool2d(rgb[None], k, stride=1, padding=k // 2, count_include_pad=False)[0]
-    return rgb.clamp(0, 1), label
+    return rgb.clamp(0, 1), label, normal
 
 
 def block(cin, cout):
@@ -104,9 +116,9 @@ def block(cin, cout):
 
 
 class UNet(nn.Module):
-    def __init__(self, classes=len(CLASSES), width=(16, 32, 64, 128, 128)):
+    def __init__(self, classes=len(CLASSES), width=(16, 32, 64, 128, 128), inputs=3):
         super().__init__()
-        self.enc = nn.ModuleList([block(3, width[0])] + [block(width[i], width[i + 1]) for i in range(len(width) - 1)])
+        self.enc = nn.ModuleList([block(inputs, width[0])] + [block(width[i], width[i + 1]) for i in range(len(width) - 1)])
         self.dec = nn.ModuleList([block(width[i + 1] + width[i], width[i]) for i in reversed(range(len(width) - 1))])
         self.head = nn.Conv2d(width[0], classes, 1)
 
@@ -143,7 +155,7 @@ def confusion(model, data, size, adjust, device):
     matrices = torch.zeros(len(adjust), len(CLASSES), len(CLASSES), dtype=torch.float64)
     model.eval()
     with torch.no_grad():
-        for rgb, label in data:
+        for rgb, label in data:  # rgb: the network's input (RGB, then normals if it takes them)
             h, w = label.shape[-2:]
             logits = model(F.interpolate(rgb.to(device), size=(size, size), mode="area"))
             logits = F.interpolate(logits, size=(h, w), mode="bilinear", align_corners=False).cpu()
@@ -184,6 +196,10 @@ def main():
                     help="strength of the colour augmentations (0 none, 1 the full ranges of the docstring)")
     ap.add_argument("--balance", type=float, default=0.5,
                     help="class weights (median frequency / frequency)^balance: 0 none, 0.5 square root, 1 full")
+    ap.add_argument("--normals", action="store_true",
+                    help="also feed camera-space normals (DATASET/normals, g2p_make_dataset --normals)")
+    ap.add_argument("--normal-dropout", type=float, default=0.2,
+                    help="share of training samples whose normals are zeroed, so the network works without them")
     a = ap.parse_args()
 
     random.seed(a.seed)
@@ -200,19 +216,27 @@ def main():
     weights, counts = class_weights(rows, a.balance)
     print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)
-    data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True, a.colour_jitter), batch_size=a.batch, shuffle=True,
-                                       num_workers=0, drop_last=True)
-    val_data = torch.utils.data.DataLoader(Dataset(a.dataset, val_rows, a.size, False), batch_size=32) \
-        if val_rows else None
+    data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True, a.colour_jitter, a.normals,
+                                               a.normal_dropout),
+                                       batch_size=a.batch, shuffle=True, num_workers=0, drop_last=True)
+    val_data = torch.utils.data.DataLoader(Dataset(a.dataset, val_rows, a.size, False, normals=a.normals),
+                                           batch_size=32) if val_rows else None
     # Post-hoc logit adjustment (Menon et al. 2021, "Long-tail learning via logit adjustment"): logits minus
     # tau * log(class prior), tau picked on the validation models; it moves predictions towards rare classes.
     prior = torch.tensor(counts / max(counts.sum(), 1), dtype=torch.float32)
     taus = [0.0, 0.25, 0.5, 0.75, 1.0]
     adjust = [torch.where(prior > 0, -t * torch.log(prior.clamp(min=1e-12)), torch.full_like(prior, -30.0))
               for t in taus]
-    model = UNet()
+    inputs = 6 if a.normals else 3
+    model = UNet(inputs=inputs)
     if a.init:
-        model.load_state_dict(torch.load(a.init, map_location="cpu"))
+        state = torch.load(a.init, map_location="cpu")
+        first = state["enc.0.0.weight"]
+        if first.shape[1] < inputs:
+            # An RGB network grows normal inputs with zero weights: it starts as the network it was.
+            state["enc.0.0.weight"] = torch.cat([first, first.new_zeros(first.shape[0], inputs - first.shape[1],
+                                                                        *first.shape[2:])], 1)
+        model.load_state_dict(state)
     model = model.to(a.device)
     params = sum(p.numel() for p in model.parameters())
     opt = torch.optim.AdamW(model.parameters(), lr=a.lr, weight_decay=1e-4)
@@ -261,11 +285,12 @@ def main():
               flush=True)
     model.eval().cpu()
     onnx_path = os.path.join(a.out, "g2p-materials.onnx")
-    torch.onnx.export(model, torch.zeros(1, 3, a.export_size, a.export_size), onnx_path, input_names=["pixels"],
+    torch.onnx.export(model, torch.zeros(1, inputs, a.export_size, a.export_size), onnx_path, input_names=["pixels"],
                       output_names=["logits"], opset_version=11)
     card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
             "input": {"width": a.export_size, "height": a.export_size, "channel_order": "RGB", "scale": 1 / 255,
-                      "mean": MEAN, "std": STD, "name": "pixels"},
+                      "mean": MEAN, "std": STD, "name": "pixels",
+                      "channels": ["rgb", "normal"] if a.normals else ["rgb"]},
             "output": {"kind": "logits", "name": "logits"},
             "classes": CLASSES,
             "trained_on": "sweethome3d-furniture: BlendSwap-CC-0, BlendSwap-CC-BY, Scopia (docs/training.md)"}

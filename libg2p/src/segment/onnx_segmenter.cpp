@@ -6,18 +6,26 @@
 //    "model": "net.onnx",                       // relative to the card
 //    "input": {"width": 512, "height": 512, "channel_order": "RGB",
 //              "scale": 0.00392156862745098, "mean": [0.485, 0.456, 0.406],
-//              "std": [0.229, 0.224, 0.225], "name": "pixel_values"},
+//              "std": [0.229, 0.224, 0.225], "name": "pixel_values",
+//              "channels": ["rgb"]},               // optional; or ["rgb", "normal"]
 //    "output": {"kind": "logits", "name": "logits"},   // or "probabilities"
 //    "classes": ["background", "Wood", "Metal", ...]}  // per output channel
 //
 // The view's RGB is resized to the input size, each channel becomes
-// (value * scale - mean) / std, and the NCHW output is resized back to the
+// (value * scale - mean) / std. input.channels lists the buffers the network
+// takes, in order: "rgb" (3 channels, as above) and "normal" (3 channels: the
+// view's unit normal in its camera's frame, x right, y down, z away from the
+// viewer; 0 on the background, and 0 everywhere when the view was rendered
+// without geometry buffers, which networks trained with normal dropout
+// tolerate). The NCHW output is resized back to the
 // view (bilinear), turned into probabilities (softmax for logits) and summed
 // per vocabulary class. Channels named "background", "ignore" or with no
 // class in the table are dropped; on object pixels the rest are renormalised,
 // background pixels (face ID -1) stay unknown.
 //
 // Settings: model_card = path of the card (required).
+#include <Eigen/Core>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -44,6 +52,7 @@ struct ModelCard {
   std::string input_name, output_name;
   bool logits = true;
   std::vector<std::string> classes;
+  std::vector<std::string> channels{"rgb"};  // the input's buffers, in order
 };
 
 Result<ModelCard> read_card(const std::string& path) {
@@ -83,6 +92,18 @@ Result<ModelCard> read_card(const std::string& path) {
       card.std = cv::Scalar(s[0], s[1], s[2]);
     }
     card.input_name = input.value("name", "");
+    if (input.contains("channels")) {
+      card.channels = input.at("channels").get<std::vector<std::string>>();
+      if (card.channels.empty()) return Status::ParseError(path + ": input.channels is empty");
+      for (std::size_t i = 0; i < card.channels.size(); ++i) {
+        if (card.channels[i] != "rgb" && card.channels[i] != "normal")
+          return Status::ParseError(path + ": input.channels[" + std::to_string(i) + "] is '" + card.channels[i] +
+                                    "'; known: rgb, normal");
+        if (std::find(card.channels.begin(), card.channels.begin() + static_cast<long>(i), card.channels[i]) !=
+            card.channels.begin() + static_cast<long>(i))
+          return Status::ParseError(path + ": input.channels names '" + card.channels[i] + "' twice");
+      }
+    }
     if (doc.contains("output")) {
       const json& output = doc.at("output");
       const std::string kind = output.value("kind", "logits");
@@ -99,6 +120,28 @@ Result<ModelCard> read_card(const std::string& path) {
     return Status::ParseError(path + ": input size outside 8..8192");
   if (card.classes.empty()) return Status::ParseError(path + ": 'classes' is empty");
   return card;
+}
+
+// The view's normals in its camera's frame at the network's input size
+// (area-averaged), 3 float channels; zeros on the background and where the
+// view has no normal buffer.
+cv::Mat camera_normals(const View& view, cv::Size size) {
+  const int w = view.face_id.width(), h = view.face_id.height();
+  cv::Mat normals(h, w, CV_32FC3, cv::Scalar(0, 0, 0));
+  if (view.normal.width() == w && view.normal.height() == h && view.normal.channels() == 3) {
+    const Eigen::Matrix3f to_camera = view.camera.rotation.transpose().cast<float>();
+    for (int y = 0; y < h; ++y) {
+      auto* row = normals.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < w; ++x) {
+        if (view.face_id.at(x, y) < 0) continue;
+        const Eigen::Vector3f n = to_camera * Eigen::Map<const Eigen::Vector3f>(view.normal.pixel(x, y));
+        row[x] = cv::Vec3f(n.x(), n.y(), n.z());
+      }
+    }
+  }
+  cv::Mat resized;
+  cv::resize(normals, resized, size, 0, 0, cv::INTER_AREA);
+  return resized;
 }
 
 class OnnxSegmenter final : public Segmenter {
@@ -140,16 +183,32 @@ class OnnxSegmenter final : public Segmenter {
     if (view.rgb.width() != w || view.rgb.height() != h || view.rgb.channels() != 3)
       return Status::InvalidArgument("onnx: the view needs an RGB image (render with shading on)");
 
-    cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.data()));
-    cv::Mat input;
-    cv::resize(rgb, input, cv::Size(card_.width, card_.height), 0, 0, cv::INTER_AREA);
-    if (card_.bgr) cv::cvtColor(input, input, cv::COLOR_RGB2BGR);
-    input.convertTo(input, CV_32FC3, card_.scale);
-    input = (input - card_.mean) / card_.std;
+    const cv::Size size(card_.width, card_.height);
+    std::vector<cv::Mat> inputs;  // one 3-channel float image per entry of card_.channels
+    for (const std::string& channel : card_.channels) {
+      if (channel == "normal") {
+        inputs.push_back(camera_normals(view, size));
+        continue;
+      }
+      cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.data()));
+      cv::Mat input;
+      cv::resize(rgb, input, size, 0, 0, cv::INTER_AREA);
+      if (card_.bgr) cv::cvtColor(input, input, cv::COLOR_RGB2BGR);
+      input.convertTo(input, CV_32FC3, card_.scale);
+      inputs.push_back((input - card_.mean) / card_.std);
+    }
     cv::Mat output;
     try {
-      const cv::Mat blob = cv::dnn::blobFromImage(input);  // NCHW, no further scaling
-      std::lock_guard<std::mutex> lock(mutex_);            // cv::dnn::Net::forward is not const
+      // NCHW: the planes of every input, in the card's order.
+      const int sizes[4] = {1, 3 * static_cast<int>(inputs.size()), size.height, size.width};
+      cv::Mat blob(4, sizes, CV_32F);
+      for (std::size_t i = 0; i < inputs.size(); ++i) {
+        cv::Mat planes[3];
+        for (int c = 0; c < 3; ++c) planes[c] = cv::Mat(size, CV_32F, blob.ptr<float>(0, 3 * static_cast<int>(i) + c));
+        const int from_to[] = {0, 0, 1, 1, 2, 2};
+        cv::mixChannels(&inputs[i], 1, planes, 3, from_to, 3);  // writes into the blob's memory
+      }
+      std::lock_guard<std::mutex> lock(mutex_);  // cv::dnn::Net::forward is not const
       net_.setInput(blob, card_.input_name);
       output = net_.forward(card_.output_name).clone();
     } catch (const cv::Exception& e) {

@@ -20,7 +20,10 @@
 // 127.5 * (n + 1), background 128: the encoding segment/onnx reads),
 // OUT/manifest.csv (one row per image, with its library and split),
 // OUT/labels.json (per model and material, the ground truth `g2p eval seg`
-// reads) and OUT/stats.json (labelled faces and area per class and split).
+// reads), OUT/stats.json (labelled faces and area per class and split) and
+// OUT/materials.csv (every material of every model read: its name, texture,
+// colour, share of the model's area, the rule that labelled it and the class;
+// the list to review when extending the overrides file).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -142,6 +145,13 @@ int run(const Args& a) {
   fs::create_directories(a.out + "/images");
   fs::create_directories(a.out + "/labels");
   if (a.normals) fs::create_directories(a.out + "/normals");
+  std::ofstream materials_csv(a.out + "/materials.csv");
+  materials_csv << "library,model,split,material,name,texture,r,g,b,area_share,rule,class\n";
+  const auto csv_field = [](std::string v) {
+    for (char& c : v)
+      if (c == ',' || c == '"' || c == '\n') c = ' ';
+    return v;
+  };
   std::ofstream manifest(a.out + "/manifest.csv");
   manifest << "image,library,model,split,view,labelled_pixels";
   for (const g2p::MaterialClass& c : table.classes()) manifest << "," << c.name;
@@ -173,15 +183,35 @@ int run(const Args& a) {
       }
       g2p::Model& model = *loaded;
       std::vector<int> material_label(model.materials.size(), g2p::kUnknownLabel);
+      std::vector<std::string> material_rule(model.materials.size());
       json model_labels = json::object();
       for (std::size_t m = 0; m < model.materials.size(); ++m) {
-        std::string why;
-        material_label[m] = label_material(model.materials[m], key, overrides, table, why);
-        ++reasons[split][why];
+        material_label[m] = label_material(model.materials[m], key, overrides, table, material_rule[m]);
+        ++reasons[split][material_rule[m]];
         model_labels[std::to_string(m)] =
             table.valid_label(material_label[m]) ? table[material_label[m]].name : std::string("ignore");
       }
       const g2p::Mesh& mesh = model.mesh;
+      {
+        std::vector<double> material_area(model.materials.size(), 0.0);
+        double total = 0;
+        for (int f = 0; f < mesh.num_faces(); ++f) {
+          const int m = mesh.face_source[static_cast<std::size_t>(f)].material;
+          const double fa = g2p::face_area(mesh, f);
+          total += fa;
+          if (m >= 0 && m < static_cast<int>(material_area.size())) material_area[static_cast<std::size_t>(m)] += fa;
+        }
+        for (std::size_t m = 0; m < model.materials.size(); ++m) {
+          const g2p::SourceMaterial& sm = model.materials[m];
+          char colour[64];
+          std::snprintf(colour, sizeof colour, "%.3f,%.3f,%.3f", sm.base_color.x(), sm.base_color.y(),
+                        sm.base_color.z());
+          materials_csv << library << "," << csv_field(key) << "," << split << "," << m << "," << csv_field(sm.name)
+                        << "," << csv_field(fs::path(sm.base_color_texture.uri).filename().string()) << "," << colour
+                        << "," << (total > 0 ? material_area[m] / total : 0.0) << "," << material_rule[m] << ","
+                        << (table.valid_label(material_label[m]) ? table[material_label[m]].name : "") << "\n";
+        }
+      }
       std::vector<int> face_label(static_cast<std::size_t>(mesh.num_faces()), g2p::kUnknownLabel);
       double labelled_area = 0, area = 0;
       for (int f = 0; f < mesh.num_faces(); ++f) {

@@ -125,6 +125,13 @@ TEST(ToolEval, SharedAssetsWithAndWithoutNames) {
         }
         EXPECT_NEAR(equal[key][row][col].get<double>(), expected, 1e-9) << row << " " << col;
       }
+    // The bootstrap interval over the two models brackets their per-model mIoU.
+    const nlohmann::json& interval = j["total_3d_per_model_interval"];
+    ASSERT_TRUE(interval.is_object()) << j.dump();
+    EXPECT_LE(interval["low"].get<double>(), equal["miou"].get<double>() + 1e-12);
+    EXPECT_GE(interval["high"].get<double>(), equal["miou"].get<double>() - 1e-12);
+    EXPECT_EQ(interval["resamples"].get<int>(), 2000);
+    EXPECT_NE(r.out.find("% interval over models"), std::string::npos) << r.out;
   }
   EXPECT_EQ(run_tool("eval seg --assets /nonexistent").exit_code, 1);
 }

@@ -81,6 +81,7 @@ int run_eval_seg(const EvalArgs& args) {
   ConfusionMatrix total(table->size()), total_3d(table->size()), per_model_3d(table->size());
   CalibrationBins calibration;
   nlohmann::json per_model = nlohmann::json::object();
+  std::vector<ConfusionMatrix> model_matrices_3d;  // for the bootstrap interval
   for (const std::string& key : keys) {
     // A key that is a model file's path relative to `assets` (a generated
     // dataset's labels.json), else the shared assets' NAME/NAME.glb.
@@ -147,6 +148,7 @@ int run_eval_seg(const EvalArgs& args) {
     total.merge(matrix);
     total_3d.merge(matrix_3d);
     if (matrix_3d.total() > 0) per_model_3d.merge(matrix_3d, 1.0 / matrix_3d.total());
+    model_matrices_3d.push_back(matrix_3d);
     std::printf(
         "%-28s 2D: %9.0f px, accuracy %6.2f %%, mIoU %6.2f %% | 3D: %8.4f m^2, accuracy %6.2f %%, mIoU %6.2f %%\n",
         key.c_str(), matrix.total(), 100.0 * matrix.accuracy(), 100.0 * matrix.mean_iou(), matrix_3d.total(),
@@ -158,23 +160,34 @@ int run_eval_seg(const EvalArgs& args) {
   std::cout << total.table(*table) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
             << total_3d.table(*table) << "\nPer face (3D, after voting), each model weighing the same, IoU %:\n"
             << per_model_3d.table(*table);
+  const Result<MeanIouInterval> interval = bootstrap_mean_iou(model_matrices_3d);
+  if (interval.ok())
+    std::printf("mIoU %.2f %%, %.0f %% interval over models %.2f-%.2f %% (bootstrap, %d resamples of %zu models)\n",
+                100.0 * interval->miou, 100.0 * interval->confidence, 100.0 * interval->low, 100.0 * interval->high,
+                interval->resamples, model_matrices_3d.size());
   if (calibration.accuracy() == calibration.accuracy())  // has probabilities
     std::printf("calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n", calibration.mean_confidence(),
                 calibration.accuracy(), calibration.expected_calibration_error());
   if (!args.json_out.empty()) {
-    const nlohmann::json doc = {{"segmenter", args.segmenter.name},
-                                {"anonymized_names", args.anonymize},
-                                {"base_color_only", args.base_color_only},
-                                {"views", args.views.views},
-                                {"resolution", args.views.resolution},
-                                {"total", nlohmann::json::parse(total.to_json(*table))},
-                                {"total_3d", nlohmann::json::parse(total_3d.to_json(*table))},
-                                {"total_3d_per_model", nlohmann::json::parse(per_model_3d.to_json(*table))},
-                                {"calibration",
-                                 {{"ece", calibration.expected_calibration_error()},
-                                  {"mean_confidence", calibration.mean_confidence()},
-                                  {"accuracy", calibration.accuracy()}}},
-                                {"models", per_model}};
+    const nlohmann::json doc = {
+        {"segmenter", args.segmenter.name},
+        {"anonymized_names", args.anonymize},
+        {"base_color_only", args.base_color_only},
+        {"views", args.views.views},
+        {"resolution", args.views.resolution},
+        {"total", nlohmann::json::parse(total.to_json(*table))},
+        {"total_3d", nlohmann::json::parse(total_3d.to_json(*table))},
+        {"total_3d_per_model", nlohmann::json::parse(per_model_3d.to_json(*table))},
+        {"total_3d_per_model_interval", interval.ok() ? nlohmann::json{{"low", interval->low},
+                                                                       {"high", interval->high},
+                                                                       {"confidence", interval->confidence},
+                                                                       {"resamples", interval->resamples}}
+                                                      : nlohmann::json(nullptr)},
+        {"calibration",
+         {{"ece", calibration.expected_calibration_error()},
+          {"mean_confidence", calibration.mean_confidence()},
+          {"accuracy", calibration.accuracy()}}},
+        {"models", per_model}};
     std::ofstream out(args.json_out, std::ios::binary | std::ios::trunc);
     out << doc.dump(2) << "\n";
     if (!out) {

@@ -43,10 +43,15 @@ TEST(BootstrapMeanIou, TwoModelsSpanTheirOwnScores) {
   EXPECT_NEAR(r->miou, merged.mean_iou(), 1e-12);
   EXPECT_LT(r->low, r->miou);
   EXPECT_GT(r->high, r->miou);
-  // Deterministic per seed; a wider confidence never gives a narrower interval.
+  // Deterministic per seed; a narrower confidence gives an interval inside the wider one.
   Result<MeanIouInterval> again = bootstrap_mean_iou({good, poor});
   EXPECT_EQ(again->low, r->low);
   EXPECT_EQ(again->high, r->high);
+  Result<MeanIouInterval> half = bootstrap_mean_iou({good, poor}, 0.5);
+  ASSERT_TRUE(half.ok());
+  EXPECT_GE(half->low, r->low);
+  EXPECT_LE(half->high, r->high);
+  EXPECT_LT(half->high - half->low, r->high - r->low);
 }
 
 TEST(BootstrapMeanIou, MoreModelsNarrowTheInterval) {

@@ -135,5 +135,49 @@ TEST(CamerasJson, RoundTrip) {
   EXPECT_NE(cameras_from_json(R"({"views": [{"width": 3}]})").status().message().find("views[0]"), std::string::npos);
 }
 
+// camera_space_normals on a real asset: every surface the camera sees faces
+// it (against the pixel's ray in the camera's frame), the vectors stay unit length, the
+// background is zero, and a view without geometry buffers has none.
+TEST(CameraSpaceNormals, FaceTheCameraOnTheChair) {
+  Result<Model> chair = load_model(test::source_path("../shared/assets/SheenChair/SheenChair.glb"));
+  ASSERT_TRUE(chair.ok()) << chair.status().to_string();
+  Result<std::vector<Camera>> cameras = make_views(chair->mesh, {3, ViewLayout::kSphere, 96, 96});
+  ASSERT_TRUE(cameras.ok());
+  Result<std::unique_ptr<Renderer>> renderer = renderer_registry().create("embree");
+  ASSERT_TRUE(renderer.ok() && (*renderer)->set_model(*chair).ok());
+  for (const Camera& camera : *cameras) {
+    Result<View> view = (*renderer)->render(camera);
+    ASSERT_TRUE(view.ok());
+    const ImageF n = camera_space_normals(*view);
+    ASSERT_EQ(n.width(), 96);
+    ASSERT_EQ(n.channels(), 3);
+    int object = 0;
+    for (int y = 0; y < 96; ++y)
+      for (int x = 0; x < 96; ++x) {
+        const Eigen::Vector3f v(n.at(x, y, 0), n.at(x, y, 1), n.at(x, y, 2));
+        if (view->face_id.at(x, y) < 0) {
+          ASSERT_EQ(v.norm(), 0.f);
+          continue;
+        }
+        ++object;
+        ASSERT_NEAR(v.norm(), 1.f, 1e-4f);
+        // Facing the viewer: against the pixel's ray, in the camera's frame.
+        Eigen::Vector3d origin, direction;
+        camera.ray(x + 0.5, y + 0.5, origin, direction);
+        const Eigen::Vector3f ray = (camera.rotation.transpose() * direction).cast<float>();
+        ASSERT_LT(v.dot(ray), 1e-4f) << "pixel " << x << "," << y;
+        // The same vector as the world-space buffer, turned by the camera's rotation.
+        const Eigen::Vector3f world(view->normal.at(x, y, 0), view->normal.at(x, y, 1), view->normal.at(x, y, 2));
+        ASSERT_NEAR((camera.rotation.cast<float>() * v - world).norm(), 0.f, 1e-5f);
+      }
+    EXPECT_GT(object, 500);
+  }
+  RenderOptions bare;
+  bare.geometry_buffers = false;
+  Result<View> view = (*renderer)->render(cameras->front(), bare);
+  ASSERT_TRUE(view.ok());
+  EXPECT_TRUE(camera_space_normals(*view).empty());
+}
+
 }  // namespace
 }  // namespace g2p

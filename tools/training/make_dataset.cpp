@@ -105,20 +105,13 @@ struct Args {
   bool normals = false;       // also write OUT/normals (camera-space normals)
 };
 
-// The view's normals in its camera's frame (x right, y down, z away from the
-// viewer), 8-bit: round(127.5 * (n + 1)); background pixels hold 128 (n = 0).
-g2p::ImageU8 camera_normals(const g2p::View& view) {
-  const int w = view.face_id.width(), h = view.face_id.height();
-  g2p::ImageU8 out(w, h, 3, 128);
-  const Eigen::Matrix3f to_camera = view.camera.rotation.transpose().cast<float>();
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      if (view.face_id.at(x, y) < 0) continue;
-      const Eigen::Vector3f n =
-          to_camera * Eigen::Vector3f(view.normal.at(x, y, 0), view.normal.at(x, y, 1), view.normal.at(x, y, 2));
-      for (int c = 0; c < 3; ++c)
-        out.at(x, y, c) = static_cast<std::uint8_t>(std::lround(std::clamp(127.5f * (n[c] + 1.f), 0.f, 255.f)));
-    }
+// The view's camera-space normals (camera_space_normals) as 8 bits per
+// channel: round(127.5 * (n + 1)); background pixels hold 128 (n = 0).
+g2p::ImageU8 encode_normals(const g2p::View& view) {
+  const g2p::ImageF n = g2p::camera_space_normals(view);
+  g2p::ImageU8 out(n.width(), n.height(), 3, 128);
+  for (std::size_t i = 0; i < n.size(); ++i)
+    out.data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(127.5f * (n.data()[i] + 1.f), 0.f, 255.f)));
   return out;
 }
 
@@ -284,7 +277,7 @@ int run(const Args& a) {
         std::snprintf(name, sizeof name, "%06d.png", image_count++);
         if (!g2p::write_image(a.out + "/images/" + name, view->rgb).ok() ||
             !g2p::write_image(a.out + "/labels/" + name, label).ok() ||
-            (a.normals && !g2p::write_image(a.out + "/normals/" + name, camera_normals(*view)).ok())) {
+            (a.normals && !g2p::write_image(a.out + "/normals/" + name, encode_normals(*view)).ok())) {
           std::cerr << "g2p_make_dataset: cannot write " << a.out << "/images/" << name << "\n";
           return 1;
         }

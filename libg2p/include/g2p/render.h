@@ -120,6 +120,12 @@ G2P_API Registry<Renderer>& renderer_registry();
 G2P_API Result<std::vector<View>> render_views(Renderer& renderer, const Model& model,
                                                const std::vector<Camera>& cameras, const RenderOptions& options = {});
 
+// The view's normal buffer turned into its camera's frame (x right, y down, z
+// away from the viewer: surfaces facing the camera have z < 0), 3 channels;
+// zeros on the background. Empty when the view has no normal buffer
+// (RenderOptions::geometry_buffers off). What a network that takes normals sees.
+G2P_API ImageF camera_space_normals(const View& view);
+
 // ---- Files -------------------------------------------------------------------
 
 struct ViewFileOptions {

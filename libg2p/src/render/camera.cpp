@@ -175,4 +175,18 @@ Result<std::vector<View>> render_views(Renderer& renderer, const Model& model, c
   return views;
 }
 
+ImageF camera_space_normals(const View& view) {
+  const int w = view.face_id.width(), h = view.face_id.height();
+  if (view.normal.width() != w || view.normal.height() != h || view.normal.channels() != 3 || w == 0) return {};
+  ImageF out(w, h, 3, 0.f);
+  const Eigen::Matrix3f to_camera = view.camera.rotation.transpose().cast<float>();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (view.face_id.at(x, y) < 0) continue;
+      Eigen::Map<Eigen::Vector3f>(out.pixel(x, y)) =
+          to_camera * Eigen::Map<const Eigen::Vector3f>(view.normal.pixel(x, y));
+    }
+  return out;
+}
+
 }  // namespace g2p

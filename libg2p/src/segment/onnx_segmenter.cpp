@@ -24,7 +24,6 @@
 // background pixels (face ID -1) stay unknown.
 //
 // Settings: model_card = path of the card (required).
-#include <Eigen/Core>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -122,25 +121,13 @@ Result<ModelCard> read_card(const std::string& path) {
   return card;
 }
 
-// The view's normals in its camera's frame at the network's input size
-// (area-averaged), 3 float channels; zeros on the background and where the
-// view has no normal buffer.
-cv::Mat camera_normals(const View& view, cv::Size size) {
-  const int w = view.face_id.width(), h = view.face_id.height();
-  cv::Mat normals(h, w, CV_32FC3, cv::Scalar(0, 0, 0));
-  if (view.normal.width() == w && view.normal.height() == h && view.normal.channels() == 3) {
-    const Eigen::Matrix3f to_camera = view.camera.rotation.transpose().cast<float>();
-    for (int y = 0; y < h; ++y) {
-      auto* row = normals.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < w; ++x) {
-        if (view.face_id.at(x, y) < 0) continue;
-        const Eigen::Vector3f n = to_camera * Eigen::Map<const Eigen::Vector3f>(view.normal.pixel(x, y));
-        row[x] = cv::Vec3f(n.x(), n.y(), n.z());
-      }
-    }
-  }
+// The view's camera-space normals at the network's input size
+// (area-averaged), 3 float channels; zeros where the view has none.
+cv::Mat normals_input(const View& view, cv::Size size) {
+  ImageF normals = camera_space_normals(view);
+  if (normals.empty()) return cv::Mat(size, CV_32FC3, cv::Scalar(0, 0, 0));
   cv::Mat resized;
-  cv::resize(normals, resized, size, 0, 0, cv::INTER_AREA);
+  cv::resize(cv::Mat(normals.height(), normals.width(), CV_32FC3, normals.data()), resized, size, 0, 0, cv::INTER_AREA);
   return resized;
 }
 
@@ -187,7 +174,7 @@ class OnnxSegmenter final : public Segmenter {
     std::vector<cv::Mat> inputs;  // one 3-channel float image per entry of card_.channels
     for (const std::string& channel : card_.channels) {
       if (channel == "normal") {
-        inputs.push_back(camera_normals(view, size));
+        inputs.push_back(normals_input(view, size));
         continue;
       }
       cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.data()));

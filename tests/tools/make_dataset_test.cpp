@@ -1,0 +1,142 @@
+// g2p_make_dataset (tools/training/make_dataset.cpp) on a small library the
+// test writes: three boxes whose materials are named by the lexicon ("oak"),
+// by a per-model override ("Material.001") and by nothing ("Material.002").
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include "g2p/io.h"
+#include "g2p/materials.h"
+#include "support/test_data.h"
+#include "support/tool_run.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+using test::quote;
+
+// An OBJ of three unit boxes along x, one per material, and its MTL.
+void write_boxes(const std::string& dir, const std::string& name) {
+  fs::create_directories(dir);
+  std::ostringstream obj;
+  obj << "mtllib " << name << ".mtl\n";
+  const char* materials[3] = {"oak", "Material.001", "Material.002"};
+  for (int b = 0; b < 3; ++b) {
+    const double x0 = 1.2 * b;
+    for (int i = 0; i < 8; ++i) obj << "v " << x0 + (i & 1) << " " << ((i >> 1) & 1) << " " << ((i >> 2) & 1) << "\n";
+    obj << "usemtl " << materials[b] << "\n";
+    const int o = 8 * b + 1;  // OBJ indices start at 1
+    const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads)
+      obj << "f " << o + q[0] << " " << o + q[1] << " " << o + q[2] << " " << o + q[3] << "\n";
+  }
+  test::write_file(dir + "/" + name + ".obj", obj.str());
+  test::write_file(dir + "/" + name + ".mtl",
+                   "newmtl oak\nKd 0.6 0.4 0.2\nnewmtl Material.001\nKd 0.7 0.7 0.7\nnewmtl Material.002\nKd 0.2 0.3 "
+                   "0.8\n");
+}
+
+int run_make_dataset(const std::string& args) {
+  const std::string cmd = quote(G2P_TEST_MAKE_DATASET) + " " + args + " >/dev/null 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(ToolMakeDataset, LabelsRendersAndReportsEveryMaterial) {
+  const std::string dir = test::scratch_dir("ToolMakeDataset.library");
+  fs::remove_all(dir);
+  write_boxes(dir + "/TrainLib/boxes", "boxes");
+  write_boxes(dir + "/HeldOut/boxes", "boxes");
+  test::write_file(dir + "/overrides.json",
+                   R"({"names": {}, "models": {"TrainLib/boxes/boxes.obj": {"Material.001": "Metal"}}})");
+  const std::string out = dir + "/dataset";
+  ASSERT_EQ(
+      run_make_dataset(quote(out) + " " + quote(dir + "/TrainLib") + " " + quote(dir + "/HeldOut") +
+                       " --test HeldOut --views 3 --size 48 --normals --overrides " + quote(dir + "/overrides.json")),
+      0);
+
+  // Labels: the lexicon for "oak", the override for Material.001 (only in the
+  // model it names), nothing for Material.002.
+  const MaterialTable& table = MaterialTable::paper_default();
+  const nlohmann::json labels = nlohmann::json::parse(test::read_file(out + "/labels.json"))["models"];
+  ASSERT_TRUE(labels.contains("TrainLib/boxes/boxes.obj")) << labels.dump();
+  EXPECT_EQ(labels["TrainLib/boxes/boxes.obj"]["split"], "train");
+  EXPECT_EQ(labels["HeldOut/boxes/boxes.obj"]["split"], "test");
+  std::map<std::string, std::string> rule, label;  // "library/name" -> ...
+  {
+    std::istringstream csv(test::read_file(out + "/materials.csv"));
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "library,model,split,material,name,texture,r,g,b,area_share,rule,class");
+    while (std::getline(csv, line)) {
+      std::vector<std::string> f;
+      std::stringstream s(line);
+      for (std::string field; std::getline(s, field, ',');) f.push_back(field);
+      if (line.back() == ',') f.emplace_back();
+      ASSERT_EQ(f.size(), 12u) << line;
+      rule[f[0] + "/" + f[4]] = f[10];
+      label[f[0] + "/" + f[4]] = f[11];
+      EXPECT_NEAR(std::stod(f[9]), 1.0 / 3.0, 1e-6) << line;  // three equal boxes
+    }
+  }
+  EXPECT_EQ(rule["TrainLib/oak"], "lexicon");
+  EXPECT_EQ(label["TrainLib/oak"], "Wood");
+  EXPECT_EQ(rule["TrainLib/Material.001"], "override (model)");
+  EXPECT_EQ(label["TrainLib/Material.001"], "Metal");
+  EXPECT_EQ(rule["HeldOut/Material.001"], "no material word");
+  EXPECT_EQ(label["HeldOut/Material.001"], "");
+  EXPECT_EQ(rule["TrainLib/Material.002"], "no material word");
+
+  // Per class and split: each box is 12 triangles.
+  const nlohmann::json stats = nlohmann::json::parse(test::read_file(out + "/stats.json"));
+  EXPECT_EQ(stats["splits"]["train"]["classes"]["Wood"]["faces"], 12);
+  EXPECT_EQ(stats["splits"]["train"]["classes"]["Metal"]["faces"], 12);
+  EXPECT_EQ(stats["splits"]["test"]["classes"]["Wood"]["faces"], 12);
+  EXPECT_EQ(stats["splits"]["test"]["classes"]["Metal"]["faces"], 0);
+
+  // Every manifest row has its image, label map and normals; label pixels are
+  // Wood, Metal (train only) or 255; normals decode to unit vectors on labelled pixels.
+  std::istringstream manifest(test::read_file(out + "/manifest.csv"));
+  std::string row;
+  std::getline(manifest, row);
+  int rows = 0, metal_pixels = 0;
+  while (std::getline(manifest, row)) {
+    ++rows;
+    const std::string image = row.substr(0, row.find(','));
+    const bool train = row.find(",train,") != std::string::npos;
+    Result<ImageU8> rgb = read_image(out + "/images/" + image), lab = read_image(out + "/labels/" + image),
+                    nor = read_image(out + "/normals/" + image);
+    ASSERT_TRUE(rgb.ok() && lab.ok() && nor.ok()) << image;
+    ASSERT_EQ(lab->width(), 48);
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 48; ++x) {
+        const int l = lab->at(x, y);
+        ASSERT_TRUE(l == 255 || l == table.find("Wood") || (train && l == table.find("Metal"))) << image << " " << l;
+        metal_pixels += l == table.find("Metal");
+        if (l == 255) continue;
+        double norm2 = 0;
+        for (int c = 0; c < 3; ++c) norm2 += std::pow(nor->at(x, y, c) / 127.5 - 1.0, 2);
+        ASSERT_NEAR(std::sqrt(norm2), 1.0, 0.02) << image << " pixel " << x << "," << y;
+      }
+  }
+  EXPECT_EQ(rows, 6);  // 3 views of each model
+  EXPECT_GT(metal_pixels, 0);
+
+  // An existing folder is refused and left as it was.
+  const std::string before = test::read_file(out + "/labels.json");
+  EXPECT_EQ(run_make_dataset(quote(out) + " " + quote(dir + "/TrainLib")), 2);
+  EXPECT_EQ(test::read_file(out + "/labels.json"), before);
+}
+
+}  // namespace
+}  // namespace g2p

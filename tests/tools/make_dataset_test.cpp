@@ -138,5 +138,57 @@ TEST(ToolMakeDataset, LabelsRendersAndReportsEveryMaterial) {
   EXPECT_EQ(test::read_file(out + "/labels.json"), before);
 }
 
+// --flat-textures: a striped red and blue texture becomes its mean colour
+// (purple, no stripes left; dropping the texture would leave the white of
+// Kd); without it both stripes show.
+TEST(ToolMakeDataset, FlatTexturesKeepTheMeanColourAndLoseThePattern) {
+  const std::string dir = test::scratch_dir("ToolMakeDataset.flat");
+  fs::remove_all(dir);
+  const std::string model = dir + "/Lib/box";
+  fs::create_directories(model);
+  ImageU8 stripes(64, 64, 3, 0);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) stripes.at(x, y, (x / 8) % 2 == 0 ? 0 : 2) = 255;
+  ASSERT_TRUE(write_image(model + "/stripes.png", stripes).ok());
+  std::ostringstream obj;
+  obj << "mtllib box.mtl\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+  for (int i = 0; i < 8; ++i) obj << "v " << (i & 1) << " " << ((i >> 1) & 1) << " " << ((i >> 2) & 1) << "\n";
+  obj << "usemtl oak\n";
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads)
+    obj << "f " << q[0] + 1 << "/1 " << q[1] + 1 << "/2 " << q[2] + 1 << "/3 " << q[3] + 1 << "/4\n";
+  test::write_file(model + "/box.obj", obj.str());
+  test::write_file(model + "/box.mtl", "newmtl oak\nKd 1 1 1\nmap_Kd stripes.png\n");
+
+  for (const char* flat : {"0", "1"}) {
+    const std::string out = dir + "/out" + flat;
+    ASSERT_EQ(run_make_dataset(quote(out) + " " + quote(dir + "/Lib") + " --test None --views 4 --size 64 --white 0 " +
+                               "--pbr-defaults 0 --flat-textures " + flat),
+              0);
+    int pixels = 0, red = 0, blue = 0, even = 0;
+    for (const auto& entry : fs::directory_iterator(out + "/images")) {
+      Result<ImageU8> rgb = read_image(entry.path().string());
+      Result<ImageU8> label = read_image(out + "/labels/" + entry.path().filename().string());
+      ASSERT_TRUE(rgb.ok() && label.ok());
+      for (int y = 0; y < rgb->height(); ++y)
+        for (int x = 0; x < rgb->width(); ++x) {
+          if (label->at(x, y, 0) == 255) continue;
+          const int r = rgb->at(x, y, 0), g = rgb->at(x, y, 1), b = rgb->at(x, y, 2);
+          ++pixels;
+          red += r > 2 * b + 10;
+          blue += b > 2 * r + 10;
+          even += std::abs(r - b) <= 0.15 * std::max(r, b) + 4 && g < 0.6 * std::max(r, b);  // purple, not grey
+        }
+    }
+    ASSERT_GT(pixels, 500) << flat;
+    if (flat[0] == '0') {
+      EXPECT_GT(red, pixels / 5) << "stripes expected";
+      EXPECT_GT(blue, pixels / 5) << "stripes expected";
+    } else {
+      EXPECT_GT(even, 0.97 * pixels) << "one mean colour expected: red " << red << ", blue " << blue;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace g2p

@@ -99,6 +99,23 @@ TEST(ToolEval, ReproducesAHandComputedMeanIoU) {
   EXPECT_DOUBLE_EQ(j["total"]["iou"]["Metal"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(j["total"]["miou"].get<double>(), 0.5 * n_a / (n_a + n_b));
   EXPECT_DOUBLE_EQ(j["total"]["total_weight"].get<double>(), n_a + n_b);
+  EXPECT_EQ(j["vote"], "hard");
+  EXPECT_EQ(j["refiner"], "none");
+
+  // Soft votes of the oracle's one-hot probabilities are its hard votes, and
+  // smoothing an all-Wood labelling changes nothing: the same 3D matrix, with
+  // the refiner's report on stdout and the choices in the JSON.
+  r = run_tool("eval seg --assets " + quote(assets) +
+               " --views 3 --resolution 40 --segmenter oracle --set labels=" + quote(assets + "/predicted.json") +
+               " --set key=Boxes --soft --refiner smooth --json " + quote(assets + "/refined.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("smooth: "), std::string::npos) << r.out;
+  const nlohmann::json refined = nlohmann::json::parse(test::read_file(assets + "/refined.json"));
+  EXPECT_EQ(refined["vote"], "soft");
+  EXPECT_EQ(refined["refiner"], "smooth");
+  EXPECT_EQ(refined["total_3d"], j["total_3d"]);
+  EXPECT_EQ(run_tool("eval seg --assets " + quote(assets) + " --refiner magic").exit_code, 2);
+  EXPECT_EQ(run_tool("eval seg --assets " + quote(assets) + " --refine-set lambda=2").exit_code, 2);
 }
 
 TEST(ToolEval, SharedAssetsWithAndWithoutNames) {

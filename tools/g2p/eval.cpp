@@ -15,6 +15,7 @@
 #include "g2p/io.h"
 #include "g2p/project.h"
 #include "g2p/segment.h"
+#include "stage_outputs.h"
 
 namespace g2p::cli {
 namespace {
@@ -30,6 +31,8 @@ struct EvalArgs {
   std::string truth;  // labels.json elsewhere than in `assets`
   std::string split;  // only models whose entry has this "split"
   std::string json_out;
+  bool soft = false;  // soft votes (the segmenter's probabilities) instead of one vote per pixel
+  RefineArgs refine;  // the refine stage after voting (default none: the project stage alone)
 };
 
 // What image-to-3D generators emit: base colour only. Metallic and roughness
@@ -124,11 +127,18 @@ int run_eval_seg(const EvalArgs& args) {
     }
     // 3D: the predictions voted onto the faces (the project stage), scored per
     // face weighted by area; ground truth per face from its source material.
-    Result<Projection> projection = project(model->mesh, *views, predictions, table->size());
+    ProjectOptions project_options;
+    project_options.vote.mode = args.soft ? VoteMode::kSoft : VoteMode::kHard;
+    Result<Projection> projection = project(model->mesh, *views, predictions, table->size(), project_options);
     if (!projection.ok()) {
       std::cerr << "g2p eval seg: error: " << key << ": " << projection.status().to_string() << "\n";
       return kExitFailure;
     }
+    nlohmann::json refine_report;
+    if (const int code = refine_projection("eval seg", args.refine, *model, *views, *table, project_options.partition,
+                                           *projection, refine_report);
+        code != kExitOk)
+      return code;
     Result<std::vector<int>> material_truth =
         material_labels_from_json(text.str(), key, *table, static_cast<int>(model->materials.size()));
     if (!material_truth.ok()) {
@@ -173,6 +183,8 @@ int run_eval_seg(const EvalArgs& args) {
         {"segmenter", args.segmenter.name},
         {"anonymized_names", args.anonymize},
         {"base_color_only", args.base_color_only},
+        {"vote", args.soft ? "soft" : "hard"},
+        {"refiner", args.refine.name},
         {"views", args.views.views},
         {"resolution", args.views.resolution},
         {"total", nlohmann::json::parse(total.to_json(*table))},
@@ -277,6 +289,8 @@ void add_eval_command(CLI::App& app, Command& run) {
   seg->add_option("--json", args->json_out, "Also write the results as JSON to this file");
   add_view_flags(seg, args->views);
   add_segmenter_flags(seg, args->segmenter);
+  seg->add_flag("--soft", args->soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
+  add_refiner_flags(seg, args->refine, "none");
   seg->callback([args, &run] { run = [args] { return run_eval_seg(*args); }; });
 
   auto margs = std::make_shared<MassArgs>();

@@ -3,7 +3,8 @@
 //
 //   g2p_make_dataset OUT LIBRARY_DIR... [--views 8] [--size 160] [--seed 1]
 //                    [--overrides tools/training/overrides.json] [--test KatorLegaz,Reallusion]
-//                    [--pbr-defaults 0.5] [--normals]
+//                    [--pbr-defaults 0.5] [--flat-textures 0.25] [--white 0.1]
+//                    [--normals]
 //
 // Each LIBRARY_DIR is an unpacked furniture library (Sweet Home 3D's .sh3f
 // zip files hold OBJ/MTL models); its folder name names the library. Every
@@ -13,8 +14,8 @@
 // unlabelled (255, ignored by the loss). Each model is turned about its up
 // axis at random and rendered from `views` of 24 directions on a Fibonacci
 // sphere, with a random field of view and background; its PBR values are set
-// to glTF's defaults, its textures dropped or its colours whitened on a share
-// of models, as image-to-3D meshes arrive. Writes OUT/images/*.png (RGB),
+// to glTF's defaults, its colour textures flattened to their mean colour or its
+// colours whitened on a share of models, as image-to-3D meshes arrive. Writes OUT/images/*.png (RGB),
 // OUT/labels/*.png (class index, 255 = unlabelled or background),
 // with --normals OUT/normals/*.png (camera-space unit normal n as 8-bit
 // 127.5 * (n + 1), background 128: the encoding segment/onnx reads),
@@ -101,8 +102,10 @@ struct Args {
   std::string overrides, test = "KatorLegaz,Reallusion";
   double min_labelled = 0.2;
   int max_models = 0;
-  double pbr_defaults = 0.5;  // share of models given glTF's default metallic and roughness
-  bool normals = false;       // also write OUT/normals (camera-space normals)
+  double pbr_defaults = 0.5;    // share of models given glTF's default metallic and roughness
+  double flat_textures = 0.25;  // share of models whose colour textures become their mean colour
+  double white = 0.1;           // share of models whose colours all become a light grey (shape only)
+  bool normals = false;         // also write OUT/normals (camera-space normals)
 };
 
 // The view's camera-space normals (camera_space_normals) as 8 bits per
@@ -113,6 +116,29 @@ g2p::ImageU8 encode_normals(const g2p::View& view) {
   for (std::size_t i = 0; i < n.size(); ++i)
     out.data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(127.5f * (n.data()[i] + 1.f), 0.f, 255.f)));
   return out;
+}
+
+// The mean colour of an sRGB texture in linear RGB (what a texture far too
+// coarse to show any pattern bakes to), weighted by alpha; white when the
+// texture is absent or fully transparent.
+Eigen::Vector3f mean_linear_colour(const g2p::Texture& texture) {
+  if (texture.empty() || texture.image->channels() < 3) return Eigen::Vector3f::Ones();
+  const g2p::ImageU8& im = *texture.image;
+  float to_linear[256];
+  for (int i = 0; i < 256; ++i) {
+    const float c = i / 255.f;
+    to_linear[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  }
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double weight = 0;
+  for (int y = 0; y < im.height(); ++y)
+    for (int x = 0; x < im.width(); ++x) {
+      const double w = im.channels() >= 4 ? im.at(x, y, 3) / 255.0 : 1.0;
+      for (int c = 0; c < 3; ++c) sum[c] += w * to_linear[im.at(x, y, c)];
+      weight += w;
+    }
+  if (!(weight > 0)) return Eigen::Vector3f::Ones();
+  return (sum / weight).cast<float>();
 }
 
 int run(const Args& a) {
@@ -231,13 +257,17 @@ int run(const Args& a) {
       ++models_used;
 
       // Appearance as generated meshes have it: glTF's default metallic and
-      // roughness on a share of models (--pbr-defaults), textures dropped on a
-      // quarter, colours whitened (shape only) on a tenth.
+      // roughness on a share of models (--pbr-defaults), colour textures
+      // flattened to their mean colour on a share (--flat-textures: coarse
+      // bakes and untextured models keep the colour but lose the pattern),
+      // colours whitened (shape only) on a share (--white).
       std::uniform_real_distribution<double> u(0.0, 1.0);
-      const bool defaults = u(rng) < a.pbr_defaults, no_textures = u(rng) < 0.25, white = u(rng) < 0.1;
+      const bool defaults = u(rng) < a.pbr_defaults, flat = u(rng) < a.flat_textures, white = u(rng) < a.white;
       for (g2p::SourceMaterial& m : model.materials) {
         if (defaults) m.metallic = 1.f, m.roughness = 1.f, m.metallic_roughness_texture = g2p::Texture{};
-        if (no_textures || white) m.base_color_texture = g2p::Texture{};
+        if (flat && !white && !m.base_color_texture.empty())
+          m.base_color.head<3>() = m.base_color.head<3>().cwiseProduct(mean_linear_colour(m.base_color_texture));
+        if (flat || white) m.base_color_texture = g2p::Texture{};
         if (white) m.base_color = Eigen::Vector4f(0.8f, 0.8f, 0.8f, m.base_color.w());
       }
       turn(model.mesh, 2 * M_PI * u(rng));
@@ -317,6 +347,11 @@ int main(int argc, char** argv) {
   app.add_option("--min-labelled", a.min_labelled, "Skip models with less labelled area (default 0.2)");
   app.add_option("--pbr-defaults", a.pbr_defaults,
                  "Share of models rendered with glTF's default metallic and roughness (default 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--flat-textures", a.flat_textures,
+                 "Share of models whose colour textures are replaced by their mean colour (default 0.25)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--white", a.white, "Share of models rendered light grey, shape only (default 0.1)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--normals", a.normals, "Also write OUT/normals: camera-space normals for networks that take them");
   app.add_option("--max-models", a.max_models, "At most this many models per library (0 = all)");

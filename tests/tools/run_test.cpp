@@ -53,6 +53,7 @@ TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("2 parts"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(dir + "/refined/faces.csv"));
+  EXPECT_EQ(nlohmann::json::parse(test::read_file(dir + "/out/project.json"))["vote"], "hard");
 
   // An existing output is a usage error and stays untouched; --overwrite replaces it.
   r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick);
@@ -64,6 +65,12 @@ TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/out/hammer.urdf"));
   EXPECT_FALSE(fs::exists(dir + "/out/hammer.xml"));
+
+  // --soft reaches the project stage: soft votes, the same two parts on the hammer.
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/soft") + kQuick + " --soft --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["parts"].size(), 2u);
+  EXPECT_EQ(nlohmann::json::parse(test::read_file(dir + "/soft/project.json"))["vote"], "soft");
 }
 
 TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
@@ -146,8 +153,9 @@ TEST(ToolRun, InterruptCancelsAndWritesNothing) {
 TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {
   test::ToolRun r = test::run_tool("run --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* flag : {"--segmenter", "--refiner", "--completer", "--estimator", "--views", "--resolution",
-                           "--materials", "--vlm-url", "--vlm-model", "--format", "--json", "--save-intermediates"})
+  for (const char* flag :
+       {"--segmenter", "--refiner", "--completer", "--estimator", "--views", "--resolution", "--materials", "--soft",
+        "--vlm-url", "--vlm-model", "--format", "--json", "--save-intermediates"})
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
   EXPECT_NE(r.out.find("130 cancelled"), std::string::npos);
 }

@@ -31,6 +31,7 @@ struct RunArgs {
   EstimatorArgs estimator;
   std::string vlm_url, vlm_model;
   std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
+  bool soft = false;  // soft votes in the project stage
   bool fixed = false, anonymize = false, overwrite = false, intermediates = false, json = false, quiet = false;
 };
 
@@ -86,6 +87,7 @@ int run_pipeline(const RunArgs& args) {
   if (!import.ok()) return usage(import.status().message());
   o.import = *import;
   o.anonymize_names = args.anonymize;
+  if (args.soft) o.project.vote.mode = VoteMode::kSoft;
   Result<ViewOptions> views = view_options(args.views);
   if (!views.ok()) return usage(views.status().message());
   o.views = *views;
@@ -190,6 +192,9 @@ void add_run_command(CLI::App& app, Command& run) {
       ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
   cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
   cmd->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one first");
+  cmd->add_flag("--soft", args->soft,
+                "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
+                "the learned and onnx segmenters)");
   cmd->add_option("--vlm-url", args->vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
   cmd->add_option("--vlm-model", args->vlm_model, "Model name for the vlm refiner/estimator");
   cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output folder (after the run succeeded)");

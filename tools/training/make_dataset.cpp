@@ -4,6 +4,7 @@
 //   g2p_make_dataset OUT LIBRARY_DIR... [--views 8] [--size 160] [--seed 1]
 //                    [--overrides tools/training/overrides.json] [--test KatorLegaz,Reallusion]
 //                    [--pbr-defaults 0.5] [--flat-textures 0.25] [--white 0.1]
+//                    [--geometry-noise 0.3]
 //                    [--normals]
 //
 // Each LIBRARY_DIR is an unpacked furniture library (Sweet Home 3D's .sh3f
@@ -15,7 +16,8 @@
 // axis at random and rendered from `views` of 24 directions on a Fibonacci
 // sphere, with a random field of view and background; its PBR values are set
 // to glTF's defaults, its colour textures flattened to their mean colour or its
-// colours whitened on a share of models, as image-to-3D meshes arrive. Writes OUT/images/*.png (RGB),
+// colours whitened on a share of models, and mild geometry noise added to a
+// share, as image-to-3D meshes arrive. Writes OUT/images/*.png (RGB),
 // OUT/labels/*.png (class index, 255 = unlabelled or background),
 // with --normals OUT/normals/*.png (camera-space unit normal n as 8-bit
 // 127.5 * (n + 1), background 128: the encoding segment/onnx reads),
@@ -94,6 +96,36 @@ void turn(g2p::Mesh& mesh, double yaw) {
   for (Eigen::Vector3f& n : mesh.normals) n = r * n;
 }
 
+// Mild geometry noise, as image-to-3D surfaces are bumpy: every vertex moves
+// by a random offset of standard deviation `sigma` (a fraction of the bounding
+// box's diagonal) per axis and its normal tilts by about `tilt` radians. The
+// noise is a function of the vertex's position, so vertices that coincide
+// (split at UV seams or creases) move together and open no cracks.
+void add_geometry_noise(g2p::Mesh& mesh, double sigma, double tilt, unsigned seed) {
+  const Eigen::AlignedBox3d box = g2p::bounds(mesh);
+  const double diagonal = box.isEmpty() ? 0.0 : box.diagonal().norm();
+  if (!(diagonal > 0)) return;
+  const double cell = 1e-6 * diagonal;  // positions closer than this share their noise
+  auto noise = [&](const Eigen::Vector3f& p) {
+    std::size_t h = seed;
+    for (int i = 0; i < 3; ++i) {
+      const auto q = static_cast<long long>(std::llround(p[i] / cell));
+      h ^= std::hash<long long>{}(q) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+    }
+    std::mt19937 rng(static_cast<std::uint32_t>(h ^ (h >> 32)));
+    std::normal_distribution<float> n(0.f, 1.f);
+    Eigen::Vector3f a, b;
+    for (int i = 0; i < 3; ++i) a[i] = n(rng);
+    for (int i = 0; i < 3; ++i) b[i] = n(rng);
+    return std::make_pair(a, b);
+  };
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const auto [offset, turn_by] = noise(mesh.positions[v]);
+    mesh.positions[v] += static_cast<float>(sigma * diagonal) * offset;
+    if (v < mesh.normals.size()) mesh.normals[v] = (mesh.normals[v] + static_cast<float>(tilt) * turn_by).normalized();
+  }
+}
+
 struct Args {
   std::string out;
   std::vector<std::string> libraries;
@@ -105,6 +137,7 @@ struct Args {
   double pbr_defaults = 0.5;    // share of models given glTF's default metallic and roughness
   double flat_textures = 0.25;  // share of models whose colour textures become their mean colour
   double white = 0.1;           // share of models whose colours all become a light grey (shape only)
+  double geometry_noise = 0.3;  // share of models given mild geometry noise
   bool normals = false;         // also write OUT/normals (camera-space normals)
 };
 
@@ -270,6 +303,11 @@ int run(const Args& a) {
         if (flat || white) m.base_color_texture = g2p::Texture{};
         if (white) m.base_color = Eigen::Vector4f(0.8f, 0.8f, 0.8f, m.base_color.w());
       }
+      // (Drawn whether used or not: the views stay those of --geometry-noise 0.)
+      const bool bumpy = u(rng) < a.geometry_noise;
+      const double sigma = 0.001 * (1 + 2 * u(rng));
+      const auto noise_seed = static_cast<unsigned>(rng());
+      if (bumpy) add_geometry_noise(model.mesh, sigma, 0.15, noise_seed);
       turn(model.mesh, 2 * M_PI * u(rng));
       g2p::ViewOptions vo;
       vo.layout = g2p::ViewLayout::kFibonacci;
@@ -352,6 +390,9 @@ int main(int argc, char** argv) {
                  "Share of models whose colour textures are replaced by their mean colour (default 0.25)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--white", a.white, "Share of models rendered light grey, shape only (default 0.1)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--geometry-noise", a.geometry_noise,
+                 "Share of models whose vertices move by 0.1-0.3 % of the diagonal, normals tilted (default 0.3)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--normals", a.normals, "Also write OUT/normals: camera-space normals for networks that take them");
   app.add_option("--max-models", a.max_models, "At most this many models per library (0 = all)");

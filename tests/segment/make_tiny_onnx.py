@@ -12,6 +12,8 @@ A second network, tiny_normals.onnx (card card_normals.json, input channels
 ["rgb", "normal"]), ignores colour and reads the camera-space normal n:
 logits (10 n_x, -10 n_x, 1), so surfaces facing right (n_x > 0.1) are Wood,
 those facing left Metal and the rest, or a view without normals, Glass.
+A third, tiny_normals_only.onnx (card card_normals_only.json, input channels
+["normal"]), is the same network without the colour planes.
 
 usage: make_tiny_onnx.py OUT_DIR
 """
@@ -66,6 +68,21 @@ def main(out_dir):
             "input": {"width": 32, "height": 32, "name": "input", "channels": ["rgb", "normal"]},
             "output": {"kind": "logits", "name": "logits"}, "classes": ["Wood", "Metal", "Glass"]}
     with open(os.path.join(out_dir, "card_normals.json"), "w") as f:
+        json.dump(card, f, indent=2)
+
+    conv = helper.make_node("Conv", ["input", "w", "b"], ["logits"], kernel_shape=[1, 1])
+    graph = helper.make_graph(
+        [conv], "tiny_normals_only",
+        [helper.make_tensor_value_info("input", TensorProto.FLOAT, [1, 3, 32, 32])],
+        [helper.make_tensor_value_info("logits", TensorProto.FLOAT, [1, 3, 32, 32])],
+        initializer=[numpy_helper.from_array(np.ascontiguousarray(w[:, 3:]), name="w"),
+                     numpy_helper.from_array(np.array([0.0, 0.0, 1.0], dtype=np.float32), name="b")])
+    model = helper.make_model(graph, producer_name="libg2p-tests", opset_imports=[helper.make_opsetid("", 11)])
+    model.ir_version = 7
+    onnx.checker.check_model(model)
+    onnx.save(model, os.path.join(out_dir, "tiny_normals_only.onnx"))
+    card = dict(card, model="tiny_normals_only.onnx", input=dict(card["input"], channels=["normal"]))
+    with open(os.path.join(out_dir, "card_normals_only.json"), "w") as f:
         json.dump(card, f, indent=2)
 
 

@@ -119,6 +119,40 @@ TEST(OnnxSegmenter, FeedsCameraSpaceNormalsWhenTheCardAsksForThem) {
   EXPECT_GT(object, 500);
 }
 
+// A card that takes normals only needs no RGB image: a view rendered
+// without shading is segmented as the view with it, and a colour-only card
+// refuses that view, naming what it lacks.
+TEST(OnnxSegmenter, ANormalsOnlyCardNeedsNoShading) {
+  const std::string dir = make_model_dir();
+  const Model model = rgb_boxes();
+  const MaterialTable& table = MaterialTable::paper_default();
+  Result<std::unique_ptr<Segmenter>> s = make_segmenter("onnx", {{"model_card", dir + "/card_normals_only.json"}});
+  ASSERT_TRUE(s.ok()) << s.status().to_string();
+  ASSERT_TRUE((*s)->set_model(model, table).ok());
+  Result<std::unique_ptr<Renderer>> renderer = renderer_registry().create("embree");
+  ASSERT_TRUE(renderer.ok() && (*renderer)->set_model(model).ok());
+  const View shaded = test::render(model, 1, 96)[0];
+  RenderOptions unshaded_options;
+  unshaded_options.shade = false;
+  Result<View> unshaded = (*renderer)->render(shaded.camera, unshaded_options);
+  ASSERT_TRUE(unshaded.ok());
+  ASSERT_TRUE(unshaded->rgb.empty());
+  Result<LabelMap> with = (*s)->segment(shaded), without = (*s)->segment(*unshaded);
+  ASSERT_TRUE(with.ok() && without.ok()) << without.status().to_string();
+  int wood = 0, metal = 0;
+  for (std::size_t i = 0; i < with->labels.size(); ++i) {
+    ASSERT_EQ(without->labels.data()[i], with->labels.data()[i]);
+    wood += with->labels.data()[i] == table.find("Wood");
+    metal += with->labels.data()[i] == table.find("Metal");
+  }
+  EXPECT_GT(wood + metal, 500);  // the normals decide, as in the rgb+normal network
+  auto colour = std::move(*make_segmenter("onnx", {{"model_card", dir + "/card_rgb.json"}}));
+  ASSERT_TRUE(colour->set_model(model, table).ok());
+  Result<LabelMap> refused = colour->segment(*unshaded);
+  EXPECT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.status().message().find("RGB image"), std::string::npos) << refused.status().to_string();
+}
+
 TEST(OnnxSegmenter, ModelCardErrors) {
   const std::string dir = make_model_dir();
   EXPECT_EQ(make_segmenter("onnx", {{"model_card", dir + "/none.json"}}).status().code(), StatusCode::kNotFound);

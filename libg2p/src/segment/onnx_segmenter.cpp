@@ -167,7 +167,8 @@ class OnnxSegmenter final : public Segmenter {
   Status segment_into(const View& view, LabelMap& out) const override {
     if (channel_class_.empty()) return Status::InvalidArgument("onnx: set_model() first");
     const int w = view.face_id.width(), h = view.face_id.height();
-    if (view.rgb.width() != w || view.rgb.height() != h || view.rgb.channels() != 3)
+    const bool needs_rgb = std::find(card_.channels.begin(), card_.channels.end(), "rgb") != card_.channels.end();
+    if (needs_rgb && (view.rgb.width() != w || view.rgb.height() != h || view.rgb.channels() != 3))
       return Status::InvalidArgument("onnx: the view needs an RGB image (render with shading on)");
 
     const cv::Size size(card_.width, card_.height);

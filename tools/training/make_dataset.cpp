@@ -40,6 +40,7 @@
 #include <set>
 #include <sstream>
 
+#include "augment.h"
 #include "g2p/g2p.h"
 
 namespace fs = std::filesystem;
@@ -96,36 +97,6 @@ void turn(g2p::Mesh& mesh, double yaw) {
   for (Eigen::Vector3f& n : mesh.normals) n = r * n;
 }
 
-// Mild geometry noise, as image-to-3D surfaces are bumpy: every vertex moves
-// by a random offset of standard deviation `sigma` (a fraction of the bounding
-// box's diagonal) per axis and its normal tilts by about `tilt` radians. The
-// noise is a function of the vertex's position, so vertices that coincide
-// (split at UV seams or creases) move together and open no cracks.
-void add_geometry_noise(g2p::Mesh& mesh, double sigma, double tilt, unsigned seed) {
-  const Eigen::AlignedBox3d box = g2p::bounds(mesh);
-  const double diagonal = box.isEmpty() ? 0.0 : box.diagonal().norm();
-  if (!(diagonal > 0)) return;
-  const double cell = 1e-6 * diagonal;  // positions closer than this share their noise
-  auto noise = [&](const Eigen::Vector3f& p) {
-    std::size_t h = seed;
-    for (int i = 0; i < 3; ++i) {
-      const auto q = static_cast<long long>(std::llround(p[i] / cell));
-      h ^= std::hash<long long>{}(q) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
-    }
-    std::mt19937 rng(static_cast<std::uint32_t>(h ^ (h >> 32)));
-    std::normal_distribution<float> n(0.f, 1.f);
-    Eigen::Vector3f a, b;
-    for (int i = 0; i < 3; ++i) a[i] = n(rng);
-    for (int i = 0; i < 3; ++i) b[i] = n(rng);
-    return std::make_pair(a, b);
-  };
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    const auto [offset, turn_by] = noise(mesh.positions[v]);
-    mesh.positions[v] += static_cast<float>(sigma * diagonal) * offset;
-    if (v < mesh.normals.size()) mesh.normals[v] = (mesh.normals[v] + static_cast<float>(tilt) * turn_by).normalized();
-  }
-}
-
 struct Args {
   std::string out;
   std::vector<std::string> libraries;
@@ -149,29 +120,6 @@ g2p::ImageU8 encode_normals(const g2p::View& view) {
   for (std::size_t i = 0; i < n.size(); ++i)
     out.data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(127.5f * (n.data()[i] + 1.f), 0.f, 255.f)));
   return out;
-}
-
-// The mean colour of an sRGB texture in linear RGB (what a texture far too
-// coarse to show any pattern bakes to), weighted by alpha; white when the
-// texture is absent or fully transparent.
-Eigen::Vector3f mean_linear_colour(const g2p::Texture& texture) {
-  if (texture.empty() || texture.image->channels() < 3) return Eigen::Vector3f::Ones();
-  const g2p::ImageU8& im = *texture.image;
-  float to_linear[256];
-  for (int i = 0; i < 256; ++i) {
-    const float c = i / 255.f;
-    to_linear[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-  }
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double weight = 0;
-  for (int y = 0; y < im.height(); ++y)
-    for (int x = 0; x < im.width(); ++x) {
-      const double w = im.channels() >= 4 ? im.at(x, y, 3) / 255.0 : 1.0;
-      for (int c = 0; c < 3; ++c) sum[c] += w * to_linear[im.at(x, y, c)];
-      weight += w;
-    }
-  if (!(weight > 0)) return Eigen::Vector3f::Ones();
-  return (sum / weight).cast<float>();
 }
 
 int run(const Args& a) {
@@ -299,15 +247,17 @@ int run(const Args& a) {
       for (g2p::SourceMaterial& m : model.materials) {
         if (defaults) m.metallic = 1.f, m.roughness = 1.f, m.metallic_roughness_texture = g2p::Texture{};
         if (flat && !white && !m.base_color_texture.empty())
-          m.base_color.head<3>() = m.base_color.head<3>().cwiseProduct(mean_linear_colour(m.base_color_texture));
+          m.base_color.head<3>() =
+              m.base_color.head<3>().cwiseProduct(g2p::training::mean_linear_colour(m.base_color_texture));
         if (flat || white) m.base_color_texture = g2p::Texture{};
         if (white) m.base_color = Eigen::Vector4f(0.8f, 0.8f, 0.8f, m.base_color.w());
       }
-      // (Drawn whether used or not: the views stay those of --geometry-noise 0.)
-      const bool bumpy = u(rng) < a.geometry_noise;
-      const double sigma = 0.001 * (1 + 2 * u(rng));
-      const auto noise_seed = static_cast<unsigned>(rng());
-      if (bumpy) add_geometry_noise(model.mesh, sigma, 0.15, noise_seed);
+      // Geometry noise draws from a generator of its own (seeded by --seed
+      // and the model), so the views and appearance above are those of
+      // datasets made without it.
+      std::mt19937_64 noise_rng(g2p::training::splitmix64(a.seed) ^ g2p::training::fnv1a(key));
+      if (u(noise_rng) < a.geometry_noise)
+        g2p::training::add_geometry_noise(model.mesh, 0.001 * (1 + 2 * u(noise_rng)), 0.15, noise_rng());
       turn(model.mesh, 2 * M_PI * u(rng));
       g2p::ViewOptions vo;
       vo.layout = g2p::ViewLayout::kFibonacci;

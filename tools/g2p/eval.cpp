@@ -77,6 +77,8 @@ int run_eval_seg(const EvalArgs& args) {
   if (!table.ok()) return exit_code;
   Result<std::unique_ptr<Segmenter>> predictor = make_segmenter_flag("eval seg", args.segmenter, exit_code);
   if (!predictor.ok()) return exit_code;
+  Result<std::unique_ptr<Refiner>> refiner = make_refiner_flag("eval seg", args.refine, exit_code);
+  if (!refiner.ok()) return exit_code;
 
   // total_3d pools every face by its area; per_model_3d scales each model's
   // matrix to one first, so that no model dominates by its size or units
@@ -134,9 +136,9 @@ int run_eval_seg(const EvalArgs& args) {
       std::cerr << "g2p eval seg: error: " << key << ": " << projection.status().to_string() << "\n";
       return kExitFailure;
     }
-    nlohmann::json refine_report;
-    if (const int code = refine_projection("eval seg", args.refine, *model, *views, *table, project_options.partition,
-                                           *projection, refine_report);
+    nlohmann::json refine_report;  // kept in the JSON, not printed: the table stays one line per model
+    if (const int code = apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
+                                       project_options.partition, *projection, refine_report, /*print_notes=*/false);
         code != kExitOk)
       return code;
     Result<std::vector<int>> material_truth =
@@ -165,6 +167,10 @@ int run_eval_seg(const EvalArgs& args) {
         100.0 * matrix_3d.accuracy(), 100.0 * matrix_3d.mean_iou());
     per_model[key] = {{"2d", nlohmann::json::parse(matrix.to_json(*table))},
                       {"3d", nlohmann::json::parse(matrix_3d.to_json(*table))}};
+    if (refiner->get() != nullptr) {
+      refine_report.erase("changes_first_1000");  // per face: too long for a score file
+      per_model[key]["refine"] = refine_report;
+    }
   }
   std::printf("\nAll %zu models, one confusion matrix (%.0f labelled pixels), IoU %%:\n", keys.size(), total.total());
   std::cout << total.table(*table) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
@@ -185,6 +191,7 @@ int run_eval_seg(const EvalArgs& args) {
         {"base_color_only", args.base_color_only},
         {"vote", args.soft ? "soft" : "hard"},
         {"refiner", args.refine.name},
+        {"refine_settings", args.refine.settings},
         {"views", args.views.views},
         {"resolution", args.views.resolution},
         {"total", nlohmann::json::parse(total.to_json(*table))},

@@ -17,33 +17,41 @@ void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& defau
                   "api_key_env, timeout, retries, backoff, max_response_bytes, prompt_file, max_views)");
 }
 
-int refine_projection(const std::string& command, const RefineArgs& args, const Model& model,
-                      const std::vector<View>& views, const MaterialTable& table,
-                      const PartitionOptions& partition_options, Projection& projection, nlohmann::json& report) {
-  report = {{"refiner", args.name}};
+Result<std::unique_ptr<Refiner>> make_refiner_flag(const std::string& command, const RefineArgs& args, int& exit_code) {
+  exit_code = kExitUsage;
   if (args.name == "none") {
     if (!args.settings.empty()) {
       std::cerr << "g2p " << command << ": --refine-set needs a --refiner other than none\n";
-      return kExitUsage;
+      return Status::InvalidArgument("--refine-set without --refiner");
     }
-    return kExitOk;
+    exit_code = kExitOk;
+    return std::unique_ptr<Refiner>();  // no refiner
   }
   BackendSettings settings;
   for (const std::string& kv : args.settings) {
     const std::size_t eq = kv.find('=');
     if (eq == std::string::npos || eq == 0) {
       std::cerr << "g2p " << command << ": --refine-set expects KEY=VALUE, got '" << kv << "'\n";
-      return kExitUsage;
+      return Status::InvalidArgument("bad --refine-set");
     }
     settings[kv.substr(0, eq)] = kv.substr(eq + 1);
   }
   Result<std::unique_ptr<Refiner>> refiner = make_refiner(args.name, settings);
   if (!refiner.ok()) {
     std::cerr << "g2p " << command << ": " << refiner.status().message() << "\n";
-    return kExitUsage;
+    return refiner.status();
   }
+  exit_code = kExitOk;
+  return refiner;
+}
+
+int apply_refiner(const std::string& command, const std::string& name, const Refiner* refiner, const Model& model,
+                  const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition_options,
+                  Projection& projection, nlohmann::json& report, bool print_notes) {
+  report = {{"refiner", name}};
+  if (refiner == nullptr) return kExitOk;
   RefineInput in{&model.mesh, &projection.graph, &projection.votes, &projection.labels, &views, &table};
-  Result<RefineResult> refined = (*refiner)->refine(in);
+  Result<RefineResult> refined = refiner->refine(in);
   if (!refined.ok() &&
       (refined.status().code() == StatusCode::kInvalidArgument || refined.status().code() == StatusCode::kNotFound)) {
     // Missing settings (no model name, an unreadable prompt file): the command line is wrong.
@@ -69,8 +77,19 @@ int refine_projection(const std::string& command, const RefineArgs& args, const 
     changes.push_back({{"face", c.face}, {"from", c.from}, {"to", c.to}, {"reason", c.reason}});
   }
   report["changes_first_1000"] = changes;
-  for (const std::string& n : refined->notes) std::cout << n << "\n";
+  if (print_notes)
+    for (const std::string& n : refined->notes) std::cout << n << "\n";
   return kExitOk;
+}
+
+int refine_projection(const std::string& command, const RefineArgs& args, const Model& model,
+                      const std::vector<View>& views, const MaterialTable& table,
+                      const PartitionOptions& partition_options, Projection& projection, nlohmann::json& report) {
+  int exit_code = kExitOk;
+  Result<std::unique_ptr<Refiner>> refiner = make_refiner_flag(command, args, exit_code);
+  if (!refiner.ok()) return exit_code;
+  return apply_refiner(command, args.name, refiner->get(), model, views, table, partition_options, projection, report,
+                       /*print_notes=*/true);
 }
 
 Status write_projection(const std::string& out, const Model& model, const std::vector<View>& views,

@@ -20,6 +20,18 @@ struct RefineArgs {
 };
 void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& default_name);
 
+// The refiner the flags name, or null for "none"; prints a usage error and
+// sets exit_code to kExitUsage when they are bad.
+Result<std::unique_ptr<Refiner>> make_refiner_flag(const std::string& command, const RefineArgs& args, int& exit_code);
+
+// Runs `refiner` (null: nothing) on the projection and re-partitions with its
+// labels; `report` gets what refine_projection writes to refine.json. A
+// refiner failure keeps the projected labels (a warning; the report says
+// why). With print_notes, its notes go to stdout.
+int apply_refiner(const std::string& command, const std::string& name, const Refiner* refiner, const Model& model,
+                  const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition,
+                  Projection& projection, nlohmann::json& report, bool print_notes);
+
 // Runs the refiner on the projection and re-partitions with its labels. A
 // refiner failure keeps the projected labels (a warning; the report says
 // why). Returns an exit code: kExitOk, or kExitUsage for bad flags.

@@ -121,7 +121,8 @@ TEST(OnnxSegmenter, FeedsCameraSpaceNormalsWhenTheCardAsksForThem) {
 
 // A card that takes normals only needs no RGB image: a view rendered
 // without shading is segmented as the view with it, and a colour-only card
-// refuses that view, naming what it lacks.
+// refuses that view, naming what it lacks; so does the normals-only card a
+// view without normals.
 TEST(OnnxSegmenter, ANormalsOnlyCardNeedsNoShading) {
   const std::string dir = make_model_dir();
   const Model model = rgb_boxes();
@@ -146,11 +147,20 @@ TEST(OnnxSegmenter, ANormalsOnlyCardNeedsNoShading) {
     metal += with->labels.data()[i] == table.find("Metal");
   }
   EXPECT_GT(wood + metal, 500);  // the normals decide, as in the rgb+normal network
-  auto colour = std::move(*make_segmenter("onnx", {{"model_card", dir + "/card_rgb.json"}}));
-  ASSERT_TRUE(colour->set_model(model, table).ok());
-  Result<LabelMap> refused = colour->segment(*unshaded);
+  Result<std::unique_ptr<Segmenter>> colour = make_segmenter("onnx", {{"model_card", dir + "/card_rgb.json"}});
+  ASSERT_TRUE(colour.ok()) << colour.status().to_string();
+  ASSERT_TRUE((*colour)->set_model(model, table).ok());
+  Result<LabelMap> refused = (*colour)->segment(*unshaded);
   EXPECT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(refused.status().message().find("RGB image"), std::string::npos) << refused.status().to_string();
+  // Neither shading nor geometry buffers: the normals-only card has nothing to read.
+  RenderOptions nothing = unshaded_options;
+  nothing.geometry_buffers = false;
+  Result<View> bare = (*renderer)->render(shaded.camera, nothing);
+  ASSERT_TRUE(bare.ok());
+  Result<LabelMap> blind = (*s)->segment(*bare);
+  EXPECT_EQ(blind.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(blind.status().message().find("normals only"), std::string::npos) << blind.status().to_string();
 }
 
 TEST(OnnxSegmenter, ModelCardErrors) {

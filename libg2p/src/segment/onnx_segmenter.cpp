@@ -170,6 +170,10 @@ class OnnxSegmenter final : public Segmenter {
     const bool needs_rgb = std::find(card_.channels.begin(), card_.channels.end(), "rgb") != card_.channels.end();
     if (needs_rgb && (view.rgb.width() != w || view.rgb.height() != h || view.rgb.channels() != 3))
       return Status::InvalidArgument("onnx: the view needs an RGB image (render with shading on)");
+    if (!needs_rgb && view.normal.empty())  // zeros would be all the network sees
+      return Status::InvalidArgument(
+          "onnx: the model card takes normals only and the view has none (render with "
+          "geometry buffers on)");
 
     const cv::Size size(card_.width, card_.height);
     std::vector<cv::Mat> inputs;  // one 3-channel float image per entry of card_.channels

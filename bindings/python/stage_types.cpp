@@ -102,6 +102,12 @@ void bind_stage_types(py::module_& m) {
       .def_readwrite("orthographic", &ViewOptions::orthographic)
       .def_readwrite("margin", &ViewOptions::margin)
       .def_readwrite("elevation_deg", &ViewOptions::elevation_deg);
+  py::class_<CameraLight>(m, "CameraLight", "A directional light that turns with the camera")
+      .def(py::init([](const py::kwargs& kw) { return from_kwargs<CameraLight>(kw); }))
+      .def_readwrite("direction", &CameraLight::direction,
+                     "towards the light in the camera's frame (x right, y down, z forward)")
+      .def_readwrite("irradiance", &CameraLight::irradiance, ">= 0; the studio key light is 2.4");
+  m.def("studio_lights", &studio_lights, "libg2p's studio set: key, fill and rim");
   py::class_<RenderOptions>(m, "RenderOptions")
       .def(py::init([](const py::kwargs& kw) { return from_kwargs<RenderOptions>(kw); }))
       .def_readwrite("shade", &RenderOptions::shade)
@@ -109,7 +115,8 @@ void bind_stage_types(py::module_& m) {
       .def_readwrite("geometry_buffers", &RenderOptions::geometry_buffers)
       .def_readwrite("background", &RenderOptions::background, "sRGB (r, g, b)")
       .def_readwrite("max_layers", &RenderOptions::max_layers)
-      .def_readwrite("tile_size", &RenderOptions::tile_size);
+      .def_readwrite("tile_size", &RenderOptions::tile_size)
+      .def_readwrite("lights", &RenderOptions::lights, "CameraLight list; empty: studio_lights()");
 
   py::class_<View> view(m, "View",
                         "One rendered view. Buffers are numpy copies (None when not rendered): rgb (H, W, 3) "

@@ -402,6 +402,25 @@ class ModelsAndStagesTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             g2p.Model.from_arrays(np.zeros((3, 2)), np.array([[0, 1, 2]]))
 
+    def test_render_lights(self):
+        model = g2p.load_model(HAMMER)
+        cameras = g2p.make_views(model.mesh, g2p.ViewOptions(num_views=1, width=64, height=64))
+        renderer = g2p.make_renderer("embree")
+        studio = g2p.studio_lights()
+        self.assertEqual(len(studio), 3)
+        self.assertAlmostEqual(studio[0].irradiance, 2.4, places=5)
+        default = g2p.render_views(renderer, model, cameras)[0].rgb
+        explicit = g2p.render_views(renderer, model, cameras, g2p.RenderOptions(lights=studio))[0].rgb
+        np.testing.assert_array_equal(default, explicit)
+        dim = g2p.RenderOptions(lights=[g2p.CameraLight(direction=np.array([0.0, 0.0, -1.0]), irradiance=0.2)])
+        darker = g2p.render_views(renderer, model, cameras, dim)[0]
+        hit = darker.face_id >= 0
+        self.assertLess(darker.rgb[hit].mean(), default[hit].mean() - 10)
+        bad = g2p.RenderOptions(lights=[g2p.CameraLight(irradiance=-1.0)])
+        with self.assertRaises(ValueError) as caught:
+            g2p.render_views(renderer, model, cameras, bad)
+        self.assertIn("lights[0]", str(caught.exception))
+
     def test_stages_one_by_one(self):
         model = g2p.load_model(HAMMER)
         cameras = g2p.make_views(model.mesh, g2p.ViewOptions(num_views=4, width=96, height=96))

@@ -299,6 +299,63 @@ TEST(EmbreeRenderer, DeterministicAndBuffersConsistent) {
   }
 }
 
+// RenderOptions::lights: empty is the studio set; one light from the camera's
+// left brightens the surfaces that face left, its mirror image those that face
+// right; a bad light is an error naming it.
+TEST(EmbreeRenderer, LightsDefaultToTheStudioSetAndCanBeReplaced) {
+  Result<Model> model = load_model(test::asset_path("Avocado"));
+  ASSERT_TRUE(model.ok());
+  auto renderer = embree();
+  ASSERT_TRUE(renderer->set_model(*model).ok());
+  ViewOptions vo;
+  vo.num_views = 1;
+  vo.width = vo.height = 128;
+  const Camera cam = (*make_views(model->mesh, vo))[0];
+  RenderOptions studio;
+  studio.lights = studio_lights();
+  Result<View> by_default = renderer->render(cam), explicit_studio = renderer->render(cam, studio);
+  ASSERT_TRUE(by_default.ok() && explicit_studio.ok());
+  EXPECT_EQ(by_default->rgb, explicit_studio->rgb);
+
+  // Mean brightness of the pixels facing the camera's left and right.
+  auto left_over_right = [&](const Eigen::Vector3f& towards_light) {
+    RenderOptions one;
+    one.lights = {CameraLight{towards_light, 3.f}};
+    Result<View> v = renderer->render(cam, one);
+    EXPECT_TRUE(v.ok());
+    double sum[2] = {0, 0};
+    int count[2] = {0, 0};
+    const Eigen::Matrix3f to_camera = cam.rotation.cast<float>().transpose();
+    for (int y = 0; y < 128; ++y)
+      for (int x = 0; x < 128; ++x) {
+        if (v->face_id.at(x, y) < 0) continue;
+        const Eigen::Vector3f n =
+            to_camera * Eigen::Vector3f(v->normal.at(x, y, 0), v->normal.at(x, y, 1), v->normal.at(x, y, 2));
+        if (std::abs(n.x()) < 0.5f) continue;
+        const int side = n.x() < 0 ? 0 : 1;
+        sum[side] += v->rgb.at(x, y, 0) + v->rgb.at(x, y, 1) + v->rgb.at(x, y, 2);
+        ++count[side];
+      }
+    EXPECT_GT(count[0], 50);
+    EXPECT_GT(count[1], 50);
+    return (sum[0] / std::max(count[0], 1)) / (sum[1] / std::max(count[1], 1) + 1e-9);
+  };
+  const double from_left = left_over_right({-1.f, 0.f, -0.3f}), from_right = left_over_right({1.f, 0.f, -0.3f});
+  std::printf("left/right brightness: %.2f lit from the left, %.2f from the right\n", from_left, from_right);
+  EXPECT_GT(from_left, 1.25);  // measured 1.58: the ambient terms light both sides
+  EXPECT_LT(from_right, 0.8);  // measured 0.45
+  EXPECT_GT(from_left, 2 * from_right);
+
+  for (const CameraLight& bad : {CameraLight{Eigen::Vector3f::Zero(), 1.f}, CameraLight{Eigen::Vector3f::UnitX(), -1.f},
+                                 CameraLight{Eigen::Vector3f::UnitX(), std::nanf("")}}) {
+    RenderOptions o;
+    o.lights = {studio_lights()[0], bad};
+    Result<View> v = renderer->render(cam, o);
+    EXPECT_EQ(v.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(v.status().message().find("lights[1]"), std::string::npos) << v.status().to_string();
+  }
+}
+
 TEST(EmbreeRenderer, RenderIntoReusesAViewWithoutChangingTheResult) {
   Result<Model> model = load_model(test::asset_path("SheenChair"));
   ASSERT_TRUE(model.ok());

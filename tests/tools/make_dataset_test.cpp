@@ -218,6 +218,52 @@ TEST(GeometryNoise, CoincidentVerticesMoveTogether) {
   EXPECT_EQ(again.positions, mesh.positions);
 }
 
+// --random-lights: the same views and labels, other shading.
+TEST(ToolMakeDataset, RandomLightsChangeTheShadingNotTheViews) {
+  const std::string dir = test::scratch_dir("ToolMakeDataset.lights");
+  fs::remove_all(dir);
+  write_boxes(dir + "/Lib/boxes", "boxes");
+  for (const char* share : {"0", "1"})
+    ASSERT_EQ(run_make_dataset(quote(dir + "/out" + share) + " " + quote(dir + "/Lib") +
+                               " --test None --views 4 --size 64 --geometry-noise 0 --random-lights " + share),
+              0);
+  int images = 0;
+  double change = 0;
+  long pixels = 0;
+  for (const auto& entry : fs::directory_iterator(dir + "/out0/images")) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(test::read_file(dir + "/out0/labels/" + name), test::read_file(dir + "/out1/labels/" + name)) << name;
+    Result<ImageU8> a = read_image(entry.path().string()), b = read_image(dir + "/out1/images/" + name);
+    Result<ImageU8> label = read_image(dir + "/out0/labels/" + name);
+    ASSERT_TRUE(a.ok() && b.ok() && label.ok()) << name;
+    for (int y = 0; y < a->height(); ++y)
+      for (int x = 0; x < a->width(); ++x) {
+        if (label->at(x, y) == 255) continue;
+        ++pixels;
+        for (int c = 0; c < 3; ++c) change += std::abs(a->at(x, y, c) - b->at(x, y, c));
+      }
+    ++images;
+  }
+  EXPECT_EQ(images, 4);
+  ASSERT_GT(pixels, 500);
+  EXPECT_GT(change / (3.0 * pixels), 3.0) << "mean change per channel, 8-bit";
+}
+
+TEST(RandomLights, JitteredStudioLightsAreValidAndReproducible) {
+  std::mt19937_64 a(7), b(7);
+  const std::vector<CameraLight> first = training::jittered_studio_lights(a);
+  const std::vector<CameraLight> again = training::jittered_studio_lights(b);
+  const std::vector<CameraLight> studio = studio_lights();
+  ASSERT_EQ(first.size(), studio.size());
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    EXPECT_NEAR(first[i].direction.norm(), 1.f, 1e-5f);
+    EXPECT_GE(first[i].irradiance, 0.5f * studio[i].irradiance - 1e-6f);
+    EXPECT_LE(first[i].irradiance, 1.5f * studio[i].irradiance + 1e-6f);
+    EXPECT_EQ(first[i].direction, again[i].direction);
+    EXPECT_NE(first[i].direction, studio[i].direction);
+  }
+}
+
 TEST(FlatTexture, MeanLinearColourWeighsByAlpha) {
   auto image = std::make_shared<ImageU8>(2, 1, 4, 0);
   image->at(0, 0, 0) = 255, image->at(0, 0, 3) = 255;  // opaque red

@@ -6,10 +6,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <random>
 #include <string_view>
+#include <vector>
 
 #include "g2p/mesh.h"
 #include "g2p/model.h"
+#include "g2p/render.h"
 
 namespace g2p::training {
 
@@ -86,6 +89,24 @@ inline void add_geometry_noise(Mesh& mesh, double sigma, double tilt, std::uint6
     mesh.positions[v] += static_cast<float>(sigma * diagonal) * offset;
     if (v < mesh.normals.size()) mesh.normals[v] = (mesh.normals[v] + static_cast<float>(tilt) * turn).normalized();
   }
+}
+
+// The studio lights (studio_lights()) jittered, as photographs and baked
+// textures are lit in many ways: each light's direction moves by a Gaussian
+// vector of standard deviation `turn` (then normalised) and its irradiance is
+// scaled by a factor drawn from [1 - spread, 1 + spread].
+template <class Rng>
+std::vector<CameraLight> jittered_studio_lights(Rng& rng, float turn = 0.5f, float spread = 0.5f) {
+  std::normal_distribution<float> gauss(0.f, turn);
+  std::uniform_real_distribution<float> scale(1.f - spread, 1.f + spread);
+  std::vector<CameraLight> lights = studio_lights();
+  for (CameraLight& l : lights) {
+    Eigen::Vector3f d = l.direction;
+    for (int i = 0; i < 3; ++i) d[i] += gauss(rng);
+    if (d.norm() > 1e-3f) l.direction = d.normalized();
+    l.irradiance *= scale(rng);
+  }
+  return lights;
 }
 
 }  // namespace g2p::training

@@ -4,7 +4,7 @@
 //   g2p_make_dataset OUT LIBRARY_DIR... [--views 8] [--size 160] [--seed 1]
 //                    [--overrides tools/training/overrides.json] [--test KatorLegaz,Reallusion]
 //                    [--pbr-defaults 0.5] [--flat-textures 0.25] [--white 0.1]
-//                    [--geometry-noise 0.3]
+//                    [--geometry-noise 0.3] [--random-lights 0.3]
 //                    [--normals]
 //
 // Each LIBRARY_DIR is an unpacked furniture library (Sweet Home 3D's .sh3f
@@ -16,8 +16,9 @@
 // axis at random and rendered from `views` of 24 directions on a Fibonacci
 // sphere, with a random field of view and background; its PBR values are set
 // to glTF's defaults, its colour textures flattened to their mean colour or its
-// colours whitened on a share of models, and mild geometry noise added to a
-// share, as image-to-3D meshes arrive. Writes OUT/images/*.png (RGB),
+// colours whitened on a share of models, mild geometry noise added to a share
+// and the studio lights jittered per view on a share, as image-to-3D meshes
+// arrive. Writes OUT/images/*.png (RGB),
 // OUT/labels/*.png (class index, 255 = unlabelled or background),
 // with --normals OUT/normals/*.png (camera-space unit normal n as 8-bit
 // 127.5 * (n + 1), background 128: the encoding segment/onnx reads),
@@ -109,6 +110,7 @@ struct Args {
   double flat_textures = 0.25;  // share of models whose colour textures become their mean colour
   double white = 0.1;           // share of models whose colours all become a light grey (shape only)
   double geometry_noise = 0.3;  // share of models given mild geometry noise
+  double random_lights = 0.3;   // share of models whose views are lit by jittered studio lights
   bool normals = false;         // also write OUT/normals (camera-space normals)
 };
 
@@ -258,6 +260,9 @@ int run(const Args& a) {
       std::mt19937_64 noise_rng(g2p::training::splitmix64(a.seed) ^ g2p::training::fnv1a(key));
       if (u(noise_rng) < a.geometry_noise)
         g2p::training::add_geometry_noise(model.mesh, 0.001 * (1 + 2 * u(noise_rng)), 0.15, noise_rng());
+      // Lights likewise: jittered studio lights per view on a share of models.
+      std::mt19937_64 light_rng(g2p::training::splitmix64(a.seed + 1) ^ g2p::training::fnv1a(key));
+      const bool relit = u(light_rng) < a.random_lights;
       turn(model.mesh, 2 * M_PI * u(rng));
       g2p::ViewOptions vo;
       vo.layout = g2p::ViewLayout::kFibonacci;
@@ -275,6 +280,7 @@ int run(const Args& a) {
         g2p::RenderOptions ro;
         ro.material_buffers = false;
         ro.geometry_buffers = a.normals;
+        if (relit) ro.lights = g2p::training::jittered_studio_lights(light_rng);
         for (auto& c : ro.background) c = static_cast<std::uint8_t>(255 * u(rng));
         g2p::Result<g2p::View> view = (*renderer)->render(chosen[v], ro);
         if (!view.ok()) continue;
@@ -343,6 +349,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--geometry-noise", a.geometry_noise,
                  "Share of models whose vertices move by 0.1-0.3 % of the diagonal, normals tilted (default 0.3)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--random-lights", a.random_lights,
+                 "Share of models whose views are lit by jittered studio lights (default 0.3)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--normals", a.normals, "Also write OUT/normals: camera-space normals for networks that take them");
   app.add_option("--max-models", a.max_models, "At most this many models per library (0 = all)");

@@ -73,6 +73,18 @@ struct ViewOptions {
 // front. kSphere with 11 views: top, bottom, 5 views at +30 deg, 4 at -30 deg.
 G2P_API Result<std::vector<Camera>> make_views(const Mesh& mesh, const ViewOptions& options = {});
 
+// A directional light that turns with the camera, so that every view of an
+// object is lit alike. No shadows.
+struct CameraLight {
+  Eigen::Vector3f direction{0.f, 0.f, -1.f};  // towards the light in the camera's frame (x right, y down, z
+                                              // forward); any length > 0 (normalised when rendering)
+  float irradiance = 1.f;                     // >= 0; the studio key light is 2.4
+};
+
+// libg2p's studio set: key (irradiance 2.4) from the upper left in front of the
+// object, fill (0.8) from the right, rim (1.0) from behind and above.
+G2P_API std::vector<CameraLight> studio_lights();
+
 struct RenderOptions {
   bool shade = true;                                      // the RGB image (Lambert + GGX under the studio lights)
   bool material_buffers = true;                           // base colour, metallic-roughness and transmission per pixel
@@ -80,6 +92,9 @@ struct RenderOptions {
   std::array<std::uint8_t, 3> background{200, 200, 200};  // sRGB, neutral grey
   int max_layers = 4;  // transparent surfaces composited per pixel (BLEND, transmission)
   int tile_size = 32;  // pixels; square tiles are rendered in parallel
+  // The lights of the RGB image; empty: studio_lights(). The ambient sky,
+  // ground and environment terms apply either way (render.md).
+  std::vector<CameraLight> lights;
 };
 
 // One rendered view. Every buffer has the camera's size; background pixels

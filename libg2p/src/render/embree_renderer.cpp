@@ -198,6 +198,15 @@ Status EmbreeRenderer::render_into(const Camera& camera, const RenderOptions& op
   G2P_RETURN_IF_ERROR(camera.validate().with_context("render"));
   if (options.tile_size < 1 || options.max_layers < 1)
     return Status::InvalidArgument("render: tile_size and max_layers must be >= 1");
+  std::vector<CameraLight> lights = options.lights.empty() ? studio_lights() : options.lights;
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const float length = lights[i].direction.norm();
+    if (!(length > 0.f) || !std::isfinite(length) || !(lights[i].irradiance >= 0.f) ||
+        !std::isfinite(lights[i].irradiance))
+      return Status::InvalidArgument("render: lights[" + std::to_string(i) +
+                                     "] needs a finite, non-zero direction and a finite irradiance >= 0");
+    lights[i].direction /= length;
+  }
 
   const int w = camera.width, h = camera.height;
   view.camera = camera;
@@ -259,7 +268,8 @@ Status EmbreeRenderer::render_into(const Camera& camera, const RenderOptions& op
         for (int layer = 0; layer < options.max_layers && hit.face >= 0; ++layer) {
           const detail::SurfaceSample s =
               detail::evaluate_material(material_of(hit.face), uv_at(hit.face, hit.u, hit.v));
-          const detail::ShadedColor lit = detail::shade(s, facing_normal(hit, to_viewer), to_viewer, camera_to_world);
+          const detail::ShadedColor lit =
+              detail::shade(s, facing_normal(hit, to_viewer), to_viewer, camera_to_world, lights);
           // Transmission leaves a faint body colour, keeps the highlights and
           // tints what is seen through it: glass reads as glass.
           // The last layer allowed is treated as opaque rather than dropped.

@@ -6,8 +6,9 @@
 // alpha = roughness^2 and k = (roughness + 1)^2 / 8 (Karis 2013, "Real Shading
 // in Unreal Engine 4").
 //
-// The studio light set is fixed relative to the camera, so every view of every
-// object is lit alike (what a segmenter trained on studio renders expects):
+// The default (studio) light set is fixed relative to the camera, so every view
+// of every object is lit alike (what a segmenter trained on studio renders
+// expects); RenderOptions::lights replaces the three directional lights:
 //   key   irradiance 2.4 from the camera's upper left, in front of the object
 //   fill  irradiance 0.8 from the right
 //   rim   irradiance 1.0 from behind and above the object
@@ -44,20 +45,6 @@ int wrap(int i, int n, WrapMode mode) {
     case WrapMode::kRepeat: break;
   }
   return ((i % n) + n) % n;
-}
-
-struct Light {
-  Eigen::Vector3f direction_camera;  // towards the light, camera frame (x right, y down, z forward)
-  float irradiance;
-};
-
-const std::array<Light, 3>& studio_lights() {
-  static const std::array<Light, 3> lights = {
-      Light{Eigen::Vector3f(-0.4f, -0.6f, -0.7f).normalized(), 2.4f},  // key
-      Light{Eigen::Vector3f(0.8f, -0.1f, -0.6f).normalized(), 0.8f},   // fill
-      Light{Eigen::Vector3f(0.1f, -0.5f, 0.85f).normalized(), 1.0f},   // rim
-  };
-  return lights;
 }
 
 constexpr float kSky = 0.25f, kGround = 0.10f, kEnvironment = 0.35f;
@@ -131,7 +118,7 @@ SurfaceSample evaluate_material(const SourceMaterial& m, const Eigen::Vector2f& 
 }
 
 ShadedColor shade(const SurfaceSample& s, const Eigen::Vector3f& n, const Eigen::Vector3f& v,
-                  const Eigen::Matrix3f& camera_to_world) {
+                  const Eigen::Matrix3f& camera_to_world, const std::vector<CameraLight>& lights) {
   ShadedColor out;
   const float roughness = std::max(s.roughness, 0.05f);  // a perfect mirror would show no highlight at all
   const float a = roughness * roughness, a2 = a * a;
@@ -141,8 +128,8 @@ ShadedColor shade(const SurfaceSample& s, const Eigen::Vector3f& n, const Eigen:
   const float n_dot_v = std::max(n.dot(v), 1e-4f);
   const float g_v = n_dot_v / (n_dot_v * (1.f - k) + k);
 
-  for (const Light& light : studio_lights()) {
-    const Eigen::Vector3f l = camera_to_world * light.direction_camera;
+  for (const CameraLight& light : lights) {
+    const Eigen::Vector3f l = camera_to_world * light.direction;
     const float n_dot_l = n.dot(l);
     if (n_dot_l <= 0.f) continue;
     const Eigen::Vector3f h = (l + v).normalized();
@@ -166,3 +153,15 @@ ShadedColor shade(const SurfaceSample& s, const Eigen::Vector3f& n, const Eigen:
 }
 
 }  // namespace g2p::detail
+
+namespace g2p {
+
+std::vector<CameraLight> studio_lights() {
+  return {
+      CameraLight{Eigen::Vector3f(-0.4f, -0.6f, -0.7f).normalized(), 2.4f},  // key
+      CameraLight{Eigen::Vector3f(0.8f, -0.1f, -0.6f).normalized(), 0.8f},   // fill
+      CameraLight{Eigen::Vector3f(0.1f, -0.5f, 0.85f).normalized(), 1.0f},   // rim
+  };
+}
+
+}  // namespace g2p

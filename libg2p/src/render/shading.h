@@ -5,7 +5,10 @@
 
 #include <Eigen/Core>
 
+#include <vector>
+
 #include "g2p/model.h"
+#include "g2p/render.h"
 
 namespace g2p::detail {
 
@@ -34,15 +37,15 @@ SurfaceSample evaluate_material(const SourceMaterial& material, const Eigen::Vec
 // Alpha of a material at `uv` (factor times texture), for MASK cut-outs.
 float material_alpha(const SourceMaterial& material, const Eigen::Vector2f& uv);
 
-// Radiance leaving the surface towards the camera under libg2p's fixed studio
-// light set (see shading.cpp), split so callers can weight the specular part
-// of transparent surfaces separately. `n` and `v` are unit world vectors with
-// dot(n, v) >= 0; `camera_to_world` orients the camera-relative lights.
+// Radiance leaving the surface towards the camera under `lights` (unit
+// directions; studio_lights() by default) and the ambient terms (see shading.cpp), split so callers can weight the
+// specular part of transparent surfaces separately. `n` and `v` are unit world vectors with dot(n, v) >= 0;
+// `camera_to_world` orients the camera-relative lights.
 struct ShadedColor {
   Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();
   Eigen::Vector3f specular = Eigen::Vector3f::Zero();
 };
 ShadedColor shade(const SurfaceSample& s, const Eigen::Vector3f& n, const Eigen::Vector3f& v,
-                  const Eigen::Matrix3f& camera_to_world);
+                  const Eigen::Matrix3f& camera_to_world, const std::vector<CameraLight>& lights);
 
 }  // namespace g2p::detail

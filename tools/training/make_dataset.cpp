@@ -339,20 +339,16 @@ int main(int argc, char** argv) {
   app.add_option("--overrides", a.overrides, "Reviewed label overrides (JSON)");
   app.add_option("--test", a.test, "Libraries held out as the test split (default KatorLegaz,Reallusion)");
   app.add_option("--min-labelled", a.min_labelled, "Skip models with less labelled area (default 0.2)");
-  app.add_option("--pbr-defaults", a.pbr_defaults,
-                 "Share of models rendered with glTF's default metallic and roughness (default 0.5)")
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--flat-textures", a.flat_textures,
-                 "Share of models whose colour textures are replaced by their mean colour (default 0.25)")
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--white", a.white, "Share of models rendered light grey, shape only (default 0.1)")
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--geometry-noise", a.geometry_noise,
-                 "Share of models whose vertices move by 0.1-0.3 % of the diagonal, normals tilted (default 0.3)")
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--random-lights", a.random_lights,
-                 "Share of models whose views are lit by jittered studio lights (default 0.3)")
-      ->check(CLI::Range(0.0, 1.0));
+  // The augmentations: each a share of the models, in [0, 1].
+  auto share = [&app](const char* flag, double& value, const std::string& what) {
+    app.add_option(flag, value, "Share of models " + what)->check(CLI::Range(0.0, 1.0));
+  };
+  share("--pbr-defaults", a.pbr_defaults, "rendered with glTF's default metallic and roughness (default 0.5)");
+  share("--flat-textures", a.flat_textures, "whose colour textures are replaced by their mean colour (default 0.25)");
+  share("--white", a.white, "rendered light grey, shape only (default 0.1)");
+  share("--geometry-noise", a.geometry_noise,
+        "whose vertices move by 0.1-0.3 % of the diagonal, normals tilted (default 0.3)");
+  share("--random-lights", a.random_lights, "whose views are lit by jittered studio lights (default 0.3)");
   app.add_flag("--normals", a.normals, "Also write OUT/normals: camera-space normals for networks that take them");
   app.add_option("--max-models", a.max_models, "At most this many models per library (0 = all)");
   CLI11_PARSE(app, argc, argv);

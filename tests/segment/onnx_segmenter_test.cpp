@@ -266,6 +266,13 @@ TEST(ShippedNetwork, IsSmallDocumentedAndRunsOnAStrippedAsset) {
   const std::string attribution = test::read_file(dir + "/ATTRIBUTION.md");
   for (const char* library : {"BlendSwap-CC-0", "BlendSwap-CC-BY", "Scopia"})
     EXPECT_NE(attribution.find(library), std::string::npos) << library;
+  // A network with a pretrained encoder inside (train.py --context) carries its licence and notice.
+  if (training["settings"].value("context", "") != "") {
+    const std::string notice = test::read_file(dir + "/NOTICE.md");
+    for (const char* credit : {"NanoDet", "RangiLyu", "Apache License, Version 2.0", "Changes made"})
+      EXPECT_NE(notice.find(credit), std::string::npos) << credit;
+    EXPECT_NE(test::read_file(dir + "/LICENSE-Apache-2.0.txt").find("TERMS AND CONDITIONS"), std::string::npos);
+  }
 
   Result<Model> model = load_model(test::asset_path("SheenChair"));
   ASSERT_TRUE(model.ok()) << model.status().to_string();

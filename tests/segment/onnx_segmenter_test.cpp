@@ -269,7 +269,8 @@ TEST(ShippedNetwork, IsSmallDocumentedAndRunsOnAStrippedAsset) {
   // A network with a pretrained encoder inside (train.py --context) carries its licence and notice.
   if (training["settings"].value("context", "") != "") {
     const std::string notice = test::read_file(dir + "/NOTICE.md");
-    for (const char* credit : {"NanoDet", "RangiLyu", "Apache License, Version 2.0", "Changes made"})
+    for (const char* credit : {"NanoDet", "RangiLyu", "Apache License, Version 2.0", "Changes made", "Vladimir Mandic",
+                               "Permission is hereby granted"})
       EXPECT_NE(notice.find(credit), std::string::npos) << credit;
     EXPECT_NE(test::read_file(dir + "/LICENSE-Apache-2.0.txt").find("TERMS AND CONDITIONS"), std::string::npos);
   }

@@ -25,8 +25,9 @@ _QUANTISED = {"float16": np.float16, "uint8": np.uint8, "uint16": np.uint16}
 _NHWC_IN_NCHW = (0, 2, 3, 1)  # logical NHWC axes stored as an NCHW tensor
 
 
-def read_weights(folder, manifest):
-    """{name: numpy array} from a weights manifest; float16 and affine-quantised entries are widened."""
+def read_weights(folder, manifest, names=None):
+    """{name: numpy array} from a weights manifest (only `names`, if given); float16 and affine-quantised
+    entries are widened."""
     out = {}
     for group in manifest:
         blob = b"".join(open(os.path.join(folder, p), "rb").read() for p in group["paths"])
@@ -34,9 +35,16 @@ def read_weights(folder, manifest):
         for w in group["weights"]:
             n = int(np.prod(w["shape"])) if w["shape"] else 1
             q = w.get("quantization")
-            stored = _QUANTISED[q["dtype"]] if q else _DTYPES[w["dtype"]]
+            stored = _QUANTISED[q["dtype"]] if q else _DTYPES.get(w["dtype"])
+            if stored is None:
+                if names is not None and w["name"] not in names:
+                    raise ValueError(f"weight {w['name']}: dtype {w['dtype']} is not supported (and its size is "
+                                     "unknown, so the weights after it cannot be read)")
+                raise ValueError(f"weight {w['name']}: dtype {w['dtype']} is not supported")
             raw = np.frombuffer(blob, stored, n, at)
             at += n * np.dtype(stored).itemsize
+            if names is not None and w["name"] not in names:
+                continue
             if q and q["dtype"] != "float16":
                 raw = raw.astype(np.float32) * q["scale"] + q["min"]
             out[w["name"]] = raw.astype(_DTYPES[w["dtype"]]).reshape(w["shape"])
@@ -53,14 +61,16 @@ class _Value:
         self.t, self.axes, self.pad, self.fill = t, axes, pad, fill
 
     def settled(self):
-        """The same value with any pending padding applied."""
+        """The same value with any pending padding applied (once, however many operations read it)."""
         if self.pad is None:
             return self
-        stored = [[0, 0] for _ in range(self.t.dim())]
-        for i, p in enumerate(self.pad):
-            stored[self.axes[i] if self.axes else i] = list(p)
-        flat = [v for a in reversed(range(self.t.dim())) for v in stored[a]]
-        return _Value(F.pad(self.t, flat, value=self.fill), self.axes)
+        if getattr(self, "_settled", None) is None:
+            stored = [[0, 0] for _ in range(self.t.dim())]
+            for i, p in enumerate(self.pad):
+                stored[self.axes[i] if self.axes else i] = list(p)
+            flat = [v for a in reversed(range(self.t.dim())) for v in stored[a]]
+            self._settled = _Value(F.pad(self.t, flat, value=self.fill), self.axes)
+        return self._settled
 
     def logical(self):
         v = self.settled()
@@ -86,7 +96,7 @@ class GraphModel(nn.Module):
     """The part of a TF.js graph model that `outputs` (node names) need, as a torch module. Float weights
     become parameters (frozen unless `trainable`); forward(x) takes the graph's single input and returns the
     outputs in their logical layout. Resize operations keep the ratio of their output to their input size in
-    the graph as converted (its input size is fixed), so other input sizes work."""
+    the graph as converted (its input size is fixed; see calibrate()), so other input sizes work."""
 
     def __init__(self, folder, graph_json, outputs, trainable=False):
         super().__init__()
@@ -98,7 +108,7 @@ class GraphModel(nn.Module):
             if o.partition(":")[0] not in self.nodes:
                 raise KeyError(f"{graph_json}: no node {o}")
         needed = self._needed()
-        weights = read_weights(folder, model["weightsManifest"])
+        weights = read_weights(folder, model["weightsManifest"], needed)
         self.weights = nn.ParameterDict()
         self.constants = {}
         self.keys = {}
@@ -114,6 +124,7 @@ class GraphModel(nn.Module):
                 self.constants[name] = t
         self.input_name = next(n for n, v in self.nodes.items() if v["op"] == "Placeholder")
         self.ratios = {}
+        self._calibrating = False
         signature = model.get("signature", {}).get("inputs", {})
         shape = [int(d["size"]) for d in next(iter(signature.values()))["tensorShape"]["dim"]] if signature else None
         if shape and all(d > 0 for d in shape):
@@ -234,15 +245,24 @@ class GraphModel(nn.Module):
         return _Value(y, _NHWC_IN_NCHW)
 
     def _resized(self, name, hw, size):
-        # The converted graph's sizes assume its own input size; the first call (at that size: calibrate(),
-        # which the constructor runs when the graph's signature gives the input shape) records the ratio.
-        ratio = self.ratios.setdefault(name, (size[0] / int(hw[0]), size[1] / int(hw[1])))
-        return (int(round(int(hw[0]) * ratio[0])), int(round(int(hw[1]) * ratio[1])))
+        # The converted graph's sizes assume its own input size; calibrate() runs it at that size (the
+        # constructor does when the graph's signature gives the input shape) and records the ratios.
+        if self._calibrating:
+            self.ratios[name] = (size[0] / int(hw[0]), size[1] / int(hw[1]))
+        if name not in self.ratios:
+            raise ValueError(f"{name}: resize ratio unknown; the graph has no fixed input shape, call calibrate()")
+        ratio = self.ratios[name]
+        # floor, as TensorFlow and torch size a downsampled odd map
+        return (int(math.floor(int(hw[0]) * ratio[0])), int(math.floor(int(hw[1]) * ratio[1])))
 
     def calibrate(self, input_shape):
         """Runs the graph once at its converted input size so that resize ratios are known."""
-        with torch.no_grad():
-            self.forward(torch.zeros(input_shape))
+        self._calibrating = True
+        try:
+            with torch.no_grad():
+                self.forward(torch.zeros(input_shape))
+        finally:
+            self._calibrating = False
 
     @staticmethod
     def _stored(c, axes):

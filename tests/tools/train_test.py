@@ -1,9 +1,15 @@
 #!/usr/bin/python3
 """tools/training/train.py's networks: ContextUNet starts as the U-Net it is given, feeds its encoder NanoDet's
-normalisation, learns only what it should, and checkpoints load into the right part (load_init)."""
+normalisation, learns only what it should, and checkpoints load into the right part (load_init); datasets of
+the same models rendered with other seeds join the training set without leaking validation models
+(training_rows, Dataset)."""
+import csv
 import os
 import sys
+import tempfile
 import unittest
+
+import numpy as np
 
 import torch
 import torch.nn as nn
@@ -95,6 +101,68 @@ class LoadInitTest(unittest.TestCase):
             train.load_init(train.UNet(inputs=3), context_state, "ctx.pt")
         with self.assertRaisesRegex(ValueError, "other.pt is not a checkpoint"):
             train.load_init(train.UNet(inputs=3), {"weight": torch.zeros(1)}, "other.pt")
+
+
+def write_dataset(folder, models, value, split="train"):
+    """A g2p_make_dataset-shaped folder: two 4x4 views per model, every pixel of an image equal to `value`."""
+    from PIL import Image
+    for sub in ("images", "labels", "normals"):
+        os.makedirs(os.path.join(folder, sub))
+    with open(os.path.join(folder, "manifest.csv"), "w", newline="") as f:
+        out = csv.writer(f)
+        out.writerow(["image", "library", "model", "split", "view", "labelled_pixels"] + train.CLASSES)
+        for i, (model, view) in enumerate((m, v) for m in models for v in range(2)):
+            name = f"{i:06d}.png"
+            Image.fromarray(np.full((4, 4, 3), value, np.uint8)).save(os.path.join(folder, "images", name))
+            Image.fromarray(np.full((4, 4), 1, np.uint8)).save(os.path.join(folder, "labels", name))
+            Image.fromarray(np.full((4, 4, 3), 128, np.uint8)).save(os.path.join(folder, "normals", name))
+            out.writerow([name, "Lib", model, split, view, 16] + [0, 16] + [0] * 10)
+
+
+class TrainingRowsTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.models = [f"Lib/m{i}.obj" for i in range(10)]
+        self.first, self.second = (os.path.join(self.tmp.name, d) for d in ("first", "second"))
+        write_dataset(self.first, self.models, 10)
+        write_dataset(self.second, self.models, 200)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_more_datasets_join_training_and_keep_validation_models_out(self):
+        rows, val_rows, sha, more_sha = train.training_rows(self.first, [self.second], 0.2, 1)
+        val_models = {r["model"] for r in val_rows}
+        self.assertEqual(len(val_models), 2)
+        self.assertEqual(len(val_rows), 4)
+        self.assertTrue(all("root" not in r for r in val_rows))  # validation images come from DATASET only
+        self.assertEqual(len(rows), 2 * 16)  # 8 training models, two views, both datasets
+        self.assertFalse(val_models & {r["model"] for r in rows})
+        self.assertEqual(sum(r.get("root") == self.second for r in rows), 16)
+        self.assertEqual(len(sha), 64)
+        self.assertEqual(len(more_sha), 1)
+        # Without --more, the same validation models (the split depends on DATASET and the seed only).
+        alone, alone_val, _, none = train.training_rows(self.first, [], 0.2, 1)
+        self.assertEqual({r["model"] for r in alone_val}, val_models)
+        self.assertEqual((len(alone), none), (16, []))
+
+    def test_images_are_read_from_their_own_dataset(self):
+        rows, _, _, _ = train.training_rows(self.first, [self.second], 0.2, 1)
+        data = train.Dataset(self.first, rows, 4, False, normals=True)
+        first = [float(data[i][0][0, 0, 0]) for i, r in enumerate(rows) if "root" not in r]
+        second = [float(data[i][0][0, 0, 0]) for i, r in enumerate(rows) if "root" in r]
+        normalised = [(v / 255 - train.MEAN[0]) / train.STD[0] for v in (10, 200)]
+        self.assertTrue(all(abs(v - normalised[0]) < 1e-5 for v in first))
+        self.assertTrue(all(abs(v - normalised[1]) < 1e-5 for v in second))
+        self.assertEqual(tuple(data[0][0].shape), (6, 4, 4))
+
+    def test_a_dataset_of_other_models_is_refused(self):
+        other = os.path.join(self.tmp.name, "other")
+        write_dataset(other, self.models[:5] + ["Lib/stranger.obj"], 10)
+        with self.assertRaisesRegex(ValueError, "--more .*other: 1 training models .*Lib/stranger.obj"):
+            train.training_rows(self.first, [other], 0.2, 1)
+        with self.assertRaisesRegex(ValueError, "missing.manifest.csv: not found"):
+            train.training_rows(self.first, [os.path.join(self.tmp.name, "missing")], 0.2, 1)
 
 
 if __name__ == "__main__":

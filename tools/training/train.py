@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """Trains libg2p's material segmentation network and exports it for the `onnx` backend.
 
-    python3 tools/training/train.py DATASET OUT [--epochs 12] [--threads 2] [--device cpu]
+    python3 tools/training/train.py DATASET OUT [--epochs 12] [--threads 2] [--device cpu] [--more DATASET2 ...]
 
 DATASET is a folder written by g2p_make_dataset (images/, labels/, manifest.csv). Only the rows of
 split "train" are used; the held-out libraries are never read here. OUT receives g2p-materials.onnx,
 its model card g2p-materials.json (the format docs/segment.md describes), training.json (the exact
-settings, per-epoch losses and the data manifest's checksum) and the checkpoint. docs/training.md
+settings, per-epoch losses and the data manifests' checksums) and the checkpoint. `--more` adds the
+training images of further datasets rendered from the same models with other seeds (new views, lights and
+augmentations of the same models); the validation models are those of DATASET, left out of every dataset. docs/training.md
 gives the recipe and the measured accuracy.
 
 The network is a compact U-Net (Ronneberger et al. 2015): four stride-2 stages of two 3x3 convolutions
@@ -43,16 +45,19 @@ def read_png(path):
 
 
 class Dataset(torch.utils.data.Dataset):
-    """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image). With
+    """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image); a row's
+    "root" key, where present, names the dataset folder it comes from (default `root`). With
     `normals`, each sample has 6 channels: the normalised RGB and the camera-space normal (components in -1..1,
     0 on the background), as the `onnx` backend feeds a card whose input.channels is ["rgb", "normal"]."""
 
     def __init__(self, root, rows, size, train, colour=1.0, normals=False, normal_dropout=0.0):
         self.size, self.train, self.colour, self.normal_dropout = size, train, colour, normal_dropout
-        self.rgb = torch.from_numpy(np.stack([read_png(os.path.join(root, "images", r["image"])) for r in rows]))
-        self.label = torch.from_numpy(np.stack([read_png(os.path.join(root, "labels", r["image"])) for r in rows]))
-        self.normal = torch.from_numpy(np.stack([read_png(os.path.join(root, "normals", r["image"])) for r in rows])) \
-            if normals else None
+        def load(folder):
+            return torch.from_numpy(np.stack([read_png(os.path.join(r.get("root", root), folder, r["image"]))
+                                              for r in rows]))
+
+        self.rgb, self.label = load("images"), load("labels")
+        self.normal = load("normals") if normals else None
 
     def __len__(self):
         return len(self.label)
@@ -244,6 +249,38 @@ def class_weights(rows, balance):
     return torch.tensor(np.clip(w, 0.0, 5.0), dtype=torch.float32), counts
 
 
+def read_manifest(dataset):
+    """The training rows of a g2p_make_dataset folder and the SHA-256 of its manifest.csv."""
+    path = os.path.join(dataset, "manifest.csv")
+    if not os.path.isfile(path):
+        raise ValueError(f"{path}: not found (a dataset is a folder written by g2p_make_dataset)")
+    with open(path, "rb") as f:
+        sha = hashlib.sha256(f.read()).hexdigest()
+    with open(path) as f:
+        return [r for r in csv.DictReader(f) if r["split"] == "train"], sha
+
+
+def training_rows(dataset, more, share, seed):
+    """(training rows, validation rows, DATASET's manifest SHA-256, those of `more`). The validation models are
+    drawn from DATASET and left out of every dataset in `more`, whose rows join the training rows with their
+    folder as "root". A dataset in `more` with training models DATASET lacks was rendered from other libraries
+    (or other overrides): refused, since its images would not be the same models seen anew."""
+    rows, sha = read_manifest(dataset)
+    rows, val_rows = validation_split(rows, share, seed)
+    held = {r["model"] for r in val_rows}
+    known = {r["model"] for r in rows} | held
+    more_sha = []
+    for extra in more:
+        extra_rows, extra_sha = read_manifest(extra)
+        unknown = sorted({r["model"] for r in extra_rows} - known)
+        if unknown:
+            raise ValueError(f"--more {extra}: {len(unknown)} training models that {dataset} does not have (for "
+                             f"example {unknown[0]}); render it from the same libraries with another --seed")
+        rows += [dict(r, root=extra) for r in extra_rows if r["model"] not in held]
+        more_sha.append(extra_sha)
+    return rows, val_rows, sha, more_sha
+
+
 def validation_split(rows, share, seed):
     """Whole models of the training libraries held out for validation (never images of one model on both sides)."""
     models = sorted({r["model"] for r in rows})
@@ -291,6 +328,9 @@ def main():
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--max-minutes", type=float, default=0, help="stop after this long (0 = no limit)")
+    ap.add_argument("--more", action="append", default=[], metavar="DATASET",
+                    help="another g2p_make_dataset folder of the same models (another --seed) whose training images "
+                         "join DATASET's; repeatable. Validation models stay out of all of them")
     ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
     ap.add_argument("--val-share", type=float, default=0.1,
                     help="share of the training libraries' models held out to pick the epoch and the logit adjustment")
@@ -317,12 +357,11 @@ def main():
     torch.manual_seed(a.seed)
     torch.set_num_threads(a.threads)
     os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.dataset, "manifest.csv")) as f:
-        rows = [r for r in csv.DictReader(f) if r["split"] == "train"]
-    rows, val_rows = validation_split(rows, a.val_share, a.seed)
+    try:
+        rows, val_rows, manifest_sha, more_sha = training_rows(a.dataset, a.more, a.val_share, a.seed)
+    except ValueError as e:
+        ap.error(str(e))
     val_rows = val_rows[::max(1, len(val_rows) // 256)]  # at most ~256 images: validation stays cheap per epoch
-    with open(os.path.join(a.dataset, "manifest.csv"), "rb") as f:
-        manifest_sha = hashlib.sha256(f.read()).hexdigest()
     weights, counts = class_weights(rows, a.balance)
     print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)
@@ -415,7 +454,7 @@ def main():
         f.write("\n")
     with open(os.path.join(a.out, "training.json"), "w") as f:
         json.dump({"settings": vars(a), "parameters": params, "images": len(rows), "validation_images": len(val_rows),
-                   "exported": best, "manifest_sha256": manifest_sha,
+                   "exported": best, "manifest_sha256": manifest_sha, "more_manifest_sha256": more_sha,
                    "class_weights": dict(zip(CLASSES, weights.tolist())), "epochs": log,
                    "stopped_early": stopped_early, "torch": torch.__version__}, f, indent=2)
         f.write("\n")

@@ -103,8 +103,9 @@ class LoadInitTest(unittest.TestCase):
             train.load_init(train.UNet(inputs=3), {"weight": torch.zeros(1)}, "other.pt")
 
 
-def write_dataset(folder, models, value, split="train"):
-    """A g2p_make_dataset-shaped folder: two 4x4 views per model, every pixel of an image equal to `value`."""
+def write_dataset(folder, models, value, split="train", libraries=None):
+    """A g2p_make_dataset-shaped folder: two 4x4 views per model, every pixel of an image equal to `value`; the
+    library of model i is libraries[i] (default "Lib")."""
     from PIL import Image
     for sub in ("images", "labels", "normals"):
         os.makedirs(os.path.join(folder, sub))
@@ -116,7 +117,8 @@ def write_dataset(folder, models, value, split="train"):
             Image.fromarray(np.full((4, 4, 3), value, np.uint8)).save(os.path.join(folder, "images", name))
             Image.fromarray(np.full((4, 4), 1, np.uint8)).save(os.path.join(folder, "labels", name))
             Image.fromarray(np.full((4, 4, 3), 128, np.uint8)).save(os.path.join(folder, "normals", name))
-            out.writerow([name, "Lib", model, split, view, 16] + [0, 16] + [0] * 10)
+            library = libraries[models.index(model)] if libraries else "Lib"
+            out.writerow([name, library, model, split, view, 16] + [0, 16] + [0] * 10)
 
 
 class TrainingRowsTest(unittest.TestCase):
@@ -155,6 +157,23 @@ class TrainingRowsTest(unittest.TestCase):
         self.assertTrue(all(abs(v - normalised[0]) < 1e-5 for v in first))
         self.assertTrue(all(abs(v - normalised[1]) < 1e-5 for v in second))
         self.assertEqual(tuple(data[0][0].shape), (6, 4, 4))
+
+    def test_a_whole_library_can_be_the_validation_set(self):
+        libraries = ["A"] * 6 + ["B"] * 4
+        first, second = (os.path.join(self.tmp.name, d) for d in ("lib1", "lib2"))
+        write_dataset(first, self.models, 10, libraries=libraries)
+        write_dataset(second, self.models, 200, libraries=libraries)
+        rows, val_rows, _, _ = train.training_rows(first, [second], 0.2, 1, "B")
+        self.assertEqual({r["library"] for r in val_rows}, {"B"})
+        self.assertEqual(len(val_rows), 8)  # every model of B, DATASET's images only
+        self.assertEqual({r["library"] for r in rows}, {"A"})
+        self.assertEqual(len(rows), 2 * 12)
+        with self.assertRaisesRegex(ValueError, "--val-library C: not a training library of .* \\(it has A, B\\)"):
+            train.training_rows(first, [], 0.2, 1, "C")
+        single = os.path.join(self.tmp.name, "single")
+        write_dataset(single, self.models, 10)
+        with self.assertRaisesRegex(ValueError, "no other training library"):
+            train.training_rows(single, [], 0.2, 1, "Lib")
 
     def test_a_dataset_of_other_models_is_refused(self):
         other = os.path.join(self.tmp.name, "other")

@@ -260,13 +260,22 @@ def read_manifest(dataset):
         return [r for r in csv.DictReader(f) if r["split"] == "train"], sha
 
 
-def training_rows(dataset, more, share, seed):
+def training_rows(dataset, more, share, seed, val_library=""):
     """(training rows, validation rows, DATASET's manifest SHA-256, those of `more`). The validation models are
-    drawn from DATASET and left out of every dataset in `more`, whose rows join the training rows with their
-    folder as "root". A dataset in `more` with training models DATASET lacks was rendered from other libraries
+    drawn from DATASET (a random `share` of its models, or every model of `val_library`) and left out of every
+    dataset in `more`, whose rows join the training rows with their folder as "root". A dataset in `more` with training models DATASET lacks was rendered from other libraries
     (or other overrides): refused, since its images would not be the same models seen anew."""
     rows, sha = read_manifest(dataset)
-    rows, val_rows = validation_split(rows, share, seed)
+    if val_library:
+        libraries = sorted({r["library"] for r in rows})
+        if val_library not in libraries:
+            raise ValueError(f"--val-library {val_library}: not a training library of {dataset} "
+                             f"(it has {', '.join(libraries)})")
+        if len(libraries) < 2:
+            raise ValueError(f"--val-library {val_library}: {dataset} has no other training library to train on")
+        rows, val_rows = [r for r in rows if r["library"] != val_library], [r for r in rows if r["library"] == val_library]
+    else:
+        rows, val_rows = validation_split(rows, share, seed)
     held = {r["model"] for r in val_rows}
     known = {r["model"] for r in rows} | held
     more_sha = []
@@ -334,6 +343,9 @@ def main():
     ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
     ap.add_argument("--val-share", type=float, default=0.1,
                     help="share of the training libraries' models held out to pick the epoch and the logit adjustment")
+    ap.add_argument("--val-library", default="",
+                    help="validate on this whole training library instead (left out of training): a score across "
+                         "libraries, as the held-out test libraries are; --val-share is then unused")
     ap.add_argument("--colour-jitter", type=float, default=1.0,
                     help="strength of the colour augmentations (0 none, 1 the full ranges of the docstring)")
     ap.add_argument("--balance", type=float, default=0.5,
@@ -358,7 +370,8 @@ def main():
     torch.set_num_threads(a.threads)
     os.makedirs(a.out, exist_ok=True)
     try:
-        rows, val_rows, manifest_sha, more_sha = training_rows(a.dataset, a.more, a.val_share, a.seed)
+        rows, val_rows, manifest_sha, more_sha = training_rows(a.dataset, a.more, a.val_share, a.seed,
+                                                                 a.val_library)
     except ValueError as e:
         ap.error(str(e))
     val_rows = val_rows[::max(1, len(val_rows) // 256)]  # at most ~256 images: validation stays cheap per epoch

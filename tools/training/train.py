@@ -8,8 +8,8 @@ split "train" are used; the held-out libraries are never read here. OUT receives
 its model card g2p-materials.json (the format docs/segment.md describes), training.json (the exact
 settings, per-epoch losses and the data manifests' checksums) and the checkpoint. `--more` adds the
 training images of further datasets rendered from the same models with other seeds (new views, lights and
-augmentations of the same models); the validation models are those of DATASET, left out of every dataset. docs/training.md
-gives the recipe and the measured accuracy.
+augmentations of the same models); the validation models are those of DATASET, left out of every dataset.
+docs/training.md gives the recipe and the measured accuracy.
 
 The network is a compact U-Net (Ronneberger et al. 2015): four stride-2 stages of two 3x3 convolutions
 with batch normalisation (16-32-64-128 channels, 128 at the bottleneck), bilinear upsampling with skip
@@ -263,8 +263,9 @@ def read_manifest(dataset):
 def training_rows(dataset, more, share, seed, val_library=""):
     """(training rows, validation rows, DATASET's manifest SHA-256, those of `more`). The validation models are
     drawn from DATASET (a random `share` of its models, or every model of `val_library`) and left out of every
-    dataset in `more`, whose rows join the training rows with their folder as "root". A dataset in `more` with training models DATASET lacks was rendered from other libraries
-    (or other overrides): refused, since its images would not be the same models seen anew."""
+    dataset in `more`, whose rows join the training rows with their folder as "root". A dataset in `more` with
+    training models DATASET lacks was rendered from other libraries (or other overrides): refused, since its
+    images would not be the same models seen anew."""
     rows, sha = read_manifest(dataset)
     if val_library:
         libraries = sorted({r["library"] for r in rows})
@@ -273,7 +274,8 @@ def training_rows(dataset, more, share, seed, val_library=""):
                              f"(it has {', '.join(libraries)})")
         if len(libraries) < 2:
             raise ValueError(f"--val-library {val_library}: {dataset} has no other training library to train on")
-        rows, val_rows = [r for r in rows if r["library"] != val_library], [r for r in rows if r["library"] == val_library]
+        val_rows = [r for r in rows if r["library"] == val_library]
+        rows = [r for r in rows if r["library"] != val_library]
     else:
         rows, val_rows = validation_split(rows, share, seed)
     held = {r["model"] for r in val_rows}

@@ -11,7 +11,6 @@ exactly as it scores the network. If the network does not beat this, it has lear
 (docs/training.md, "Colour alone").
 """
 import argparse
-import csv
 import json
 import os
 import random
@@ -47,9 +46,10 @@ def main():
     random.seed(a.seed)
     np.random.seed(a.seed)
     torch.manual_seed(a.seed)
-    with open(os.path.join(a.dataset, "manifest.csv")) as f:
-        rows = [r for r in csv.DictReader(f) if r["split"] == "train"]
-    rows, val_rows = T.validation_split(rows, 0.1, a.seed)
+    try:
+        rows, val_rows, _, _ = T.training_rows(a.dataset, [], 0.1, a.seed)  # the validation models train.py uses
+    except ValueError as e:
+        ap.error(str(e))
     val_rows = val_rows[::max(1, len(val_rows) // 256)]
     weights, counts = T.class_weights(rows, 0.5)
     x, y = pixels(a.dataset, rows, a.pixels)

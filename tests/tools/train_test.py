@@ -4,6 +4,9 @@ normalisation, learns only what it should, and checkpoints load into the right p
 the same models rendered with other seeds join the training set without leaking validation models
 (training_rows, Dataset)."""
 import csv
+import gzip
+import hashlib
+import json
 import os
 import sys
 import tempfile
@@ -182,6 +185,31 @@ class TrainingRowsTest(unittest.TestCase):
             train.training_rows(self.first, [other], 0.2, 1)
         with self.assertRaisesRegex(ValueError, "missing.manifest.csv: not found"):
             train.training_rows(self.first, [os.path.join(self.tmp.name, "missing")], 0.2, 1)
+
+
+class ShippedManifestTest(unittest.TestCase):
+    """libg2p/data/models/manifest.csv.gz is the exact data manifest the shipped network was trained on: its
+    SHA-256 is the one training.json records, and the split train.py makes of it with the recorded settings gives
+    the recorded numbers of training and validation images."""
+
+    def test_the_committed_manifest_is_the_one_the_network_was_trained_on(self):
+        models = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "libg2p", "data", "models")
+        with open(os.path.join(models, "training.json")) as f:
+            record = json.load(f)
+        with gzip.open(os.path.join(models, "manifest.csv.gz"), "rb") as f:
+            manifest = f.read()
+        self.assertEqual(hashlib.sha256(manifest).hexdigest(), record["manifest_sha256"])
+        settings = record["settings"]
+        with tempfile.TemporaryDirectory() as dataset:
+            with open(os.path.join(dataset, "manifest.csv"), "wb") as f:
+                f.write(manifest)
+            rows, val_rows, sha, _ = train.training_rows(dataset, [], settings["val_share"], settings["seed"],
+                                                         settings.get("val_library", ""))
+        self.assertEqual(sha, record["manifest_sha256"])
+        self.assertEqual(len(rows), record["images"])
+        self.assertEqual(len(train.validation_subsample(val_rows)), record["validation_images"])
+        self.assertFalse({r["model"] for r in rows} & {r["model"] for r in val_rows})
+        self.assertEqual({r["split"] for r in rows}, {"train"})
 
 
 if __name__ == "__main__":

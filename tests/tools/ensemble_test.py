@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""tools/training/ensemble.py: the ensemble outputs the mean of its members' log-probabilities, each member is
+rebuilt as train.py exported it (logit adjustment folded in), members validated on other models are refused,
+and the exported ONNX model is one the `onnx` backend (OpenCV 4.6) loads and runs.
+
+    ensemble_test.py [G2P_CLI SHARED_ASSETS]   (ctest passes both; without them the OpenCV check is skipped)"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import torch
+import torch.nn.functional as F
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
+sys.path.insert(0, HERE)
+import ensemble  # noqa: E402
+import train  # noqa: E402
+from train_test import seeded, write_dataset  # noqa: E402
+
+ENSEMBLE = os.path.join(HERE, "..", "..", "tools", "training", "ensemble.py")
+CLI, ASSETS = (sys.argv[1:3] + [None, None])[:2]
+
+
+def write_run(folder, dataset, state, split_seed=1, tau=0.0, sha=None):
+    """A train.py output folder: best.pt and the parts of training.json ensemble.py reads."""
+    os.makedirs(folder)
+    torch.save(state, os.path.join(folder, "best.pt"))
+    if sha is None:
+        _, sha = train.read_manifest(dataset)
+    settings = {"dataset": dataset, "out": folder, "seed": split_seed + 10, "split_seed": split_seed,
+                "val_share": 0.2, "val_library": "", "export_size": 32, "size": 16, "balance": 0.5,
+                "normals": True, "context": ""}
+    with open(os.path.join(folder, "training.json"), "w") as f:
+        json.dump({"settings": settings, "exported": {"epoch": 1, "tau": tau, "val_miou": 0.5},
+                   "manifest_sha256": sha}, f)
+
+
+class EnsembleTest(unittest.TestCase):
+    def test_the_output_is_the_mean_of_the_members_log_probabilities(self):
+        a, b = (seeded(train.UNet(inputs=3), s).eval() for s in (1, 2))
+        x = torch.randn(2, 3, 32, 32)
+        out = ensemble.Ensemble([a, b]).eval()(x)
+        pa, pb = F.softmax(a(x), 1), F.softmax(b(x), 1)
+        geometric = (pa * pb).sqrt()
+        torch.testing.assert_close(F.softmax(out, 1), geometric / geometric.sum(1, keepdim=True), rtol=1e-4,
+                                   atol=1e-6)
+        self.assertFalse(torch.allclose(pa, pb, atol=1e-3))  # the members disagree: the check above can fail
+
+    def test_members_are_rebuilt_as_train_py_exported_them(self):
+        unet = seeded(train.UNet(inputs=6), 3).eval()
+        prior = torch.tensor([0.5, 0.25, 0.25] + [0.0] * 9)
+        record = {"settings": {"normals": True, "out": "run"}, "exported": {"tau": 0.5}}
+        member, inputs = ensemble.build_member(record, unet.state_dict(), "", prior)
+        self.assertEqual(inputs, 6)
+        x = torch.randn(1, 6, 32, 32)
+        expected = unet(x)
+        adjust = torch.cat([-0.5 * torch.log(prior[:3]), torch.full((9,), -30.0)])
+        torch.testing.assert_close(member(x), expected + adjust[None, :, None, None], rtol=1e-4, atol=1e-4)
+        with self.assertRaisesRegex(ValueError, "run was trained with a pretrained context encoder: pass --context"):
+            ensemble.build_member({"settings": {"context": "models", "out": "run"}, "exported": {"tau": 0}},
+                                  unet.state_dict(), "", prior)
+
+
+class EnsembleToolTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dataset = os.path.join(self.tmp.name, "dataset")
+        write_dataset(self.dataset, [f"Lib/m{i}.obj" for i in range(10)], 90)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def run_tool(self, *args):
+        return subprocess.run([sys.executable, ENSEMBLE, *args], capture_output=True, text=True)
+
+    def test_exports_one_model_with_the_members_validation_scores(self):
+        first = seeded(train.UNet(inputs=6), 1).state_dict()
+        runs = [os.path.join(self.tmp.name, f"run{i}") for i in range(3)]
+        write_run(runs[0], self.dataset, first)
+        write_run(runs[1], self.dataset, seeded(train.UNet(inputs=6), 2).state_dict(), tau=0.25)
+        write_run(runs[2], self.dataset, first)  # the same weights twice: the exporter shares them (Identity)
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_tool(out, *runs)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(out, "training.json")) as f:
+            record = json.load(f)
+        scores = record["ensemble"]["validation_miou"]
+        self.assertEqual(set(scores), set(runs) | {"ensemble"})
+        self.assertEqual(record["ensemble"]["validation_images"], 4)  # 2 of 10 models, two views each
+        self.assertEqual(len(record["members"]), 3)
+        with open(os.path.join(out, "g2p-materials.json")) as f:
+            card = json.load(f)
+        self.assertEqual(card["input"]["channels"], ["rgb", "normal"])
+        self.assertEqual((card["input"]["width"], card["output"]["kind"]), (32, "logits"))
+        import onnx
+        model = onnx.load(os.path.join(out, "g2p-materials.onnx"))
+        constants = {t.name for t in model.graph.initializer}
+        self.assertFalse([n.name for n in model.graph.node if n.op_type == "Identity" and n.input[0] in constants])
+        if CLI is None:
+            self.skipTest("no g2p CLI given: OpenCV's loading of the model not checked")
+        views = os.path.join(self.tmp.name, "views")
+        done = subprocess.run([CLI, "segment", os.path.join(ASSETS, "WaterBottle", "WaterBottle.glb"), "-o", views,
+                               "--views", "1", "--resolution", "64", "--segmenter", "onnx", "--set",
+                               "model_card=" + os.path.join(out, "g2p-materials.json")],
+                              capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertTrue(os.listdir(views))
+
+    def test_members_validated_on_other_models_are_refused(self):
+        state = seeded(train.UNet(inputs=6), 1).state_dict()
+        a, b, c = (os.path.join(self.tmp.name, n) for n in ("a", "b", "c"))
+        write_run(a, self.dataset, state)
+        write_run(b, self.dataset, state, split_seed=2)
+        write_run(c, self.dataset, state, sha="0" * 64)
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_tool(out, a, b)
+        self.assertEqual(done.returncode, 2)
+        self.assertRegex(done.stderr, r"b: validated on other models than .* \(split_seed differs\)")
+        done = self.run_tool(out, a, c)
+        self.assertRegex(done.stderr, r"c: validated on other models .* \(manifest differs\)")
+        done = self.run_tool(out, a)
+        self.assertRegex(done.stderr, "at least two RUN folders")
+        done = self.run_tool(out, a, os.path.join(self.tmp.name, "missing"))
+        self.assertRegex(done.stderr, r"missing.training.json: not found")
+        self.assertFalse(os.path.exists(out))  # nothing written on refusal
+
+
+if __name__ == "__main__":
+    unittest.main(argv=sys.argv[:1])

@@ -1,0 +1,183 @@
+#!/usr/bin/python3
+"""Combines networks trained by train.py into one ONNX model whose output is their averaged log-probabilities.
+
+    python3 tools/training/ensemble.py OUT RUN RUN [RUN ...] [--context MODELS] [--threads 2]
+
+Each RUN is a train.py output folder (best.pt and training.json). Every member is rebuilt with the settings its
+training.json records, its exported logit adjustment (tau) folded in, and the ensemble outputs the mean of the
+members' log-softmax (the normalised geometric mean of their probabilities; Lakshminarayanan et al. 2017,
+"Simple and scalable predictive uncertainty estimation using deep ensembles", average independently trained
+networks). Unlike a weight average (a "model soup"), the members need not share a lineage: networks that
+started from different weights make different errors, and averaging their predictions cancels part of them.
+
+The members must have been validated on the same models (the same dataset manifest, seed, validation share or
+validation library), so that none of them was trained on the validation models the ensemble is scored on;
+anything else is refused. OUT receives g2p-materials.onnx, its model card and training.json (the members'
+own records, and the validation mIoU of each member and of the ensemble on the same images).
+docs/training.md, "An ensemble of two lineages", gives the measured effect.
+"""
+import argparse
+import json
+import os
+import sys
+
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import train  # noqa: E402  (tools/training/train.py)
+
+# The settings that decide which models a run validated on; they must agree across members.
+SPLIT_KEYS = ("split_seed", "val_share", "val_library")
+
+
+class Ensemble(nn.Module):
+    """The mean of the members' log-softmax: a logit vector whose softmax is the normalised geometric mean of the
+    members' class probabilities."""
+
+    def __init__(self, members):
+        super().__init__()
+        self.members = nn.ModuleList(members)
+
+    def forward(self, x):
+        return torch.stack([F.log_softmax(m(x), 1) for m in self.members]).mean(0)
+
+
+def read_run(folder):
+    """(training.json as a dict, best.pt's state dict) of a train.py output folder; ValueError names what is
+    missing."""
+    paths = {name: os.path.join(folder, name) for name in ("training.json", "best.pt")}
+    for path in paths.values():
+        if not os.path.isfile(path):
+            raise ValueError(f"{path}: not found (a member is a train.py output folder with a validated epoch)")
+    with open(paths["training.json"]) as f:
+        record = json.load(f)
+    if not record.get("exported"):
+        raise ValueError(f"{paths['training.json']}: no validated epoch was exported (trained without validation)")
+    return record, torch.load(paths["best.pt"], map_location="cpu")
+
+
+def build_member(record, state, context, prior):
+    """The network a run exported: its architecture from the recorded settings, its best weights and its logit
+    adjustment folded into the classifier's bias, as train.py exports it."""
+    settings = record["settings"]
+    inputs = 6 if settings.get("normals") else 3
+    model = train.UNet(inputs=inputs)
+    if settings.get("context"):
+        if not context:
+            raise ValueError(f"{settings['out']} was trained with a pretrained context encoder: pass --context")
+        from tfjs_graph import GraphModel  # tools/training/tfjs_graph.py
+        model = train.ContextUNet(model, GraphModel(context, train.CONTEXT_GRAPH, train.CONTEXT_OUTPUTS),
+                                  settings.get("context_upsample", 2))
+    model.load_state_dict(state)
+    tau = record["exported"]["tau"]
+    with torch.no_grad():
+        model.head.bias += torch.where(prior > 0, -tau * torch.log(prior.clamp(min=1e-12)),
+                                       torch.full_like(prior, -30.0))
+    return model.eval(), inputs
+
+
+def inline_identities(onnx_path):
+    """Replaces each Identity node that copies an initializer by a copy of that initializer. The exporter writes
+    one for weights the members share exactly (their fixed input conversion), and OpenCV 4.6's importer cannot
+    parse an Identity whose input is a constant."""
+    import copy
+    import onnx  # python3-onnx
+    model = onnx.load(onnx_path)
+    graph = model.graph
+    constants = {t.name: t for t in graph.initializer}
+    for node in [n for n in graph.node if n.op_type == "Identity" and n.input[0] in constants]:
+        tensor = copy.deepcopy(constants[node.input[0]])
+        tensor.name = node.output[0]
+        graph.initializer.append(tensor)
+        graph.node.remove(node)
+    onnx.save(model, onnx_path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out")
+    ap.add_argument("runs", nargs="+", metavar="RUN", help="train.py output folders (best.pt, training.json)")
+    ap.add_argument("--dataset", default="",
+                    help="the dataset the members were validated on (default: the first member's recorded one)")
+    ap.add_argument("--context", default="",
+                    help="folder holding nanodet.json/.bin, for members trained with --context")
+    ap.add_argument("--threads", type=int, default=2)
+    a = ap.parse_args()
+    if len(a.runs) < 2:
+        ap.error("an ensemble needs at least two RUN folders")
+    torch.set_num_threads(a.threads)
+    try:
+        runs = [read_run(r) for r in a.runs]
+    except ValueError as e:
+        ap.error(str(e))
+    records = [r for r, _ in runs]
+    first = records[0]["settings"]
+    dataset = a.dataset or first["dataset"]
+    for record in records:  # runs from before --split-seed split with --seed
+        record["settings"].setdefault("split_seed", record["settings"]["seed"])
+    rows, val_rows, sha, _ = train.training_rows(dataset, [], first["val_share"], first["split_seed"],
+                                                 first.get("val_library", ""))
+    for run, record in zip(a.runs, records):
+        s = record["settings"]
+        differs = [k for k in SPLIT_KEYS if s.get(k, "") != first.get(k, "")]
+        if record["manifest_sha256"] != sha or differs:
+            ap.error(f"{run}: validated on other models than {dataset} with {a.runs[0]}'s split "
+                     f"({'manifest' if record['manifest_sha256'] != sha else ', '.join(differs)} differs); "
+                     f"its score on these validation images would include its training models")
+        if record["settings"].get("export_size") != first.get("export_size"):
+            ap.error(f"{run}: export size {s.get('export_size')} differs from {a.runs[0]}'s")
+    val_rows = train.validation_subsample(val_rows)
+    _, counts = train.class_weights(rows, first["balance"])
+    prior = torch.tensor(counts / max(counts.sum(), 1), dtype=torch.float32)
+    try:
+        built = [build_member(record, state, a.context, prior) for record, state in runs]
+    except (ValueError, RuntimeError) as e:
+        ap.error(str(e))
+    inputs = {n for _, n in built}
+    if len(inputs) != 1:
+        ap.error("the members take different inputs (some with normals, some without)")
+    inputs = inputs.pop()
+    members = [m for m, _ in built]
+    model = Ensemble(members).eval()
+
+    size = first["export_size"]
+    val_data = torch.utils.data.DataLoader(train.Dataset(dataset, val_rows, first["size"], False,
+                                                         normals=inputs == 6), batch_size=32)
+    zero = [torch.zeros(len(train.CLASSES))]
+    scores = {run: train.mean_iou(train.confusion(m, val_data, size, zero, "cpu")[0])
+              for run, m in zip(a.runs, members)}
+    scores["ensemble"] = train.mean_iou(train.confusion(model, val_data, size, zero, "cpu")[0])
+    for name, score in scores.items():
+        print(f"validation mIoU {100 * score:.1f} %: {name}", flush=True)
+
+    os.makedirs(a.out, exist_ok=True)
+    onnx_path = os.path.join(a.out, "g2p-materials.onnx")
+    torch.onnx.export(model, torch.zeros(1, inputs, size, size), onnx_path, input_names=["pixels"],
+                      output_names=["logits"], opset_version=11)
+    inline_identities(onnx_path)
+    card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
+            "input": {"width": size, "height": size, "channel_order": "RGB", "scale": 1 / 255,
+                      "mean": train.MEAN, "std": train.STD, "name": "pixels",
+                      "channels": ["rgb", "normal"] if inputs == 6 else ["rgb"]},
+            "output": {"kind": "logits", "name": "logits"},
+            "classes": train.CLASSES,
+            "trained_on": "sweethome3d-furniture: BlendSwap-CC-0, BlendSwap-CC-BY, Scopia (docs/training.md)"}
+    if any(r["settings"].get("context") for r in records):
+        card["notice"] = train.CONTEXT_NOTICE
+        train.mark_notice(onnx_path, train.CONTEXT_NOTICE)
+    with open(os.path.join(a.out, "g2p-materials.json"), "w") as f:
+        json.dump(card, f, indent=2)
+        f.write("\n")
+    with open(os.path.join(a.out, "training.json"), "w") as f:
+        json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "dataset": dataset,
+                                "manifest_sha256": sha, "validation_images": len(val_rows),
+                                "validation_miou": scores},
+                   "members": records, "torch": torch.__version__}, f, indent=2)
+        f.write("\n")
+    print(f"{len(members)} members -> {onnx_path} ({os.path.getsize(onnx_path) / 1e6:.1f} MB)", flush=True)
+
+
+if __name__ == "__main__":
+    main()

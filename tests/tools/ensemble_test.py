@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """tools/training/ensemble.py: the ensemble outputs the mean of its members' log-probabilities, each member is
 rebuilt as train.py exported it (logit adjustment folded in), members validated on other models are refused,
-and the exported ONNX model is one the `onnx` backend (OpenCV 4.6) loads and runs.
+and the exported ONNX model, its weights in int8, is one the `onnx` backend (OpenCV 4.6) loads and runs.
 
     ensemble_test.py [G2P_CLI SHARED_ASSETS]   (ctest passes both; without them the OpenCV check is skipped)"""
 import json
@@ -92,6 +92,7 @@ class EnsembleToolTest(unittest.TestCase):
         self.assertEqual(set(scores), set(runs) | {"ensemble"})
         self.assertEqual(record["ensemble"]["validation_images"], 4)  # 2 of 10 models, two views each
         self.assertEqual(len(record["members"]), 3)
+        self.assertEqual(record["ensemble"]["int8_weights"]["convolutions"], 3 * 17)  # 18 per U-Net; the first (864 weights) stays float
         with open(os.path.join(out, "g2p-materials.json")) as f:
             card = json.load(f)
         self.assertEqual(card["input"]["channels"], ["rgb", "normal"])

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Combines networks trained by train.py into one ONNX model whose output is their averaged log-probabilities.
 
-    python3 tools/training/ensemble.py OUT RUN RUN [RUN ...] [--context MODELS] [--threads 2]
+    python3 tools/training/ensemble.py OUT RUN RUN [RUN ...] [--context MODELS] [--float-weights] [--threads 2]
 
 Each RUN is a train.py output folder (best.pt and training.json). Every member is rebuilt with the settings its
 training.json records, its exported logit adjustment (tau) folded in, and the ensemble outputs the mean of the
@@ -12,8 +12,9 @@ started from different weights make different errors, and averaging their predic
 
 The members must have been validated on the same models (the same dataset manifest, seed, validation share or
 validation library), so that none of them was trained on the validation models the ensemble is scored on;
-anything else is refused. OUT receives g2p-materials.onnx, its model card and training.json (the members'
-own records, and the validation mIoU of each member and of the ensemble on the same images).
+anything else is refused. The convolution weights are stored as 8-bit integers (quantize.py), so that an
+ensemble of four members is no larger than one member in float; --float-weights keeps them in float. OUT receives g2p-materials.onnx, its model card and training.json (the members'
+own records, and the validation mIoU of each member and of the ensemble, in float, on the same images).
 docs/training.md, "An ensemble of two lineages", gives the measured effect.
 """
 import argparse
@@ -26,6 +27,7 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import quantize  # noqa: E402  (tools/training/quantize.py)
 import train  # noqa: E402  (tools/training/train.py)
 
 # The settings that decide which models a run validated on; they must agree across members.
@@ -103,6 +105,7 @@ def main():
                     help="the dataset the members were validated on (default: the first member's recorded one)")
     ap.add_argument("--context", default="",
                     help="folder holding nanodet.json/.bin, for members trained with --context")
+    ap.add_argument("--float-weights", action="store_true", help="keep the weights in float (4x the size)")
     ap.add_argument("--threads", type=int, default=2)
     a = ap.parse_args()
     if len(a.runs) < 2:
@@ -157,6 +160,14 @@ def main():
     torch.onnx.export(model, torch.zeros(1, inputs, size, size), onnx_path, input_names=["pixels"],
                       output_names=["logits"], opset_version=11)
     inline_identities(onnx_path)
+    quantised = None
+    if not a.float_weights:
+        import onnx  # python3-onnx
+        exported = onnx.load(onnx_path)
+        count, before, after = quantize.quantize_conv_weights(exported)
+        onnx.checker.check_model(exported)
+        onnx.save(exported, onnx_path)
+        quantised = {"convolutions": count, "weight_bytes_before": before, "weight_bytes_after": after}
     card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
             "input": {"width": size, "height": size, "channel_order": "RGB", "scale": 1 / 255,
                       "mean": train.MEAN, "std": train.STD, "name": "pixels",
@@ -171,7 +182,8 @@ def main():
         json.dump(card, f, indent=2)
         f.write("\n")
     with open(os.path.join(a.out, "training.json"), "w") as f:
-        json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "dataset": dataset,
+        json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "int8_weights": quantised,
+                                "dataset": dataset,
                                 "manifest_sha256": sha, "validation_images": len(val_rows),
                                 "validation_miou": scores},
                    "members": records, "torch": torch.__version__}, f, indent=2)

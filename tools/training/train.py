@@ -164,6 +164,23 @@ def mark_notice(onnx_path, notice):
     onnx.save(model, onnx_path)
 
 
+def write_model_card(out, size, normals, context):
+    """OUT/g2p-materials.json, the card the `onnx` backend reads for OUT/g2p-materials.onnx (docs/segment.md); with
+    `context`, the pretrained encoder's notice goes into the card and the ONNX file's metadata."""
+    card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
+            "input": {"width": size, "height": size, "channel_order": "RGB", "scale": 1 / 255,
+                      "mean": MEAN, "std": STD, "name": "pixels", "channels": ["rgb", "normal"] if normals else ["rgb"]},
+            "output": {"kind": "logits", "name": "logits"},
+            "classes": CLASSES,
+            "trained_on": "sweethome3d-furniture: BlendSwap-CC-0, BlendSwap-CC-BY, Scopia (docs/training.md)"}
+    if context:
+        card["notice"] = CONTEXT_NOTICE
+        mark_notice(os.path.join(out, "g2p-materials.onnx"), CONTEXT_NOTICE)
+    with open(os.path.join(out, "g2p-materials.json"), "w") as f:
+        json.dump(card, f, indent=2)
+        f.write("\n")
+
+
 class ContextUNet(nn.Module):
     """The U-Net with a pretrained encoder beside it (frozen unless `trainable`). The encoder sees the RGB channels upsampled by
     `upsample` (its features then fall on strides 4, 8 and 16 of the U-Net's input when upsample is 2); each of
@@ -465,19 +482,7 @@ def main():
     onnx_path = os.path.join(a.out, "g2p-materials.onnx")
     torch.onnx.export(model, torch.zeros(1, inputs, a.export_size, a.export_size), onnx_path, input_names=["pixels"],
                       output_names=["logits"], opset_version=11)
-    card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
-            "input": {"width": a.export_size, "height": a.export_size, "channel_order": "RGB", "scale": 1 / 255,
-                      "mean": MEAN, "std": STD, "name": "pixels",
-                      "channels": ["rgb", "normal"] if a.normals else ["rgb"]},
-            "output": {"kind": "logits", "name": "logits"},
-            "classes": CLASSES,
-            "trained_on": "sweethome3d-furniture: BlendSwap-CC-0, BlendSwap-CC-BY, Scopia (docs/training.md)"}
-    if a.context:
-        card["notice"] = CONTEXT_NOTICE
-        mark_notice(onnx_path, CONTEXT_NOTICE)
-    with open(os.path.join(a.out, "g2p-materials.json"), "w") as f:
-        json.dump(card, f, indent=2)
-        f.write("\n")
+    write_model_card(a.out, a.export_size, a.normals, bool(a.context))
     with open(os.path.join(a.out, "training.json"), "w") as f:
         json.dump({"settings": vars(a), "parameters": params, "images": len(rows), "validation_images": len(val_rows),
                    "exported": best, "manifest_sha256": manifest_sha, "more_manifest_sha256": more_sha,

@@ -8,7 +8,6 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import unittest
 
 import torch
@@ -19,24 +18,10 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
 sys.path.insert(0, HERE)
 import ensemble  # noqa: E402
 import train  # noqa: E402
-from train_test import seeded, write_dataset  # noqa: E402
+from train_test import DatasetCase, seeded, write_run  # noqa: E402
 
 ENSEMBLE = os.path.join(HERE, "..", "..", "tools", "training", "ensemble.py")
 CLI, ASSETS = (sys.argv[1:3] + [None, None])[:2]
-
-
-def write_run(folder, dataset, state, split_seed=1, tau=0.0, sha=None):
-    """A train.py output folder: best.pt and the parts of training.json ensemble.py reads."""
-    os.makedirs(folder)
-    torch.save(state, os.path.join(folder, "best.pt"))
-    if sha is None:
-        _, sha = train.read_manifest(dataset)
-    settings = {"dataset": dataset, "out": folder, "seed": split_seed + 10, "split_seed": split_seed,
-                "val_share": 0.2, "val_library": "", "export_size": 32, "size": 16, "balance": 0.5,
-                "normals": True, "context": ""}
-    with open(os.path.join(folder, "training.json"), "w") as f:
-        json.dump({"settings": settings, "exported": {"epoch": 1, "tau": tau, "val_miou": 0.5},
-                   "manifest_sha256": sha}, f)
 
 
 class EnsembleTest(unittest.TestCase):
@@ -65,15 +50,7 @@ class EnsembleTest(unittest.TestCase):
                                   unet.state_dict(), "", prior)
 
 
-class EnsembleToolTest(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dataset = os.path.join(self.tmp.name, "dataset")
-        write_dataset(self.dataset, [f"Lib/m{i}.obj" for i in range(10)], 90)
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
+class EnsembleToolTest(DatasetCase):
     def run_tool(self, *args):
         return subprocess.run([sys.executable, ENSEMBLE, *args], capture_output=True, text=True)
 

@@ -7,7 +7,9 @@ import csv
 import gzip
 import hashlib
 import json
+import math
 import os
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -20,6 +22,8 @@ import torch.nn.functional as F
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "training"))
 import train  # noqa: E402
+
+TRAIN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "training", "train.py")
 
 
 class FakeContext(nn.Module):
@@ -124,6 +128,21 @@ def write_dataset(folder, models, value, split="train", libraries=None):
             out.writerow([name, library, model, split, view, 16] + [0, 16] + [0] * 10)
 
 
+def write_run(folder, dataset, state, split_seed=1, tau=0.0, sha=None):
+    """A train.py output folder: best.pt and the parts of training.json that ensemble.py and train.py --teacher
+    read."""
+    os.makedirs(folder)
+    torch.save(state, os.path.join(folder, "best.pt"))
+    if sha is None:
+        _, sha = train.read_manifest(dataset)
+    settings = {"dataset": dataset, "out": folder, "seed": split_seed + 10, "split_seed": split_seed,
+                "val_share": 0.2, "val_library": "", "export_size": 32, "size": 16, "balance": 0.5,
+                "normals": True, "context": ""}
+    with open(os.path.join(folder, "training.json"), "w") as f:
+        json.dump({"settings": settings, "exported": {"epoch": 1, "tau": tau, "val_miou": 0.5},
+                   "manifest_sha256": sha}, f)
+
+
 class TrainingRowsTest(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -185,6 +204,123 @@ class TrainingRowsTest(unittest.TestCase):
             train.training_rows(self.first, [other], 0.2, 1)
         with self.assertRaisesRegex(ValueError, "missing.manifest.csv: not found"):
             train.training_rows(self.first, [os.path.join(self.tmp.name, "missing")], 0.2, 1)
+
+
+class DatasetCase(unittest.TestCase):
+    """A test case with a temporary folder (self.tmp) holding a 10-model dataset (self.dataset)."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dataset = os.path.join(self.tmp.name, "dataset")
+        write_dataset(self.dataset, [f"Lib/m{i}.obj" for i in range(10)], 90)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+
+class DistillationTest(DatasetCase):
+
+    def test_the_loss_is_the_tempered_kl_on_object_pixels_only(self):
+        # Two pixels, two classes: an object pixel without a class (254) and a background one (255), whose wild
+        # logits must not count.
+        student = torch.tensor([[[[0.0, 9.0]], [[0.0, -9.0]]]])
+        teacher = torch.tensor([[[[2.0, 0.0]], [[0.0, 0.0]]]])
+        label = torch.tensor([[[train.UNLABELLED_OBJECT, 255]]])
+        t = [math.exp(1) / (math.exp(1) + 1), 1 / (math.exp(1) + 1)]  # softmax([2, 0] / T), T = 2
+        expected = 4 * sum(p * math.log(p / 0.5) for p in t)  # T^2 KL(t || (0.5, 0.5))
+        self.assertAlmostEqual(float(train.distillation_loss(student, teacher, label, 2.0)), expected, places=5)
+        self.assertAlmostEqual(float(train.distillation_loss(teacher, teacher, label, 2.0)), 0.0, places=6)
+        background = torch.full_like(label, 255)
+        zero = train.distillation_loss(student.requires_grad_(), teacher, background, 2.0)
+        self.assertEqual(float(zero), 0.0)
+        zero.backward()  # no object pixel: still a loss the training loop can step on
+
+    def test_object_pixels_without_a_class_are_kept_for_the_teacher(self):
+        from PIL import Image
+        name = "000000.png"  # model m0, view 0: its label and normals rewritten
+        label = np.full((4, 4), 255, np.uint8)
+        label[0, 0] = 3
+        normals = np.full((4, 4, 3), 128, np.uint8)
+        normals[0, :] = (128, 128, 255)  # row 0 is the object, facing the camera
+        Image.fromarray(label).save(os.path.join(self.dataset, "labels", name))
+        Image.fromarray(normals).save(os.path.join(self.dataset, "normals", name))
+        rows, _ = train.read_manifest(self.dataset)
+        plain = train.Dataset(self.dataset, rows[:1], 4, False)
+        self.assertEqual(int((plain.label[0] == train.UNLABELLED_OBJECT).sum()), 0)
+        data = train.Dataset(self.dataset, rows[:1], 4, False, objects=True)
+        self.assertEqual(data.label[0, 0].tolist(), [3] + [train.UNLABELLED_OBJECT] * 3)
+        self.assertTrue(bool((data.label[0, 1:] == 255).all()))
+        self.assertIsNone(data.normal)  # the mask only: the network's inputs stay RGB
+        # Crops centre on labelled pixels only: every crop of this image holds the class-3 pixel.
+        for _ in range(20):
+            _, crop, _ = train.augment(torch.zeros(3, 4, 4), data.label[0].long(), 4)
+            self.assertIn(3, crop.tolist()[0] + crop.tolist()[-1])
+
+    def test_the_teacher_is_the_runs_ensemble_before_their_logit_adjustment(self):
+        import ensemble
+        a, b = (seeded(train.UNet(inputs=6), s).eval() for s in (1, 2))
+        runs = [os.path.join(self.tmp.name, n) for n in ("a", "b")]
+        write_run(runs[0], self.dataset, a.state_dict(), tau=0.5)
+        write_run(runs[1], self.dataset, b.state_dict())
+        _, sha = train.read_manifest(self.dataset)
+        settings = {"split_seed": 1, "val_share": 0.2, "val_library": "", "normals": True}
+        teacher = train.load_teacher(runs, "", sha, settings)
+        x = torch.randn(1, 6, 32, 32)
+        torch.testing.assert_close(teacher(x), ensemble.Ensemble([a, b])(x), rtol=1e-4, atol=1e-5)
+        self.assertFalse(any(p.requires_grad for p in teacher.parameters()))
+        with self.assertRaisesRegex(ValueError, "--teacher .*a: validated on other models .*split_seed differs"):
+            train.load_teacher(runs, "", sha, dict(settings, split_seed=2))
+        with self.assertRaisesRegex(ValueError, "--teacher .*a: validated on other models .*manifest differs"):
+            train.load_teacher(runs, "", "0" * 64, settings)
+        with self.assertRaisesRegex(ValueError, "--teacher .*a: takes 6 input channels, this run 3"):
+            train.load_teacher(runs, "", sha, dict(settings, normals=False))
+
+    def run_train(self, out, *args):
+        return subprocess.run([sys.executable, TRAIN, self.dataset, out, "--size", "16", "--export-size", "32",
+                               "--val-share", "0.2", "--split-seed", "1", "--normals", "--threads", "1", *args],
+                              capture_output=True, text=True)
+
+    def test_a_run_with_a_teacher_moves_towards_it(self):
+        teacher_run = os.path.join(self.tmp.name, "teacher")
+        teacher = seeded(train.UNet(inputs=6), 5).eval()
+        write_run(teacher_run, self.dataset, teacher.state_dict())
+        start = os.path.join(self.tmp.name, "start.pt")
+        torch.save(seeded(train.UNet(inputs=6), 6).state_dict(), start)
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_train(out, "--teacher", teacher_run, "--distill-weight", "1", "--init", start,
+                              "--epochs", "4", "--batch", "2", "--lr", "3e-3", "--seed", "3")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(out, "training.json")) as f:
+            record = json.load(f)
+        self.assertEqual(record["settings"]["teacher"], [teacher_run])
+        x = train.Dataset(self.dataset, train.read_manifest(self.dataset)[0][:4], 16, False, normals=True)
+        x = F.interpolate(torch.stack([x[i][0] for i in range(4)]), size=(32, 32))
+        label = torch.zeros(4, 32, 32, dtype=torch.long)  # every pixel counts
+
+        def kl(state_path):
+            student = train.UNet(inputs=6)
+            student.load_state_dict(torch.load(state_path))
+            with torch.no_grad():
+                return float(train.distillation_loss(student.eval()(x), teacher(x), label, 2.0))
+
+        before, after = kl(start), kl(os.path.join(out, "checkpoint.pt"))
+        self.assertLess(after, 0.5 * before)
+
+    def test_teachers_and_datasets_that_cannot_serve_are_refused(self):
+        other = os.path.join(self.tmp.name, "other")
+        write_run(other, self.dataset, seeded(train.UNet(inputs=6), 1).state_dict(), split_seed=2)
+        done = self.run_train(os.path.join(self.tmp.name, "out"), "--teacher", other, "--epochs", "1")
+        self.assertEqual(done.returncode, 2)
+        self.assertRegex(done.stderr, "--teacher .*other: validated on other models than this run "
+                                      r"\(split_seed differs\)")
+        done = self.run_train(os.path.join(self.tmp.name, "out"), "--teacher", os.path.join(self.tmp.name, "none"))
+        self.assertRegex(done.stderr, r"none.training.json: not found")
+        import shutil
+        shutil.rmtree(os.path.join(self.dataset, "normals"))
+        done = self.run_train(os.path.join(self.tmp.name, "out2"), "--teacher", other)
+        self.assertRegex(done.stderr, "--teacher needs .*normals for the object mask")
+        done = self.run_train(os.path.join(self.tmp.name, "out3"), "--distill-weight", "2")
+        self.assertRegex(done.stderr, "--distill-weight must lie in 0..1")
 
 
 class ShippedManifestTest(unittest.TestCase):

@@ -63,7 +63,7 @@ def read_run(folder):
 
 def build_member(record, state, context, prior):
     """The network a run exported: its architecture from the recorded settings, its best weights and its logit
-    adjustment folded into the classifier's bias, as train.py exports it."""
+    adjustment folded into the classifier's bias, as train.py exports it (with `prior` None, no adjustment)."""
     settings = record["settings"]
     inputs = 6 if settings.get("normals") else 3
     model = train.UNet(inputs=inputs)
@@ -74,11 +74,23 @@ def build_member(record, state, context, prior):
         model = train.ContextUNet(model, GraphModel(context, train.CONTEXT_GRAPH, train.CONTEXT_OUTPUTS),
                                   settings.get("context_upsample", 2))
     model.load_state_dict(state)
+    if prior is None:  # the network's own probabilities, before the logit adjustment (a teacher's)
+        return model.eval(), inputs
     tau = record["exported"]["tau"]
     with torch.no_grad():
         model.head.bias += torch.where(prior > 0, -tau * torch.log(prior.clamp(min=1e-12)),
                                        torch.full_like(prior, -30.0))
     return model.eval(), inputs
+
+
+def split_mismatch(record, settings, sha):
+    """What makes a run's validation models differ from those of `settings` on the dataset whose manifest has
+    SHA-256 `sha` ("" when they are the same): "manifest" or the differing split settings."""
+    if record["manifest_sha256"] != sha:
+        return "manifest"
+    own = dict(record["settings"])
+    own.setdefault("split_seed", own.get("seed"))  # runs from before --split-seed split with --seed
+    return ", ".join(k for k in SPLIT_KEYS if own.get(k, "") != settings.get(k, ""))
 
 
 def inline_identities(onnx_path):
@@ -125,11 +137,10 @@ def main():
                                                  first.get("val_library", ""))
     for run, record in zip(a.runs, records):
         s = record["settings"]
-        differs = [k for k in SPLIT_KEYS if s.get(k, "") != first.get(k, "")]
-        if record["manifest_sha256"] != sha or differs:
+        differs = split_mismatch(record, first, sha)
+        if differs:
             ap.error(f"{run}: validated on other models than {dataset} with {a.runs[0]}'s split "
-                     f"({'manifest' if record['manifest_sha256'] != sha else ', '.join(differs)} differs); "
-                     f"its score on these validation images would include its training models")
+                     f"({differs} differs); its score on these validation images would include its training models")
         if record["settings"].get("export_size") != first.get("export_size"):
             ap.error(f"{run}: export size {s.get('export_size')} differs from {a.runs[0]}'s")
     val_rows = train.validation_subsample(val_rows)

@@ -16,12 +16,17 @@ with batch normalisation (16-32-64-128 channels, 128 at the bottleneck), bilinea
 connections, a 1x1 classifier to the 12 classes; 1.2 M parameters (4.9 MB as ONNX). Augmentations model what
 image-to-3D meshes look like: colour jitter, blur (baked, low-resolution textures), grey-scale, flips and
 random resized crops. Pixels labelled 255 (unlabelled materials, background) are ignored by the loss.
+
+`--teacher RUN ...` distils (Hinton et al. 2015, "Distilling the knowledge in a neural network") from earlier runs:
+the loss becomes (1 - w) x cross-entropy + w x T^2 x KL(teacher || network) at temperature T, the teacher being the
+runs' ensemble (mean log-softmax, as ensemble.py builds it, before their logit adjustment). The KL term covers every
+object pixel, the unlabelled materials' too (the object mask comes from DATASET/normals), so one network can learn
+what an ensemble knows at the cost of one.
 """
 import argparse
 import csv
 import hashlib
 import json
-import math
 import os
 import random
 import time
@@ -37,6 +42,9 @@ MEAN = [0.485, 0.456, 0.406]
 STD = [0.229, 0.224, 0.225]
 
 
+UNLABELLED_OBJECT = 254  # a label value in training batches with a teacher: an object pixel without a class
+
+
 def read_png(path):
     from PIL import Image  # python3-pil
     with Image.open(path) as image:
@@ -48,16 +56,22 @@ class Dataset(torch.utils.data.Dataset):
     """The images of `rows`, decoded once and kept in memory as uint8 (about 100 kB per 160 px image); a row's
     "root" key, where present, names the dataset folder it comes from (default `root`). With
     `normals`, each sample has 6 channels: the normalised RGB and the camera-space normal (components in -1..1,
-    0 on the background), as the `onnx` backend feeds a card whose input.channels is ["rgb", "normal"]."""
+    0 on the background), as the `onnx` backend feeds a card whose input.channels is ["rgb", "normal"]. With
+    `objects`, the object pixels without a class (unlabelled materials) are labelled UNLABELLED_OBJECT rather than
+    255, told from the background by the normals (the background's are (128, 128, 128))."""
 
-    def __init__(self, root, rows, size, train, colour=1.0, normals=False, normal_dropout=0.0):
+    def __init__(self, root, rows, size, train, colour=1.0, normals=False, normal_dropout=0.0, objects=False):
         self.size, self.train, self.colour, self.normal_dropout = size, train, colour, normal_dropout
         def load(folder):
             return torch.from_numpy(np.stack([read_png(os.path.join(r.get("root", root), folder, r["image"]))
                                               for r in rows]))
 
         self.rgb, self.label = load("images"), load("labels")
-        self.normal = load("normals") if normals else None
+        normal = load("normals") if normals or objects else None
+        if objects:
+            on_object = (normal != 128).any(-1)
+            self.label[(self.label == 255) & on_object] = UNLABELLED_OBJECT
+        self.normal = normal if normals else None
 
     def __len__(self):
         return len(self.label)
@@ -80,7 +94,7 @@ def augment(rgb, label, size, colour=1.0, normal=None):
     h, w = label.shape
     s = random.uniform(0.6, 1.0)
     ch, cw = int(h * s), int(w * s)
-    ys, xs = torch.nonzero(label != 255, as_tuple=True)
+    ys, xs = torch.nonzero(label < len(CLASSES), as_tuple=True)
     if len(ys):
         k = random.randrange(len(ys))
         y = min(max(int(ys[k]) - ch // 2, 0), h - ch)
@@ -257,6 +271,41 @@ def load_init(model, state, source="checkpoint"):
     target.load_state_dict(state)
 
 
+def distillation_loss(logits, teacher_logits, label, temperature):
+    """T^2 x KL(softmax(teacher / T) || softmax(logits / T)), averaged over the object pixels (label != 255); the T^2
+    keeps its gradients on the scale of the cross-entropy's (Hinton et al. 2015)."""
+    on_object = label != 255
+    if not on_object.any():
+        return logits.sum() * 0
+    t = F.log_softmax(teacher_logits / temperature, 1)
+    s = F.log_softmax(logits / temperature, 1)
+    kl = (t.exp() * (t - s)).sum(1)
+    return temperature ** 2 * kl[on_object].mean()
+
+
+def load_teacher(runs, context, sha, settings):
+    """The ensemble of train.py runs `runs` (ensemble.py's Ensemble, without the runs' logit adjustment), frozen. The
+    runs must have validated on the same models as `settings` on the dataset whose manifest has SHA-256 `sha`:
+    a teacher that trained on this run's validation models would leak them into its validation score."""
+    import ensemble  # tools/training/ensemble.py
+    members = []
+    for run in runs:
+        record, state = ensemble.read_run(run)
+        differs = ensemble.split_mismatch(record, settings, sha)
+        if differs:
+            raise ValueError(f"--teacher {run}: validated on other models than this run ({differs} differs); it may "
+                             f"have trained on this run's validation models")
+        member, inputs = ensemble.build_member(record, state, context, None)
+        if inputs != (6 if settings.get("normals") else 3):
+            raise ValueError(f"--teacher {run}: takes {inputs} input channels, this run "
+                             f"{6 if settings.get('normals') else 3}")
+        members.append(member)
+    teacher = ensemble.Ensemble(members).eval()
+    for p in teacher.parameters():
+        p.requires_grad_(False)
+    return teacher
+
+
 def class_weights(rows, balance):
     counts = np.array([sum(int(r[c]) for r in rows) for c in CLASSES], dtype=np.float64)
     present = counts > 0
@@ -388,9 +437,17 @@ def main():
     ap.add_argument("--context-upsample", type=int, default=2, help="the pretrained encoder sees the view this much larger")
     ap.add_argument("--context-lr", type=float, default=0.0,
                     help="learning rate of the pretrained encoder's own weights (0: frozen)")
+    ap.add_argument("--teacher", action="append", default=[], metavar="RUN",
+                    help="distil from this train.py output folder (repeatable: their ensemble); it must have "
+                         "validated on the same models. Needs DATASET/normals (g2p_make_dataset --normals)")
+    ap.add_argument("--distill-weight", type=float, default=0.5,
+                    help="share of the loss that is the distillation term, 0..1 (with --teacher)")
+    ap.add_argument("--distill-temperature", type=float, default=2.0, help="softmax temperature of the distillation")
     a = ap.parse_args()
     if (a.context_lr or a.context_upsample != 2) and not a.context:
         ap.error("--context-lr and --context-upsample need --context")
+    if not 0 <= a.distill_weight <= 1 or a.distill_temperature <= 0:
+        ap.error("--distill-weight must lie in 0..1 and --distill-temperature be positive")
 
     if a.split_seed is None:
         a.split_seed = a.seed
@@ -404,12 +461,22 @@ def main():
                                                                  a.val_library)
     except ValueError as e:
         ap.error(str(e))
+    teacher = None
+    if a.teacher:
+        for folder in [a.dataset] + a.more:
+            if not os.path.isdir(os.path.join(folder, "normals")):
+                ap.error(f"--teacher needs {os.path.join(folder, 'normals')} for the object mask "
+                         f"(render the dataset with g2p_make_dataset --normals)")
+        try:
+            teacher = load_teacher(a.teacher, a.context, manifest_sha, vars(a)).to(a.device)
+        except (ValueError, RuntimeError) as e:
+            ap.error(str(e))
     val_rows = validation_subsample(val_rows)
     weights, counts = class_weights(rows, a.balance)
     print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",
           {c: int(n) for c, n in zip(CLASSES, counts)}, flush=True)
     data = torch.utils.data.DataLoader(Dataset(a.dataset, rows, a.size, True, a.colour_jitter, a.normals,
-                                               a.normal_dropout),
+                                               a.normal_dropout, objects=teacher is not None),
                                        batch_size=a.batch, shuffle=True, num_workers=0, drop_last=True)
     val_data = torch.utils.data.DataLoader(Dataset(a.dataset, val_rows, a.size, False, normals=a.normals),
                                            batch_size=32) if val_rows else None
@@ -447,7 +514,13 @@ def main():
         total, n = 0.0, 0
         for rgb, label in data:
             rgb, label = rgb.to(a.device), label.to(a.device)
-            loss = loss_fn(model(rgb), label)
+            logits = model(rgb)
+            loss = loss_fn(logits, label.masked_fill(label == UNLABELLED_OBJECT, 255))
+            if teacher is not None:
+                with torch.no_grad():
+                    teacher_logits = teacher(rgb)
+                loss = (1 - a.distill_weight) * loss + a.distill_weight * distillation_loss(
+                    logits, teacher_logits, label, a.distill_temperature)
             opt.zero_grad()
             loss.backward()
             opt.step()

@@ -306,6 +306,19 @@ class DistillationTest(DatasetCase):
         before, after = kl(start), kl(os.path.join(out, "checkpoint.pt"))
         self.assertLess(after, 0.5 * before)
 
+    def test_a_teacher_with_no_weight_leaves_the_run_as_it_was(self):
+        # The same initial weights, batches and augmentations as without a teacher: runs compare pair-wise.
+        teacher_run = os.path.join(self.tmp.name, "teacher")
+        write_run(teacher_run, self.dataset, seeded(train.UNet(inputs=6), 5).state_dict())
+        outs = [os.path.join(self.tmp.name, n) for n in ("plain", "taught")]
+        common = ("--epochs", "2", "--batch", "4", "--seed", "4")
+        for out, extra in zip(outs, ([], ["--teacher", teacher_run, "--distill-weight", "0"])):
+            done = self.run_train(out, *common, *extra)
+            self.assertEqual(done.returncode, 0, done.stderr)
+        plain, taught = (torch.load(os.path.join(out, "checkpoint.pt")) for out in outs)
+        for key in plain:
+            torch.testing.assert_close(taught[key], plain[key], rtol=0, atol=0, msg=key)
+
     def test_teachers_and_datasets_that_cannot_serve_are_refused(self):
         other = os.path.join(self.tmp.name, "other")
         write_run(other, self.dataset, seeded(train.UNet(inputs=6), 1).state_dict(), split_seed=2)

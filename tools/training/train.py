@@ -471,6 +471,8 @@ def main():
             teacher = load_teacher(a.teacher, a.context, manifest_sha, vars(a)).to(a.device)
         except (ValueError, RuntimeError) as e:
             ap.error(str(e))
+        torch.manual_seed(a.seed)  # building the teacher drew from the generator: start the network and the
+        # batches as a run without a teacher would, so that the two compare pair-wise
     val_rows = validation_subsample(val_rows)
     weights, counts = class_weights(rows, a.balance)
     print(f"{len(rows)} training images, {len(val_rows)} validation images; labelled pixels per class:",

@@ -219,7 +219,6 @@ class DatasetCase(unittest.TestCase):
 
 
 class DistillationTest(DatasetCase):
-
     def test_the_loss_is_the_tempered_kl_on_object_pixels_only(self):
         # Two pixels, two classes: an object pixel without a class (254) and a background one (255), whose wild
         # logits must not count.
@@ -332,8 +331,10 @@ class DistillationTest(DatasetCase):
         shutil.rmtree(os.path.join(self.dataset, "normals"))
         done = self.run_train(os.path.join(self.tmp.name, "out2"), "--teacher", other)
         self.assertRegex(done.stderr, "--teacher needs .*normals for the object mask")
-        done = self.run_train(os.path.join(self.tmp.name, "out3"), "--distill-weight", "2")
+        done = self.run_train(os.path.join(self.tmp.name, "out3"), "--teacher", other, "--distill-weight", "2")
         self.assertRegex(done.stderr, "--distill-weight must lie in 0..1")
+        done = self.run_train(os.path.join(self.tmp.name, "out4"), "--distill-temperature", "3")
+        self.assertRegex(done.stderr, "--distill-weight and --distill-temperature need --teacher")
 
 
 class ShippedManifestTest(unittest.TestCase):

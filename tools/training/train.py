@@ -440,12 +440,17 @@ def main():
     ap.add_argument("--teacher", action="append", default=[], metavar="RUN",
                     help="distil from this train.py output folder (repeatable: their ensemble); it must have "
                          "validated on the same models. Needs DATASET/normals (g2p_make_dataset --normals)")
-    ap.add_argument("--distill-weight", type=float, default=0.5,
-                    help="share of the loss that is the distillation term, 0..1 (with --teacher)")
-    ap.add_argument("--distill-temperature", type=float, default=2.0, help="softmax temperature of the distillation")
+    ap.add_argument("--distill-weight", type=float, default=None,
+                    help="share of the loss that is the distillation term, 0..1 (with --teacher; default 0.5)")
+    ap.add_argument("--distill-temperature", type=float, default=None,
+                    help="softmax temperature of the distillation (with --teacher; default 2)")
     a = ap.parse_args()
     if (a.context_lr or a.context_upsample != 2) and not a.context:
         ap.error("--context-lr and --context-upsample need --context")
+    if not a.teacher and (a.distill_weight is not None or a.distill_temperature is not None):
+        ap.error("--distill-weight and --distill-temperature need --teacher")
+    a.distill_weight = 0.5 if a.distill_weight is None else a.distill_weight
+    a.distill_temperature = 2.0 if a.distill_temperature is None else a.distill_temperature
     if not 0 <= a.distill_weight <= 1 or a.distill_temperature <= 0:
         ap.error("--distill-weight must lie in 0..1 and --distill-temperature be positive")
 

@@ -1,6 +1,7 @@
 // Segmentation time per 512 x 512 view: the `onnx` backend running a network
 // (the card named by $G2P_BENCH_MODEL_CARD, e.g. the one tools/training/train.py
-// writes; by default the network libg2p ships) and the `learned` backend with the same network,
+// writes; by default the network libg2p ships), the same with test-time mirroring (flip=on) and
+// the `learned` backend with the same network,
 // against the weight-free `pbr` backend on the same views in the same run.
 // SheenChair as shipped, its 11 default views. docs/performance.md and
 // docs/training.md record the figures:
@@ -34,8 +35,9 @@ const Scene& scene() {
   return s;
 }
 
-void BM_Segment(benchmark::State& state, const std::string& backend, bool needs_card) {
+void BM_Segment(benchmark::State& state, const std::string& backend, bool needs_card, bool flip = false) {
   g2p::BackendSettings settings;
+  if (flip) settings["flip"] = "on";
   if (needs_card) {
     const char* card = std::getenv("G2P_BENCH_MODEL_CARD");
     settings["model_card"] = card != nullptr && *card != '\0' ? card : G2P_BENCH_SHIPPED_CARD;
@@ -60,6 +62,7 @@ void BM_Segment(benchmark::State& state, const std::string& backend, bool needs_
 
 BENCHMARK_CAPTURE(BM_Segment, pbr, std::string("pbr"), false)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Segment, onnx, std::string("onnx"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Segment, onnx_flip, std::string("onnx"), true, true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Segment, learned, std::string("learned"), true)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

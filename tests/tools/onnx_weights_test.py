@@ -1,0 +1,192 @@
+#!/usr/bin/python3
+"""tools/training/onnx_weights.py: a network's weights come back from its exported ONNX file (batch normalisation
+folded in) so that it computes what the file computes, and calibrated batch normalisations make training mode start
+there too; train.py --init and ensemble.py use it where a run's checkpoints are gone."""
+import copy
+import json
+import os
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+import torch
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
+sys.path.insert(0, HERE)
+import ensemble  # noqa: E402
+import onnx_weights  # noqa: E402
+import train  # noqa: E402
+from train_test import DatasetCase, FakeContext, seeded, write_run  # noqa: E402
+
+
+def trained_looking(model, seed):
+    """`model` with random weights and random batch-normalisation statistics, as after training: folding them into
+    the convolutions changes every weight."""
+    seeded(model, seed)
+    generator = torch.Generator().manual_seed(seed)
+    with torch.no_grad():
+        for m in model.modules():
+            if isinstance(m, torch.nn.BatchNorm2d):
+                m.running_mean.copy_(torch.randn(m.num_features, generator=generator) * 0.3)
+                m.running_var.copy_(torch.rand(m.num_features, generator=generator) * 1.5 + 0.5)
+                m.weight.copy_(torch.rand(m.num_features, generator=generator) + 0.5)
+    return model.eval()
+
+
+def context_network(seed, inputs=6):
+    return trained_looking(train.ContextUNet(train.UNet(inputs=inputs), FakeContext(), trainable=True), seed)
+
+
+def export(model, path, inputs=6, size=32):
+    torch.onnx.export(model, torch.zeros(1, inputs, size, size), path, input_names=["pixels"],
+                      output_names=["logits"], opset_version=11)
+
+
+def assert_same_function(got, expected, tolerance=1e-5):
+    """Equal up to float32 rounding at the outputs' scale (the random networks' logits reach hundreds, and the export
+    rounds differently where it folds a normalisation into a convolution)."""
+    scale = expected.abs().max().item()
+    torch.testing.assert_close(got, expected, rtol=0, atol=tolerance * scale)
+
+
+def initializers_in_order(path):
+    import onnx  # python3-onnx
+    graph = onnx.load(path).graph
+    values = onnx_weights._initializers(graph)
+    return [values[name] for node in graph.node for name in node.input if name in values]
+
+
+class RecoverTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.path = os.path.join(self.tmp.name, "g2p-materials.onnx")
+        self.original = context_network(1)
+        export(self.original, self.path)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def recovered(self):
+        model = context_network(2)  # other weights: everything must come from the file
+        model.load_state_dict(onnx_weights.recover_state(model, self.path, 6, 32))
+        return model.eval()
+
+    def test_the_recovered_network_computes_what_its_export_computes(self):
+        model = self.recovered()
+        x = torch.randn(2, 6, 32, 32)
+        with torch.no_grad():
+            expected, got = self.original(x), model(x)
+            self.assertGreater((context_network(2)(x) - expected).abs().max().item(), 0.1 * expected.abs().max().item())
+        assert_same_function(got, expected)
+        again = os.path.join(self.tmp.name, "again.onnx")
+        export(model, again)
+        first, second = initializers_in_order(self.path), initializers_in_order(again)
+        self.assertEqual(len(first), len(second))
+        for a, b in zip(first, second):
+            np.testing.assert_allclose(b, a, rtol=1e-6, atol=1e-7)
+        # Folded batch normalisations come back as the identity with the folded bias as beta.
+        bn = model.unet.enc[0][1]
+        torch.testing.assert_close(bn.weight, torch.ones_like(bn.weight))
+        torch.testing.assert_close(bn.running_mean, torch.zeros_like(bn.running_mean))
+
+    def test_calibration_keeps_the_function_and_makes_training_mode_start_there(self):
+        model = self.recovered()
+        x = torch.randn(4, 6, 32, 32)
+        with torch.no_grad():
+            before = model(x)
+            uncalibrated = copy.deepcopy(model).train()(x)
+        # Batch statistics instead of the identity change everything.
+        self.assertGreater((uncalibrated - before).abs().max().item(), 0.1 * before.abs().max().item())
+        self.assertEqual(onnx_weights.calibrate_batch_norm(model, [x[:2], x[2:]]), 18)  # two per U-Net block
+        self.assertFalse(model.training)
+        with torch.no_grad():
+            after = model(x)
+            in_training = copy.deepcopy(model).train()(x)
+        assert_same_function(after, before)
+        # On the batch it was calibrated on, training mode (batch statistics) computes the export's function.
+        assert_same_function(in_training, before, 1e-4)
+        bn = model.unet.enc[0][1]
+        self.assertGreater((bn.running_var - 1).abs().max().item(), 1e-3)
+
+    def test_files_that_are_not_this_networks_export_are_refused(self):
+        other = os.path.join(self.tmp.name, "rgb.onnx")
+        export(context_network(3, inputs=3), other, inputs=3)
+        with self.assertRaisesRegex(ValueError, "rgb.onnx: not this network's export"):
+            onnx_weights.recover_state(context_network(2), other, 6, 32)
+        unet = os.path.join(self.tmp.name, "unet.onnx")
+        export(trained_looking(train.UNet(inputs=6), 3), unet)
+        with self.assertRaisesRegex(ValueError, "unet.onnx: not this network's export"):
+            onnx_weights.recover_state(context_network(2), unet, 6, 32)
+        text = os.path.join(self.tmp.name, "text.onnx")
+        with open(text, "w") as f:
+            f.write("not a model")
+        with self.assertRaisesRegex(ValueError, "text.onnx: not an ONNX file"):
+            onnx_weights.recover_state(context_network(2), text, 6, 32)
+        with self.assertRaisesRegex(ValueError, "text.onnx: not an ONNX file"):
+            train.export_shape(text)
+        self.assertEqual(train.export_shape(other), (3, 32))
+
+
+class ContinueFromExportTest(DatasetCase):
+    def test_train_starts_from_an_exported_network(self):
+        first = os.path.join(self.tmp.name, "first")
+        done = self.run_train(first, "--epochs", "1", "--batch", "8")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        exported = os.path.join(first, "g2p-materials.onnx")
+        os.remove(os.path.join(first, "best.pt"))
+        os.remove(os.path.join(first, "checkpoint.pt"))
+        # No training steps: the new run exports the network it started from.
+        second = os.path.join(self.tmp.name, "second")
+        done = self.run_train(second, "--epochs", "0", "--init", exported)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertRegex(done.stdout, r"weights recovered, 18 batch normalisations calibrated")
+        before, after = initializers_in_order(exported), initializers_in_order(os.path.join(second,
+                                                                                             "g2p-materials.onnx"))
+        self.assertEqual(len(before), len(after))
+        for a, b in zip(before, after):
+            np.testing.assert_allclose(b, a, rtol=1e-4, atol=1e-5)
+        done = self.run_train(os.path.join(self.tmp.name, "third"), "--epochs", "0", "--init", exported,
+                              "--context", self.tmp.name)
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("no nanodet.json", done.stderr)
+        rgb = [a for a in self.train_args(os.path.join(self.tmp.name, "fourth"), "--epochs", "0", "--init", exported)
+               if a != "--normals"]
+        import subprocess
+        done = subprocess.run([sys.executable, train.__file__, *rgb], capture_output=True, text=True)
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("takes 6 input channels, this network 3 (--normals?)", done.stderr)
+
+
+class EnsembleMemberFromExportTest(DatasetCase):
+    def test_a_run_without_checkpoints_joins_through_its_export(self):
+        state = trained_looking(train.UNet(inputs=6), 4).state_dict()
+        run = os.path.join(self.tmp.name, "run")
+        write_run(run, self.dataset, state, tau=0.25)
+        prior = torch.tensor([0.5, 0.25, 0.25] + [0.0] * 9)
+        record, loaded = ensemble.read_run(run)
+        reference, _ = ensemble.build_member(record, loaded, "", prior)
+        export(reference, os.path.join(run, "g2p-materials.onnx"))
+        os.remove(os.path.join(run, "best.pt"))
+        record, loaded = ensemble.read_run(run)
+        self.assertIsNone(loaded)
+        self.assertEqual(record["weights_from"], os.path.join(os.path.abspath(run), "g2p-materials.onnx"))
+        member, inputs = ensemble.build_member(record, loaded, "", prior)
+        self.assertEqual(inputs, 6)
+        x = torch.randn(1, 6, 32, 32)
+        with torch.no_grad():  # the adjustment (tau 0.25) is in the export once, and not added again
+            assert_same_function(member(x), reference(x))
+        with self.assertRaisesRegex(ValueError, r"logit adjustment \(tau 0.25\) is folded into the weights"):
+            ensemble.build_member(record, None, "", None)  # a teacher needs the network before it
+        os.remove(os.path.join(run, "g2p-materials.onnx"))
+        with self.assertRaisesRegex(ValueError, "holds neither best.pt nor g2p-materials.onnx"):
+            ensemble.read_run(run)
+        with open(os.path.join(run, "training.json"), "w") as f:
+            json.dump({"ensemble": {}, "members": []}, f)
+        with self.assertRaisesRegex(ValueError, "no validated epoch was exported .*or an ensemble"):
+            ensemble.read_run(run)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -82,5 +82,56 @@ TEST(BootstrapMeanIou, RejectsWhatItCannotResample) {
   EXPECT_NEAR(r->high, m.mean_iou(), 1e-12);
 }
 
+// Forty models from easy to hard; B fixes a fifth of A's errors on every one.
+// Separately, the two intervals overlap (which models were drawn moves both
+// alike); paired, the gain is resolved.
+TEST(BootstrapMeanIouDifference, AConsistentGainIsResolvedWhereSeparateIntervalsOverlap) {
+  std::vector<ConfusionMatrix> a, b;
+  for (int i = 0; i < 40; ++i) {
+    const double wrong = 1.0 + 2.0 * (i % 5);
+    a.push_back(model(10.0, wrong));
+    b.push_back(model(10.0, 0.8 * wrong));
+  }
+  Result<MeanIouDifference> d = bootstrap_mean_iou_difference(a, b);
+  Result<MeanIouInterval> ia = bootstrap_mean_iou(a), ib = bootstrap_mean_iou(b);
+  ASSERT_TRUE(d.ok() && ia.ok() && ib.ok()) << d.status().to_string();
+  EXPECT_NEAR(d->miou_a, ia->miou, 1e-12);
+  EXPECT_NEAR(d->miou_b, ib->miou, 1e-12);
+  EXPECT_NEAR(d->difference, ib->miou - ia->miou, 1e-12);
+  EXPECT_GT(d->difference, 0.0);
+  EXPECT_LT(ib->low, ia->high);  // separately: not told apart
+  EXPECT_GT(d->low, 0.0);        // paired: told apart
+  EXPECT_LE(d->low, d->difference);
+  EXPECT_GE(d->high, d->difference);
+  EXPECT_EQ(d->models, 40);
+  EXPECT_EQ(d->resamples, 2000);
+  // B against itself: a point interval at zero; swapped sides: the mirrored interval.
+  Result<MeanIouDifference> same = bootstrap_mean_iou_difference(b, b);
+  ASSERT_TRUE(same.ok());
+  EXPECT_EQ(same->difference, 0.0);
+  EXPECT_EQ(same->low, 0.0);
+  EXPECT_EQ(same->high, 0.0);
+  Result<MeanIouDifference> swapped = bootstrap_mean_iou_difference(b, a);
+  ASSERT_TRUE(swapped.ok());
+  EXPECT_NEAR(swapped->low, -d->high, 1e-12);
+  EXPECT_NEAR(swapped->high, -d->low, 1e-12);
+}
+
+TEST(BootstrapMeanIouDifference, RejectsUnpairedModels) {
+  const ConfusionMatrix m = model(10.0, 2.0);
+  Status s = bootstrap_mean_iou_difference({m, m}, {m}).status();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("2 models against 1"), std::string::npos) << s.message();
+  s = bootstrap_mean_iou_difference({m, model(10.0, 1.0)}, {m, model(12.0, 1.0)}).status();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("model 1 has other ground truth"), std::string::npos) << s.message();
+  // The same truth predicted otherwise is what a comparison is for.
+  EXPECT_TRUE(bootstrap_mean_iou_difference({model(10.0, 1.0)}, {model(10.0, 9.0)}, 0.95, 20).ok());
+  s = bootstrap_mean_iou_difference({m}, {ConfusionMatrix(3)}).status();
+  EXPECT_NE(s.message().find("matrix 0 has 3 classes"), std::string::npos) << s.message();
+  EXPECT_EQ(bootstrap_mean_iou_difference({}, {}).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(bootstrap_mean_iou_difference({m}, {m}, 0.0).status().code(), StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace g2p

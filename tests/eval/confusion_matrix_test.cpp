@@ -101,5 +101,34 @@ TEST(CalibrationBins, HandComputedEce) {
   EXPECT_TRUE(std::isnan(CalibrationBins().expected_calibration_error()));
 }
 
+TEST(ConfusionMatrixJson, ReadsBackWhatToJsonWrote) {
+  ConfusionMatrix m(3);
+  m.add(0, 0, 2.5);
+  m.add(0, 1, 0.25);
+  m.add(1, kUnknownLabel, 1.0 / 3.0);
+  m.add(2, 2, 7.0);
+  const MaterialTable& table = MaterialTable::paper_default();
+  Result<ConfusionMatrix> back = confusion_matrix_from_json(m.to_json(table), "m.json");
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  ASSERT_EQ(back->num_classes(), 3);
+  for (int t = 0; t < 3; ++t)
+    for (int p = -1; p < 3; ++p)
+      EXPECT_DOUBLE_EQ(back->count(t, p < 0 ? kUnknownLabel : p), m.count(t, p < 0 ? kUnknownLabel : p));
+  EXPECT_DOUBLE_EQ(back->mean_iou(), m.mean_iou());
+
+  const char* bad[][2] = {
+      {"not json", "m.json: expected a confusion matrix"},
+      {R"({"matrix_rows_truth_columns_predicted_then_unknown": [[1, 2, 3]]})", "m.json: row 0 must hold 2 numbers"},
+      {R"({"matrix_rows_truth_columns_predicted_then_unknown": [[1, -2]]})", "row 0, column 1: expected a finite"},
+      {R"({"classes": ["Wood"], "matrix_rows_truth_columns_predicted_then_unknown": [[1, 0, 0], [0, 1, 0]]})",
+       "\"classes\" does not list one class per matrix row"},
+  };
+  for (const auto& [text, message] : bad) {
+    Result<ConfusionMatrix> r = confusion_matrix_from_json(text, "m.json");
+    ASSERT_FALSE(r.ok()) << text;
+    EXPECT_NE(r.status().message().find(message), std::string::npos) << r.status().message();
+  }
+}
+
 }  // namespace
 }  // namespace g2p

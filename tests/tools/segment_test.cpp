@@ -199,6 +199,65 @@ TEST(ToolEval, ShippedNetworkBeatsPbrWithoutNamesOrPbr) {
   EXPECT_GT(miou[1], miou[0] + 0.05) << "pbr " << miou[0] << ", learned " << miou[1];
 }
 
+// g2p eval compare pairs the models of two eval seg --json files: its mIoU are the files' own (every model weighing
+// the same), its interval brackets the difference, and files of other models or no scores are refused.
+TEST(ToolEval, CompareTwoScoreFiles) {
+  const std::string dir = test::scratch_dir("ToolEval.Compare");
+  const std::string base = std::string("eval seg --assets ") + quote(test::source_path("../shared/assets")) +
+                           " --anonymize-names --base-color-only --views 3 --resolution 64 --json ";
+  for (const char* name : {"pbr", "learned"}) {
+    const test::ToolRun r = run_tool(base + quote(dir + "/" + name + ".json") + " --segmenter " + name);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const nlohmann::json pbr = nlohmann::json::parse(test::read_file(dir + "/pbr.json"));
+  const nlohmann::json learned = nlohmann::json::parse(test::read_file(dir + "/learned.json"));
+  test::ToolRun r = run_tool("eval compare " + quote(dir + "/pbr.json") + " " + quote(dir + "/learned.json") +
+                             " --json " + quote(dir + "/compare.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("B - A: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("paired bootstrap, 2000 resamples of 5 models"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| Wood |"), std::string::npos) << r.out;
+  const nlohmann::json c = nlohmann::json::parse(test::read_file(dir + "/compare.json"));
+  const double a = pbr["total_3d_per_model"]["miou"].get<double>(),
+               b = learned["total_3d_per_model"]["miou"].get<double>();
+  EXPECT_NEAR(c["miou_a"].get<double>(), a, 1e-12);
+  EXPECT_NEAR(c["miou_b"].get<double>(), b, 1e-12);
+  EXPECT_NEAR(c["difference"].get<double>(), b - a, 1e-12);
+  EXPECT_LE(c["low"].get<double>(), b - a);
+  EXPECT_GE(c["high"].get<double>(), b - a);
+  EXPECT_LT(c["low"].get<double>(), c["high"].get<double>());
+  EXPECT_EQ(c["models"].get<int>(), 5);
+  EXPECT_NEAR(c["iou_per_class"]["Wood"]["b"].get<double>(), learned["total_3d_per_model"]["iou"]["Wood"].get<double>(),
+              1e-12);
+  // A file against itself: no difference at all.
+  r = run_tool("eval compare " + quote(dir + "/pbr.json") + " " + quote(dir + "/pbr.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("B - A: +0.00 points, 95 % interval +0.00 to +0.00"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not resolved"), std::string::npos) << r.out;
+
+  nlohmann::json fewer = pbr;
+  fewer["models"].erase("Avocado");
+  test::write_file(dir + "/fewer.json", fewer.dump());
+  r = run_tool("eval compare " + quote(dir + "/fewer.json") + " " + quote(dir + "/learned.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("score other models (4 and 5 models)"), std::string::npos) << r.err;
+  nlohmann::json relabelled = pbr;
+  auto& row = relabelled["models"]["Avocado"]["3d"]["matrix_rows_truth_columns_predicted_then_unknown"];
+  for (auto& cells : row)
+    for (auto& cell : cells) cell = cell.get<double>() * 2;
+  test::write_file(dir + "/relabelled.json", relabelled.dump());
+  r = run_tool("eval compare " + quote(dir + "/relabelled.json") + " " + quote(dir + "/learned.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("other ground truth on the two sides"), std::string::npos) << r.err;
+  test::write_file(dir + "/broken.json", R"({"segmenter": "pbr"})");
+  r = run_tool("eval compare " + quote(dir + "/broken.json") + " " + quote(dir + "/learned.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("broken.json: not a g2p eval seg --json file"), std::string::npos) << r.err;
+  r = run_tool("eval compare " + quote(dir + "/missing.json") + " " + quote(dir + "/learned.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("missing.json: cannot open"), std::string::npos) << r.err;
+}
+
 TEST(ToolProject, WritesFacesPartsAndRefines) {
   const std::string out = test::scratch_dir("ToolProject") + "/out";
   const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));

@@ -1,6 +1,9 @@
 // g2p eval seg: segmentation accuracy over a labelled set of models, as the
 // paper's Table 2 (one confusion matrix over the set, IoU per class, mIoU).
 // g2p eval mass: mass errors over a CSV of predictions, as the paper's Table 1.
+// g2p eval compare: whether one segmenter beats another on the same models (a paired bootstrap of two eval seg
+// --json files).
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -277,6 +280,143 @@ int run_eval_mass(const MassArgs& args) {
   return kExitOk;
 }
 
+struct CompareArgs {
+  std::string a, b;  // g2p eval seg --json files
+  double confidence = 0.95;
+  int resamples = 2000;
+  std::string json_out;
+};
+
+// One `g2p eval seg --json` file: its settings and per-model 3D matrices.
+struct ScoreFile {
+  nlohmann::json doc;
+  std::vector<std::string> keys;
+  std::vector<ConfusionMatrix> matrices;
+  std::vector<std::string> classes;
+};
+
+Result<ScoreFile> read_score_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  ScoreFile out;
+  out.doc = nlohmann::json::parse(text.str(), nullptr, false);
+  if (out.doc.is_discarded() || !out.doc.is_object() || !out.doc.contains("models") || !out.doc["models"].is_object())
+    return Status::InvalidArgument(path + ": not a g2p eval seg --json file (no \"models\" object)");
+  for (const auto& item : out.doc["models"].items()) {
+    if (!item.value().is_object() || !item.value().contains("3d"))
+      return Status::InvalidArgument(path + ": model " + item.key() + " has no \"3d\" matrix");
+    Result<ConfusionMatrix> m = confusion_matrix_from_json(item.value()["3d"].dump(), path + ": " + item.key());
+    if (!m.ok()) return m.status();
+    if (out.classes.empty() && item.value()["3d"].contains("classes"))
+      for (const auto& c : item.value()["3d"]["classes"])
+        out.classes.push_back(c.is_string() ? c.get<std::string>() : "");
+    out.keys.push_back(item.key());
+    out.matrices.push_back(std::move(*m));
+  }
+  if (out.keys.empty()) return Status::InvalidArgument(path + ": scores no model");
+  return out;
+}
+
+// What the two files were scored with, where it differs (not the segmenter: that is what is compared).
+std::string differing_conditions(const nlohmann::json& a, const nlohmann::json& b) {
+  std::string out;
+  for (const char* key : {"anonymized_names", "base_color_only", "vote", "views", "resolution"})
+    if (a.value(key, nlohmann::json()) != b.value(key, nlohmann::json()))
+      out += std::string(out.empty() ? "" : ", ") + key + " (" + a.value(key, nlohmann::json()).dump() + " / " +
+             b.value(key, nlohmann::json()).dump() + ")";
+  return out;
+}
+
+// g2p eval compare: is B better than A on the same models? The paired bootstrap of the per-face mIoU difference
+// (every model weighing the same), as docs/training.md's shipping rule asks.
+int run_eval_compare(const CompareArgs& args) {
+  Result<ScoreFile> a = read_score_file(args.a);
+  Result<ScoreFile> b = a.ok() ? read_score_file(args.b) : Result<ScoreFile>(a.status());
+  if (!b.ok()) {
+    std::cerr << "g2p eval compare: error: " << b.status().message() << "\n";
+    return kExitFailure;
+  }
+  // The same models on both sides, in A's order.
+  std::vector<ConfusionMatrix> right;
+  std::vector<std::string> only_a;
+  for (std::size_t i = 0; i < a->keys.size(); ++i) {
+    const auto at = std::find(b->keys.begin(), b->keys.end(), a->keys[i]);
+    if (at == b->keys.end())
+      only_a.push_back(a->keys[i]);
+    else
+      right.push_back(b->matrices[static_cast<std::size_t>(at - b->keys.begin())]);
+  }
+  if (!only_a.empty() || a->keys.size() != b->keys.size()) {
+    std::cerr << "g2p eval compare: error: " << args.a << " and " << args.b << " score other models (" << a->keys.size()
+              << " and " << b->keys.size() << " models"
+              << (only_a.empty() ? ""
+                                 : "; only in the first: " + only_a.front() +
+                                       (only_a.size() > 1 ? " and " + std::to_string(only_a.size() - 1) + " more" : ""))
+              << "); a paired comparison needs the same models\n";
+    return kExitFailure;
+  }
+  Result<MeanIouDifference> d = bootstrap_mean_iou_difference(a->matrices, right, args.confidence, args.resamples);
+  if (!d.ok()) {
+    std::cerr << "g2p eval compare: error: " << d.status().message() << "\n";
+    return kExitFailure;
+  }
+  const std::string differs = differing_conditions(a->doc, b->doc);
+  if (!differs.empty()) std::cerr << "g2p eval compare: note: the files were scored differently: " << differs << "\n";
+  const auto label = [](const ScoreFile& f) {
+    std::string s = f.doc.value("segmenter", std::string("?"));
+    if (f.doc.value("refiner", std::string()) != "" && f.doc.value("refiner", std::string()) != "none")
+      s += " + " + f.doc.value("refiner", std::string());
+    return s + ", " + f.doc.value("vote", std::string("?")) + " votes";
+  };
+  std::printf("A: %s (%s): mIoU %.2f %%\n", args.a.c_str(), label(*a).c_str(), 100.0 * d->miou_a);
+  std::printf("B: %s (%s): mIoU %.2f %%\n", args.b.c_str(), label(*b).c_str(), 100.0 * d->miou_b);
+  std::printf("B - A: %+.2f points, %.0f %% interval %+.2f to %+.2f (paired bootstrap, %d resamples of %d models)\n",
+              100.0 * d->difference, 100.0 * d->confidence, 100.0 * d->low, 100.0 * d->high, d->resamples, d->models);
+  std::printf("%s\n", d->low > 0.0    ? "B is better: the interval lies above zero"
+                      : d->high < 0.0 ? "B is worse: the interval lies below zero"
+                                      : "not resolved: the interval includes zero");
+  // Per class, every model weighing the same.
+  const int classes = a->matrices.front().num_classes();
+  ConfusionMatrix sum_a(classes), sum_b(classes);
+  for (std::size_t i = 0; i < right.size(); ++i) {
+    if (a->matrices[i].total() <= 0) continue;
+    sum_a.merge(a->matrices[i], 1.0 / a->matrices[i].total());
+    sum_b.merge(right[i], 1.0 / right[i].total());
+  }
+  nlohmann::json per_class = nlohmann::json::object();
+  std::printf(
+      "\nPer face (3D), each model weighing the same, IoU %%:\n| class | A | B | B - A |\n|---|---:|---:|---:|\n");
+  for (int c = 0; c < classes; ++c) {
+    if (!sum_a.present(c)) continue;
+    const std::string name = c < static_cast<int>(a->classes.size()) && !a->classes[static_cast<std::size_t>(c)].empty()
+                                 ? a->classes[static_cast<std::size_t>(c)]
+                                 : "class " + std::to_string(c);
+    std::printf("| %s | %.1f | %.1f | %+.1f |\n", name.c_str(), 100.0 * sum_a.iou(c), 100.0 * sum_b.iou(c),
+                100.0 * (sum_b.iou(c) - sum_a.iou(c)));
+    per_class[name] = {{"a", sum_a.iou(c)}, {"b", sum_b.iou(c)}};
+  }
+  if (!args.json_out.empty()) {
+    const nlohmann::json j = {{"a", args.a},
+                              {"b", args.b},
+                              {"miou_a", d->miou_a},
+                              {"miou_b", d->miou_b},
+                              {"difference", d->difference},
+                              {"low", d->low},
+                              {"high", d->high},
+                              {"confidence", d->confidence},
+                              {"resamples", d->resamples},
+                              {"models", d->models},
+                              {"iou_per_class", per_class}};
+    if (Status s = write_text_file(args.json_out, j.dump(2) + "\n"); !s.ok()) {
+      std::cerr << "g2p eval compare: error: " << s.to_string() << "\n";
+      return kExitFailure;
+    }
+  }
+  return kExitOk;
+}
+
 void add_eval_command(CLI::App& app, Command& run) {
   CLI::App* eval = app.add_subcommand("eval", "Measure accuracy against ground truth");
   eval->require_subcommand(1);
@@ -306,6 +446,20 @@ void add_eval_command(CLI::App& app, Command& run) {
   mass->add_option("csv", margs->csv, "CSV with the header object,predicted_kg,true_kg")->required();
   mass->add_option("--json", margs->json_out, "Also write the results as JSON to this file");
   mass->callback([margs, &run] { run = [margs] { return run_eval_mass(*margs); }; });
+
+  auto cargs = std::make_shared<CompareArgs>();
+  CLI::App* compare = eval->add_subcommand(
+      "compare",
+      "Is B better than A? The paired bootstrap interval of the per-face mIoU difference between two eval seg --json "
+      "files that scored the same models");
+  compare->add_option("a", cargs->a, "The reference: a g2p eval seg --json file")->required();
+  compare->add_option("b", cargs->b, "The candidate: a g2p eval seg --json file of the same models")->required();
+  compare->add_option("--confidence", cargs->confidence, "Interval coverage (default 0.95)")
+      ->check(CLI::Range(0.5, 0.999));
+  compare->add_option("--resamples", cargs->resamples, "Bootstrap resamples (default 2000)")
+      ->check(CLI::Range(10, 1000000));
+  compare->add_option("--json", cargs->json_out, "Also write the results as JSON to this file");
+  compare->callback([cargs, &run] { run = [cargs] { return run_eval_compare(*cargs); }; });
 }
 
 }  // namespace g2p::cli

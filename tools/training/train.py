@@ -429,7 +429,7 @@ def init_from_export(model, onnx_path, inputs, batches, count=8):
     model.load_state_dict(onnx_weights.recover_state(model, onnx_path, inputs, size))
     python_state, numpy_state = random.getstate(), np.random.get_state()
     with torch.random.fork_rng(devices=[]):
-        sample = [batch for batch, _ in zip(batches, range(count))]
+        sample = [batch for _, batch in zip(range(count), batches)]
     random.setstate(python_state)
     np.random.set_state(numpy_state)
     return onnx_weights.calibrate_batch_norm(model, [x for x, _ in sample])

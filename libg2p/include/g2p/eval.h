@@ -73,6 +73,37 @@ struct MeanIouInterval {
 G2P_API Result<MeanIouInterval> bootstrap_mean_iou(const std::vector<ConfusionMatrix>& per_model,
                                                    double confidence = 0.95, int resamples = 2000, unsigned seed = 1);
 
+// Whether segmenter B beats segmenter A on the same models: a paired
+// percentile bootstrap of mIoU(B) - mIoU(A). Each resample draws models with
+// replacement and scores both segmenters on that same draw (every model
+// weighing the same, as above), so the spread that comes from which models
+// were drawn (hard ones, easy ones) cancels in the difference: its interval is
+// far narrower than the two separate intervals suggest, and a difference
+// whose interval excludes zero is one the models resolve.
+struct MeanIouDifference {
+  double miou_a = 0.0;  // of all models, each weighing the same
+  double miou_b = 0.0;
+  double difference = 0.0;  // miou_b - miou_a
+  double low = 0.0;         // lower and upper percentile of the resampled differences
+  double high = 0.0;
+  double confidence = 0.95;
+  int resamples = 0;
+  int models = 0;  // models with a labelled sample
+};
+
+// `a` and `b` hold the same models in the same order: model i's ground truth
+// (its per-class row sums) must agree, within a relative 1e-6, or it fails
+// naming the model. Otherwise fails as bootstrap_mean_iou does.
+G2P_API Result<MeanIouDifference> bootstrap_mean_iou_difference(const std::vector<ConfusionMatrix>& a,
+                                                                const std::vector<ConfusionMatrix>& b,
+                                                                double confidence = 0.95, int resamples = 2000,
+                                                                unsigned seed = 1);
+
+// A matrix back from ConfusionMatrix::to_json's text (its "classes" and
+// "matrix_rows_truth_columns_predicted_then_unknown"); `what` names the text
+// in errors (a file and a key, say).
+G2P_API Result<ConfusionMatrix> confusion_matrix_from_json(const std::string& text, const std::string& what);
+
 // Calibration of predicted probabilities: how far the confidence of the top
 // class is from the accuracy it achieves. Expected calibration error (Guo et
 // al. 2017, "On Calibration of Modern Neural Networks"): samples are binned by

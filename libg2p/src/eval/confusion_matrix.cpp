@@ -201,4 +201,32 @@ double CalibrationBins::accuracy() const {
   return total > 0.0 ? c / total : std::numeric_limits<double>::quiet_NaN();
 }
 
+Result<ConfusionMatrix> confusion_matrix_from_json(const std::string& text, const std::string& what) {
+  using nlohmann::json;
+  const json doc = json::parse(text, nullptr, false);
+  const char* key = "matrix_rows_truth_columns_predicted_then_unknown";
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains(key) || !doc[key].is_array())
+    return Status::InvalidArgument(what + ": expected a confusion matrix ({\"" + key + "\": [[...]], ...})");
+  const json& rows = doc[key];
+  const int n = static_cast<int>(rows.size());
+  if (doc.contains("classes") && (!doc["classes"].is_array() || static_cast<int>(doc["classes"].size()) != n))
+    return Status::InvalidArgument(what + ": \"classes\" does not list one class per matrix row (" + std::to_string(n) +
+                                   " rows)");
+  ConfusionMatrix m(n);
+  for (int t = 0; t < n; ++t) {
+    const json& row = rows[static_cast<std::size_t>(t)];
+    if (!row.is_array() || static_cast<int>(row.size()) != n + 1)
+      return Status::InvalidArgument(what + ": row " + std::to_string(t) + " must hold " + std::to_string(n + 1) +
+                                     " numbers (the predicted classes, then unknown)");
+    for (int p = 0; p <= n; ++p) {
+      const json& cell = row[static_cast<std::size_t>(p)];
+      if (!cell.is_number() || !(cell.get<double>() >= 0.0) || !std::isfinite(cell.get<double>()))
+        return Status::InvalidArgument(what + ": row " + std::to_string(t) + ", column " + std::to_string(p) +
+                                       ": expected a finite count >= 0");
+      if (cell.get<double>() > 0.0) m.add(t, p == n ? kUnknownLabel : p, cell.get<double>());
+    }
+  }
+  return m;
+}
+
 }  // namespace g2p

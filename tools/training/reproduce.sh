@@ -17,6 +17,9 @@
 # are already done (an unpacked library, a fetched package, a dataset whose manifest matches, a trained network)
 # are not redone.
 set -euo pipefail
+# The whole script is one block, which bash reads to its end before running any of it: editing this file while a run
+# of it is under way (an hour of training) does not change what that run does next.
+{
 
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -125,3 +128,5 @@ if [ $ensemble = 1 ]; then
     --json "$work/held_ensemble.json" > "$work/held_ensemble.txt"
 fi
 echo "reproduce.sh: network in $work/model; scores in $work/held_*.txt and $work/shared_model.txt"
+exit
+}

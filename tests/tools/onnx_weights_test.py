@@ -5,6 +5,7 @@ there too; train.py --init and ensemble.py use it where a run's checkpoints are 
 import copy
 import json
 import os
+import random
 import sys
 import tempfile
 import unittest
@@ -40,8 +41,7 @@ def context_network(seed, inputs=6):
 
 
 def export(model, path, inputs=6, size=32):
-    torch.onnx.export(model, torch.zeros(1, inputs, size, size), path, input_names=["pixels"],
-                      output_names=["logits"], opset_version=11)
+    train.export_onnx(model, inputs, size, path)
 
 
 def assert_same_function(got, expected, tolerance=1e-5):
@@ -109,6 +109,33 @@ class RecoverTest(unittest.TestCase):
         assert_same_function(in_training, before, 1e-4)
         bn = model.unet.enc[0][1]
         self.assertGreater((bn.running_var - 1).abs().max().item(), 1e-3)
+
+    def test_starting_from_an_export_leaves_the_random_generators_as_they_were(self):
+        def batches():  # draws from the three generators, as the training loader's shuffling and augmentations do
+            while True:
+                random.random()
+                np.random.rand()
+                yield torch.randn(2, 6, 32, 32), None
+
+        def next_draws():
+            return random.random(), float(np.random.rand()), torch.rand(1).item()
+
+        def seed():
+            random.seed(5)
+            np.random.seed(5)
+            torch.manual_seed(5)
+
+        seed()
+        untouched = next_draws()
+        seed()
+        for _ in zip(range(8), batches()):
+            pass
+        self.assertNotEqual(next_draws(), untouched)  # the calibration batches do move all three generators
+        model = context_network(2)  # seeds torch itself
+        seed()
+        self.assertEqual(train.init_from_export(model, self.path, 6, batches()), 18)
+        # A run from an export sees the batches and augmentations the same run from a checkpoint sees.
+        self.assertEqual(next_draws(), untouched)
 
     def test_files_that_are_not_this_networks_export_are_refused(self):
         other = os.path.join(self.tmp.name, "rgb.onnx")

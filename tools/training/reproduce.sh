@@ -16,9 +16,9 @@
 #   7. with --ensemble, joins the network to the shipped one (ensemble.py, the shipped weights recovered from its
 #      ONNX file) in WORK/ensemble and scores that too.
 #
-# --max-minutes limits each training step. --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p and g2p_make_dataset are; steps that
-# are already done (an unpacked library, a fetched package, a dataset whose manifest matches, a trained network)
-# are not redone.
+# --max-minutes limits each training step; --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p
+# and g2p_make_dataset are. Steps that are already done (an unpacked library, a fetched package, a dataset whose
+# manifest matches, a trained network) are not redone.
 set -euo pipefail
 # The whole script is one block, which bash reads to its end before running any of it: editing this file while a run
 # of it is under way (an hour of training) does not change what that run does next.
@@ -99,7 +99,7 @@ echo "reproduce.sh: $dataset is the shipped network's training set (manifest $(s
 [ $data_only = 1 ] && exit 0
 
 # 4. Training: U-Net from random weights beside NanoDet-g fine-tuned, one run (docs/training.md). A network
-#    already trained in WORK/model is kept (delete the folder to train again); an unfinished one (checkpoints,
+#    already trained in WORK/model is kept (delete it, and WORK/continued, to train again); an unfinished one (checkpoints,
 #    no card) is trained again from the start (--overwrite).
 card=$work/model/g2p-materials.json
 if [ ! -f "$card" ]; then
@@ -108,7 +108,8 @@ if [ ! -f "$card" ]; then
 fi
 
 # 5. Continued from step 4's best weights, as run 13 continued run 12: a new one-cycle schedule at lower rates
-#    (U-Net 3e-4, encoder 5e-5). Kept like step 4's network once trained.
+#    (U-Net 3e-4, encoder 5e-5). Kept like step 4's network once trained: a WORK/model trained again needs
+#    WORK/continued deleted too.
 network=$work/model
 if [ "$continue_epochs" != 0 ]; then
   network=$work/continued

@@ -99,8 +99,8 @@ echo "reproduce.sh: $dataset is the shipped network's training set (manifest $(s
 [ $data_only = 1 ] && exit 0
 
 # 4. Training: U-Net from random weights beside NanoDet-g fine-tuned, one run (docs/training.md). A network
-#    already trained in WORK/model is kept (delete it, and WORK/continued, to train again); an unfinished one (checkpoints,
-#    no card) is trained again from the start (--overwrite).
+#    already trained in WORK/model is kept (delete it, and WORK/continued, to train again); an unfinished one
+#    (checkpoints, no card) is trained again from the start (--overwrite).
 card=$work/model/g2p-materials.json
 if [ ! -f "$card" ]; then
   "$python" "$here/train.py" "$dataset" "$work/model" --normals --context "$models" --context-lr 1e-4 --lr 1e-3 \

@@ -110,6 +110,50 @@ class EnsembleToolTest(DatasetCase):
         self.assertEqual(snapshot(out), first)
         self.assertEqual(sorted(os.listdir(out)), ["g2p-materials.json", "g2p-materials.onnx", "training.json"])
 
+    def test_an_ensemble_stands_for_its_members_and_one_of_them_can_be_continued(self):
+        runs = [os.path.join(self.tmp.name, f"run{i}") for i in range(2)]
+        for i, run in enumerate(runs):
+            write_run(run, self.dataset, seeded(train.UNet(inputs=6), i + 1).state_dict(), tau=0.25 * i)
+        out = os.path.join(self.tmp.name, "out")
+        self.assertEqual(self.run_tool(out, *runs).returncode, 0)
+        for name in ("best.pt", "training.json"):  # the runs are gone: only the ensemble's file is left
+            os.remove(os.path.join(runs[0], name))
+        bigger = os.path.join(self.tmp.name, "bigger")
+        done = self.run_tool(bigger, out, runs[1])
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(bigger, "training.json")) as f:
+            record = json.load(f)
+        self.assertEqual(record["ensemble"]["members"], [out + "#0", out + "#1", runs[1]])
+        self.assertEqual([m["member"] for m in record["members"][:2]], [0, 1])
+        self.assertEqual(record["ensemble"]["int8_weights"]["convolutions"], 3 * 17)
+        one = os.path.join(self.tmp.name, "one")
+        self.assertEqual(self.run_tool(one, out + "#0", runs[1]).returncode, 0)
+        done = self.run_tool(os.path.join(self.tmp.name, "none"), out + "#2", runs[1])
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("out#2: the ensemble has 2 members (#0 to #1)", done.stderr)
+
+        # train.py continues one member of an ensemble's export, named PATH#K.
+        exported = os.path.join(out, "g2p-materials.onnx")
+        done = self.run_train(os.path.join(self.tmp.name, "whole"), "--epochs", "0", "--init", exported)
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("an ensemble's export; name the member to start from as " + exported + "#K", done.stderr)
+        continued = os.path.join(self.tmp.name, "continued")
+        done = self.run_train(continued, "--epochs", "0", "--init", exported + "#1")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        (_, member_record, _), = ensemble.read_runs(out + "#1")
+        member, _ = ensemble.build_member(member_record, None, "", torch.zeros(12))
+        x = torch.randn(1, 6, 32, 32)
+        started = train.UNet(inputs=6)
+        import onnx_weights
+        started.load_state_dict(onnx_weights.recover_state(started, os.path.join(continued, "g2p-materials.onnx"),
+                                                           6, 32))
+        with torch.no_grad():  # the run starts, and with no epochs ends, as the member (its adjustment included)
+            expected = member(x)
+            torch.testing.assert_close(started.eval()(x), expected, rtol=0, atol=1e-4 * expected.abs().max().item())
+            other, _ = ensemble.build_member(ensemble.read_runs(out + "#0")[0][1], None, "", torch.zeros(12))
+            # Member #0 is farther from it than ten times the tolerance: the check above can fail.
+            self.assertGreater((other(x) - expected).abs().max().item(), 1e-3 * expected.abs().max().item())
+
     def test_members_validated_on_other_models_are_refused(self):
         state = seeded(train.UNet(inputs=6), 1).state_dict()
         a, b, c = (os.path.join(self.tmp.name, n) for n in ("a", "b", "c"))

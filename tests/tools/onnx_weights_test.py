@@ -156,6 +156,57 @@ class RecoverTest(unittest.TestCase):
         self.assertEqual(train.export_shape(other), (3, 32))
 
 
+class EnsembleRecoverTest(unittest.TestCase):
+    """An ensemble.py export (members side by side, Identity constants inlined, convolutions in int8) comes apart
+    into its members' weights: exported again, they give the same file."""
+
+    def test_the_members_come_back_with_the_rounded_weights(self):
+        import onnx  # python3-onnx
+        from onnx import numpy_helper
+        originals = [context_network(1), context_network(2)]
+        with tempfile.TemporaryDirectory() as tmp:
+            path, again = os.path.join(tmp, "ensemble.onnx"), os.path.join(tmp, "again.onnx")
+            quantised = ensemble.export_ensemble(ensemble.Ensemble(originals).eval(), 6, 32, path)
+            self.assertGreater(quantised["convolutions"], 30)
+            states = onnx_weights.recover_members([context_network(3), context_network(4)], path, 6, 32)
+            self.assertEqual(len(states), 2)
+            members = []
+            for state in states:
+                member = context_network(5)
+                member.load_state_dict(state)
+                members.append(member.eval())
+            x = torch.randn(2, 6, 32, 32)
+            for k, (original, member) in enumerate(zip(originals, members)):
+                # Each member alone, in int8, read back as one network: the same rounded weights by another path.
+                alone = os.path.join(tmp, f"alone{k}.onnx")
+                export(original, alone)
+                model = onnx.load(alone)
+                ensemble.quantize.quantize_conv_weights(model)
+                onnx.save(model, alone)
+                rounded = context_network(6)
+                rounded.load_state_dict(onnx_weights.recover_state(rounded, alone, 6, 32))
+                with torch.no_grad():
+                    expected, got = original(x), member(x)
+                    self.assertGreater((got - expected).abs().max().item(), 0)  # the weights were rounded to 8 bits
+                    assert_same_function(got, rounded.eval()(x))
+                    self.assertGreater((members[1 - k](x) - got).abs().max().item(), 0.1 * expected.abs().max().item())
+            # Exported again as ensemble.py exports, the recovered members give the file they came from.
+            ensemble.export_ensemble(ensemble.Ensemble(members).eval(), 6, 32, again)
+            first, second = onnx.load(path).graph, onnx.load(again).graph
+            with self.assertRaisesRegex(ValueError, "not this network's export .*an ensemble read as one network"):
+                onnx_weights.recover_state(context_network(3), path, 6, 32)
+        self.assertEqual([n.op_type for n in first.node], [n.op_type for n in second.node])
+        ints = 0
+        for a, b in zip(first.initializer, second.initializer):
+            a, b = numpy_helper.to_array(a), numpy_helper.to_array(b)
+            if a.dtype == np.int8:
+                ints += 1
+                np.testing.assert_array_equal(b, a)
+            else:
+                np.testing.assert_allclose(b, a, rtol=1e-5, atol=1e-6)
+        self.assertEqual(ints, quantised["convolutions"])
+
+
 class ContinueFromExportTest(DatasetCase):
     def test_train_starts_from_an_exported_network(self):
         first = os.path.join(self.tmp.name, "first")
@@ -192,11 +243,11 @@ class EnsembleMemberFromExportTest(DatasetCase):
         run = os.path.join(self.tmp.name, "run")
         write_run(run, self.dataset, state, tau=0.25)
         prior = torch.tensor([0.5, 0.25, 0.25] + [0.0] * 9)
-        record, loaded = ensemble.read_run(run)
+        record, loaded = ensemble.read_runs(run)[0][1:]
         reference, _ = ensemble.build_member(record, loaded, "", prior)
         export(reference, os.path.join(run, "g2p-materials.onnx"))
         os.remove(os.path.join(run, "best.pt"))
-        record, loaded = ensemble.read_run(run)
+        record, loaded = ensemble.read_runs(run)[0][1:]
         self.assertIsNone(loaded)
         self.assertEqual(record["weights_from"], os.path.join(os.path.abspath(run), "g2p-materials.onnx"))
         member, inputs = ensemble.build_member(record, loaded, "", prior)
@@ -208,11 +259,13 @@ class EnsembleMemberFromExportTest(DatasetCase):
             ensemble.build_member(record, None, "", None)  # a teacher needs the network before it
         os.remove(os.path.join(run, "g2p-materials.onnx"))
         with self.assertRaisesRegex(ValueError, "holds neither best.pt nor g2p-materials.onnx"):
-            ensemble.read_run(run)
+            ensemble.read_runs(run)
+        with self.assertRaisesRegex(ValueError, r"run#1: .*run is one network, not an ensemble \(drop #1\)"):
+            ensemble.read_runs(run + "#1")
         with open(os.path.join(run, "training.json"), "w") as f:
             json.dump({"ensemble": {}, "members": []}, f)
-        with self.assertRaisesRegex(ValueError, "no validated epoch was exported .*or an ensemble"):
-            ensemble.read_run(run)
+        with self.assertRaisesRegex(ValueError, "an ensemble without members"):
+            ensemble.read_runs(run)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """tools/training/quantize.py: convolution weights become int8 per output channel within half a step of the
 float ones, each quantised convolution is rewritten as Conv(x, Cast(Q)) * S + B, small or shared weights stay in
-float, and a file that is not an ONNX model gets a clear error."""
+float, dequantisation gives back the float model's nodes with the rounded weights, and a file that is not an ONNX
+model gets a clear error."""
 import os
 import subprocess
 import sys
@@ -70,6 +71,34 @@ class QuantizeTest(unittest.TestCase):
         ops = [n.op_type for n in model.graph.node]
         self.assertEqual(ops, ["Conv", "Relu", "Cast", "Conv", "Mul", "Add", "Relu", "Cast", "Conv", "Mul"])
         self.assertEqual(model.graph.node[-1].output[0], "y")  # the graph's output keeps its name
+
+    def test_dequantisation_restores_the_float_models_nodes_with_the_rounded_weights(self):
+        import onnx
+        from onnx import numpy_helper
+        with tempfile.TemporaryDirectory() as tmp:
+            model = onnx.load(export(tmp))
+        original = onnx.ModelProto()
+        original.CopyFrom(model)
+        quantize.quantize_conv_weights(model)
+        constants = {t.name: numpy_helper.to_array(t) for t in model.graph.initializer}
+        self.assertEqual(quantize.dequantize_conv_weights(model), 2)
+        onnx.checker.check_model(model)
+        self.assertEqual([n.op_type for n in model.graph.node], [n.op_type for n in original.graph.node])
+        self.assertEqual([n.output[0] for n in model.graph.node], [n.output[0] for n in original.graph.node])
+        values = {t.name: numpy_helper.to_array(t) for t in model.graph.initializer}
+        before = {t.name: numpy_helper.to_array(t) for t in original.graph.initializer}
+        for node, float_node in zip(model.graph.node, original.graph.node):
+            self.assertEqual(len(node.input), len(float_node.input), node.name)
+            for name, float_name in zip(node.input[1:], float_node.input[1:]):
+                self.assertEqual(values[name].shape, before[float_name].shape, name)
+        np.testing.assert_array_equal(values["a.weight"], before["a.weight"])  # never quantised
+        for name, channels in (("b.weight", 32), ("c.weight", 8)):  # exactly Q x S, within half a step of w
+            q, s = constants[name + "_int8"], constants[name + "_scale"].reshape(-1, 1, 1, 1)
+            np.testing.assert_array_equal(values[name], q.astype(np.float32) * s)
+            self.assertGreater(np.abs(values[name] - before[name]).max(), 0)
+        np.testing.assert_array_equal(values["b.weight_bias_flat"], before["b.bias"])
+        self.assertFalse([t.name for t in model.graph.initializer if t.data_type == onnx.TensorProto.INT8])
+        self.assertEqual(quantize.dequantize_conv_weights(model), 0)  # a float model is left as it is
 
     def test_the_tool_refuses_what_is_not_a_model(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -4,7 +4,8 @@
     python3 tools/training/ensemble.py OUT RUN RUN [RUN ...] [--context MODELS] [--float-weights] [--threads 2]
 
 Each RUN is a train.py output folder (best.pt and training.json; without best.pt, its exported g2p-materials.onnx,
-whose weights onnx_weights.py recovers: the shipped libg2p/data/models/ is such a folder). Every member is rebuilt with the settings its
+whose weights onnx_weights.py recovers) or an ensemble.py output folder, which stands for all its members
+("FOLDER#K": member K alone, from 0); the shipped libg2p/data/models/ is either kind. Every member is rebuilt with the settings its
 training.json records, its exported logit adjustment (tau) folded in, and the ensemble outputs the mean of the
 members' log-softmax (the normalised geometric mean of their probabilities; Lakshminarayanan et al. 2017,
 "Simple and scalable predictive uncertainty estimation using deep ensembles", average independently trained
@@ -49,31 +50,60 @@ class Ensemble(nn.Module):
         return torch.stack([F.log_softmax(m(x), 1) for m in self.members]).mean(0)
 
 
-def read_run(folder):
-    """(training.json as a dict, best.pt's state dict) of a train.py output folder. A folder whose checkpoints are
-    gone (the shipped libg2p/data/models/, a run from another machine) serves through its exported
-    g2p-materials.onnx: the state is then None and the record's "weights_from" names the file, whose weights
-    build_member recovers (onnx_weights.py). ValueError names what is missing."""
+def split_member(spec):
+    """(path, member index or None) of a RUN argument, "FOLDER" or "FOLDER#K" (K from 0)."""
+    path, mark, member = spec.rpartition("#")
+    if mark and member.isdigit():
+        return path, int(member)
+    return spec, None
+
+
+def read_runs(spec):
+    """The members a RUN argument stands for, as (label, training.json record, best.pt's state dict) triples.
+
+    A train.py output folder is one member. A folder whose checkpoints are gone (a run from another machine) serves
+    through its exported g2p-materials.onnx: the state is then None and the record's "weights_from" names the file,
+    whose weights build_member recovers (onnx_weights.py). An ensemble.py output folder (the shipped
+    libg2p/data/models/ is one) stands for all its members, "FOLDER#K" for member K alone (from 0): their records
+    are those the ensemble keeps, with "weights_from" its file and "member" the index. ValueError names what is
+    missing."""
+    folder, only = split_member(spec)
     paths = {name: os.path.join(folder, name) for name in ("training.json", "best.pt", "g2p-materials.onnx")}
     if not os.path.isfile(paths["training.json"]):
-        raise ValueError(f"{paths['training.json']}: not found (a member is a train.py output folder)")
+        raise ValueError(f"{paths['training.json']}: not found (a member is a train.py or ensemble.py output folder)")
     with open(paths["training.json"]) as f:
         record = json.load(f)
+    if "ensemble" in record:
+        members = record.get("members") or []
+        if not members:
+            raise ValueError(f"{paths['training.json']}: an ensemble without members")
+        if only is not None and only >= len(members):
+            raise ValueError(f"{spec}: the ensemble has {len(members)} members (#0 to #{len(members) - 1})")
+        if not os.path.isfile(paths["g2p-materials.onnx"]):
+            raise ValueError(f"{folder}: an ensemble without its g2p-materials.onnx")
+        runs = []
+        for k, member in enumerate(members):
+            if only is not None and k != only:
+                continue
+            member = dict(member, weights_from=os.path.abspath(paths["g2p-materials.onnx"]), member=k)
+            member.pop("ensemble_members", None)
+            member["ensemble_members"] = [dict(m) for m in members]
+            runs.append((f"{folder}#{k}", member, None))
+        return runs
+    if only is not None:
+        raise ValueError(f"{spec}: {folder} is one network, not an ensemble (drop #{only})")
     if not record.get("exported"):
-        raise ValueError(f"{paths['training.json']}: no validated epoch was exported (trained without validation"
-                         f"{', or an ensemble' if 'ensemble' in record else ''})")
+        raise ValueError(f"{paths['training.json']}: no validated epoch was exported (trained without validation)")
     if os.path.isfile(paths["best.pt"]):
-        return record, torch.load(paths["best.pt"], map_location="cpu")
+        return [(spec, record, torch.load(paths["best.pt"], map_location="cpu"))]
     if not os.path.isfile(paths["g2p-materials.onnx"]):
         raise ValueError(f"{folder}: holds neither best.pt nor g2p-materials.onnx (the run's weights)")
     record["weights_from"] = os.path.abspath(paths["g2p-materials.onnx"])
-    return record, None
+    return [(spec, record, None)]
 
 
-def build_member(record, state, context, prior):
-    """The network a run exported: its architecture from the recorded settings, its best weights and its logit
-    adjustment folded into the classifier's bias, as train.py exports it (with `prior` None, no adjustment). With
-    `state` None the weights are recovered from record["weights_from"], its export, which has the adjustment in."""
+def network(record, context):
+    """(the untrained network a run's recorded settings describe, its input channels)."""
     settings = record["settings"]
     inputs = 6 if settings.get("normals") else 3
     model = train.UNet(inputs=inputs)
@@ -81,14 +111,44 @@ def build_member(record, state, context, prior):
         if not context:
             raise ValueError(f"{settings['out']} was trained with a pretrained context encoder: pass --context")
         model = train.context_unet(model, settings, context)
+    return model, inputs
+
+
+_RECOVERED = {}  # (ensemble file, context) -> its members' state dicts: an ensemble is taken apart once
+
+
+def member_state(record, context):
+    """The weights of ensemble member record["member"] (a record from read_runs), recovered from its ensemble's
+    file together with its fellow members'."""
+    key = (record["weights_from"], context)
+    if key not in _RECOVERED:
+        import onnx_weights  # tools/training/onnx_weights.py
+        built = [network(m, context) for m in record["ensemble_members"]]
+        inputs = {n for _, n in built}
+        if len(inputs) != 1:
+            raise ValueError(f"{record['weights_from']}: its members take different inputs")
+        _RECOVERED[key] = onnx_weights.recover_members([m for m, _ in built], record["weights_from"], inputs.pop(),
+                                                       record["settings"]["export_size"])
+    return _RECOVERED[key][record["member"]]
+
+
+def build_member(record, state, context, prior):
+    """The network a run exported: its architecture from the recorded settings, its best weights and its logit
+    adjustment folded into the classifier's bias, as train.py exports it (with `prior` None, no adjustment). With
+    `state` None the weights are recovered from record["weights_from"], its export (or its ensemble's), which has
+    the adjustment in."""
+    model, inputs = network(record, context)
     tau = record["exported"]["tau"]
     if state is None:
-        import onnx_weights  # tools/training/onnx_weights.py
         if prior is None and tau != 0:
             raise ValueError(f"{record['weights_from']}: its logit adjustment (tau {tau}) is folded into the weights; "
                              f"without its best.pt the network before the adjustment is not known")
-        model.load_state_dict(onnx_weights.recover_state(model, record["weights_from"], inputs,
-                                                         settings["export_size"]))
+        if "member" in record:
+            model.load_state_dict(member_state(record, context))
+        else:
+            import onnx_weights  # tools/training/onnx_weights.py
+            model.load_state_dict(onnx_weights.recover_state(model, record["weights_from"], inputs,
+                                                             record["settings"]["export_size"]))
         return model.eval(), inputs
     model.load_state_dict(state)
     if prior is None:  # the network's own probabilities, before the logit adjustment (a teacher's)
@@ -109,27 +169,31 @@ def split_mismatch(record, settings, sha):
     return ", ".join(k for k in SPLIT_KEYS if own.get(k, "") != settings.get(k, ""))
 
 
-def inline_identities(onnx_path):
-    """Replaces each Identity node that copies an initializer by a copy of that initializer. The exporter writes
-    one for weights the members share exactly (their fixed input conversion), and OpenCV 4.6's importer cannot
-    parse an Identity whose input is a constant."""
-    import copy
+def export_ensemble(model, inputs, size, onnx_path, int8=True):
+    """Writes `model` (an Ensemble) to `onnx_path` as the `onnx` backend reads it: exported as train.py exports a
+    run, the Identity nodes the exporter writes for weights the members share exactly (their fixed input conversion)
+    replaced by constants, since OpenCV 4.6's importer cannot parse an Identity whose input is a constant, and with
+    `int8` the convolution weights in 8 bits (quantize.py). Returns quantize.py's counts (None without `int8`)."""
     import onnx  # python3-onnx
-    model = onnx.load(onnx_path)
-    graph = model.graph
-    constants = {t.name: t for t in graph.initializer}
-    for node in [n for n in graph.node if n.op_type == "Identity" and n.input[0] in constants]:
-        tensor = copy.deepcopy(constants[node.input[0]])
-        tensor.name = node.output[0]
-        graph.initializer.append(tensor)
-        graph.node.remove(node)
-    onnx.save(model, onnx_path)
+    import onnx_weights  # tools/training/onnx_weights.py
+    train.export_onnx(model, inputs, size, onnx_path)
+    exported = onnx.load(onnx_path)
+    onnx_weights.inline_identity_constants(exported)
+    quantised = None
+    if int8:
+        count, before, after = quantize.quantize_conv_weights(exported)
+        quantised = {"convolutions": count, "weight_bytes_before": before, "weight_bytes_after": after}
+    onnx.checker.check_model(exported)
+    onnx.save(exported, onnx_path)
+    return quantised
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out")
-    ap.add_argument("runs", nargs="+", metavar="RUN", help="train.py output folders (training.json, and best.pt or g2p-materials.onnx)")
+    ap.add_argument("runs", nargs="+", metavar="RUN",
+                    help="train.py output folders (training.json, and best.pt or g2p-materials.onnx), or ensemble.py "
+                         "ones (all their members; FOLDER#K: member K, from 0)")
     ap.add_argument("--dataset", default="",
                     help="the dataset the members were validated on (default: the first member's recorded one)")
     ap.add_argument("--context", default="",
@@ -142,29 +206,30 @@ def main():
         ap.error("an ensemble needs at least two RUN folders")
     torch.set_num_threads(a.threads)
     try:
-        runs = [read_run(r) for r in a.runs]
+        runs = [member for spec in a.runs for member in read_runs(spec)]
     except ValueError as e:
         ap.error(str(e))
-    records = [r for r, _ in runs]
+    labels = [label for label, _, _ in runs]
+    records = [r for _, r, _ in runs]
     first = records[0]["settings"]
     dataset = a.dataset or first["dataset"]
     for record in records:  # runs from before --split-seed split with --seed
         record["settings"].setdefault("split_seed", record["settings"]["seed"])
     rows, val_rows, sha, _ = train.training_rows(dataset, [], first["val_share"], first["split_seed"],
                                                  first.get("val_library", ""))
-    for run, record in zip(a.runs, records):
+    for run, record in zip(labels, records):
         s = record["settings"]
         differs = split_mismatch(record, first, sha)
         if differs:
-            ap.error(f"{run}: validated on other models than {dataset} with {a.runs[0]}'s split "
+            ap.error(f"{run}: validated on other models than {dataset} with {labels[0]}'s split "
                      f"({differs} differs); its score on these validation images would include its training models")
         if record["settings"].get("export_size") != first.get("export_size"):
-            ap.error(f"{run}: export size {s.get('export_size')} differs from {a.runs[0]}'s")
+            ap.error(f"{run}: export size {s.get('export_size')} differs from {labels[0]}'s")
     val_rows = train.validation_subsample(val_rows)
     _, counts = train.class_weights(rows, first["balance"])
     prior = torch.tensor(counts / max(counts.sum(), 1), dtype=torch.float32)
     try:
-        built = [build_member(record, state, a.context, prior) for record, state in runs]
+        built = [build_member(record, state, a.context, prior) for _, record, state in runs]
     except (ValueError, RuntimeError) as e:
         ap.error(str(e))
     inputs = {n for _, n in built}
@@ -179,31 +244,23 @@ def main():
                                                          normals=inputs == 6), batch_size=32)
     zero = [torch.zeros(len(train.CLASSES))]
     scores = {run: train.mean_iou(train.confusion(m, val_data, size, zero, "cpu")[0])
-              for run, m in zip(a.runs, members)}
+              for run, m in zip(labels, members)}
     scores["ensemble"] = train.mean_iou(train.confusion(model, val_data, size, zero, "cpu")[0])
     for name, score in scores.items():
         print(f"validation mIoU {100 * score:.1f} %: {name}", flush=True)
 
     with train.staged_export(a.out) as stage:  # OUT keeps what it held unless the whole export succeeds
         onnx_path = os.path.join(stage, "g2p-materials.onnx")
-        train.export_onnx(model, inputs, size, onnx_path)
-        inline_identities(onnx_path)
-        quantised = None
-        if not a.float_weights:
-            import onnx  # python3-onnx
-            exported = onnx.load(onnx_path)
-            count, before, after = quantize.quantize_conv_weights(exported)
-            onnx.checker.check_model(exported)
-            onnx.save(exported, onnx_path)
-            quantised = {"convolutions": count, "weight_bytes_before": before, "weight_bytes_after": after}
+        quantised = export_ensemble(model, inputs, size, onnx_path, int8=not a.float_weights)
         train.write_model_card(stage, size, inputs == 6,
                                list(dict.fromkeys(k for r in records for k in train.context_kinds(r["settings"]))))
         with open(os.path.join(stage, "training.json"), "w") as f:
-            json.dump({"ensemble": {"members": a.runs, "combine": "mean of log-softmax", "int8_weights": quantised,
+            json.dump({"ensemble": {"members": labels, "combine": "mean of log-softmax", "int8_weights": quantised,
                                     "dataset": dataset,
                                     "manifest_sha256": sha, "validation_images": len(val_rows),
                                     "validation_miou": scores},
-                       "members": records, "torch": torch.__version__}, f, indent=2)
+                       "members": [{k: v for k, v in r.items() if k != "ensemble_members"} for r in records],
+                       "torch": torch.__version__}, f, indent=2)
             f.write("\n")
         megabytes = os.path.getsize(onnx_path) / 1e6
     print(f"{len(members)} members -> {os.path.join(a.out, 'g2p-materials.onnx')} ({megabytes:.1f} MB)", flush=True)

@@ -14,6 +14,10 @@ the network computes in evaluation mode exactly what the file computes. Training
 statistics instead, so calibrate_batch_norm() then sets each batch normalisation's statistics to those of its
 inputs (and gamma, beta to match), which leaves the evaluation-mode function unchanged and makes the training-mode
 one start where the exported network is.
+
+An ensemble.py export is read the same way: its int8 convolutions are first turned back into float ones (the weights
+as rounded; quantize.py), its members' networks form the probe, and recover_members() splits the recovered state
+into the members' own. The members then compute what they computed inside the ensemble file.
 """
 import copy
 import io
@@ -47,6 +51,22 @@ def _export(model, inputs, size):
     return onnx.load_from_string(buffer.getvalue())
 
 
+def inline_identity_constants(model):
+    """Replaces, in `model` (an onnx.ModelProto), each Identity node that copies an initializer by a copy of that
+    initializer named as its output. The exporter writes such nodes for tensors that appear twice with the same
+    values (an ensemble's members' fixed input conversion); ensemble.py removes them because OpenCV 4.6 cannot parse
+    them, and the probe gets the same treatment so that both graphs keep the same nodes. Returns the number removed."""
+    graph = model.graph
+    constants = {t.name: t for t in graph.initializer}
+    identities = [n for n in graph.node if n.op_type == "Identity" and n.input[0] in constants]
+    for node in identities:
+        tensor = copy.deepcopy(constants[node.input[0]])
+        tensor.name = node.output[0]
+        graph.initializer.append(tensor)
+        graph.node.remove(node)
+    return len(identities)
+
+
 def _initializers(graph):
     from onnx import numpy_helper
     return {t.name: numpy_helper.to_array(t) for t in graph.initializer}
@@ -55,12 +75,17 @@ def _initializers(graph):
 def recover_state(model, onnx_path, inputs, size):
     """The state dict of `model` (a train.py UNet or ContextUNet, built with the settings of the run that exported
     `onnx_path` at `inputs` channels and `size` pixels) that computes, in evaluation mode, what the file computes.
-    ValueError says what does not fit: another architecture, an ensemble or int8 weights (quantize.py)."""
+    `model` may be ensemble.py's Ensemble of the members' networks, for an ensemble's export (see recover_members).
+    Int8 weights (quantize.py) come back as rounded. ValueError says what does not fit: another architecture, an
+    ensemble read as one network or one network as an ensemble."""
     import onnx  # python3-onnx
+    import quantize  # tools/training/quantize.py
     try:
         exported = onnx.load(onnx_path)
     except Exception as e:  # onnx raises its own DecodeError and OSError subclasses
         raise ValueError(f"{onnx_path}: not an ONNX file ({e})") from e
+    quantize.dequantize_conv_weights(exported)
+    inline_identity_constants(exported)
     template = copy.deepcopy(model).cpu().eval()
     bns = {name for name, m in template.named_modules() if _is_batch_norm(m)}
     gammas = {f"{name}.weight" for name in bns}
@@ -79,11 +104,12 @@ def recover_state(model, onnx_path, inputs, size):
     if next_index >= _EXACT:
         raise ValueError(f"the network has {next_index - 1} weights; positions are exact in float32 only below {_EXACT}")
     probe = _export(template, inputs, size)
+    inline_identity_constants(probe)
 
     ops = [n.op_type for n in exported.graph.node]
     if ops != [n.op_type for n in probe.graph.node]:
         raise ValueError(f"{onnx_path}: not this network's export ({len(ops)} nodes against "
-                         f"{len(probe.graph.node)}): other settings, an ensemble or int8 weights?")
+                         f"{len(probe.graph.node)}): other settings, or an ensemble read as one network?")
     values, positions = _initializers(exported.graph), _initializers(probe.graph)
     params = dict(template.named_parameters())
     state = {name: torch.full_like(params[name], float("nan")) for name in names}
@@ -117,6 +143,19 @@ def recover_state(model, onnx_path, inputs, size):
     whole = template.state_dict()
     whole.update(state)
     return whole
+
+
+def recover_members(members, onnx_path, inputs, size):
+    """The state dicts of the members of an ensemble.py export `onnx_path`, `members` being networks built with the
+    members' settings in the ensemble's order (their weights do not matter). Each computes, in evaluation mode, what
+    it computes inside the file: its logit adjustment folded in, its int8 weights as rounded."""
+    import ensemble  # tools/training/ensemble.py
+    state = recover_state(ensemble.Ensemble(members), onnx_path, inputs, size)
+    states = []
+    for k in range(len(members)):
+        prefix = f"members.{k}."
+        states.append({name[len(prefix):]: value for name, value in state.items() if name.startswith(prefix)})
+    return states
 
 
 def calibrate_batch_norm(model, batches):

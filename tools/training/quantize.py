@@ -13,7 +13,8 @@ constant into a constant. So each quantised convolution
     Conv(x, W, b)   becomes   Add(Mul(Conv(x, Cast(Q)), S), B)
 
 with Q the int8 weights, S the scales and B the bias as [1, C, 1, 1] tensors: the same result up to the rounding of
-the weights. Convolutions with fewer than MIN_WEIGHTS weights are kept in float.
+the weights. Convolutions with fewer than MIN_WEIGHTS weights are kept in float. dequantize_conv_weights() undoes
+the rewriting (the weights staying rounded), so that onnx_weights.py can recover the networks of an int8 file.
 """
 import argparse
 import sys
@@ -71,6 +72,51 @@ def quantize_conv_weights(model):
     for t in [t for t in graph.initializer if t.name not in used]:  # biases now held as [1, C, 1, 1]
         graph.initializer.remove(t)
     return count, before, after
+
+
+def dequantize_conv_weights(model):
+    """Undoes quantize_conv_weights on `model` (an onnx.ModelProto) in place: each Cast(Q) -> Conv -> Mul(S) [-> Add(B)]
+    it wrote becomes one float Conv(x, Q x S, B) again, at the same place among the nodes, so the graph has the nodes of
+    the float model it came from (the weights as rounded). Returns the number of convolutions restored."""
+    from onnx import TensorProto, helper, numpy_helper
+    graph = model.graph
+    constants = {t.name: t for t in graph.initializer}
+    nodes, count, i = list(graph.node), 0, 0
+    restored = []
+    while i < len(nodes):
+        cast = nodes[i]
+        q = constants.get(cast.input[0]) if cast.op_type == "Cast" and cast.input else None
+        conv = nodes[i + 1] if i + 1 < len(nodes) else None
+        mul = nodes[i + 2] if i + 2 < len(nodes) else None
+        if (q is None or q.data_type != TensorProto.INT8 or not cast.input[0].endswith("_int8") or conv is None
+                or conv.op_type != "Conv" or list(conv.input[1:]) != [cast.output[0]] or mul is None
+                or mul.op_type != "Mul" or list(mul.input) != [conv.output[0], cast.input[0][:-5] + "_scale"]):
+            restored.append(cast)
+            i += 1
+            continue
+        name = cast.input[0][:-5]
+        scale = numpy_helper.to_array(constants[name + "_scale"]).astype(np.float32).ravel()
+        weight = numpy_helper.to_array(q).astype(np.float32) * scale[:, None, None, None]
+        add = nodes[i + 3] if i + 3 < len(nodes) else None
+        has_bias = (add is not None and add.op_type == "Add" and list(add.input) == [mul.output[0], name + "_bias"])
+        inputs = [conv.input[0], name]
+        graph.initializer.append(numpy_helper.from_array(weight, name))
+        if has_bias:
+            bias = numpy_helper.to_array(constants[name + "_bias"]).astype(np.float32).ravel()
+            graph.initializer.append(numpy_helper.from_array(bias, name + "_bias_flat"))
+            inputs.append(name + "_bias_flat")
+        out = (add if has_bias else mul).output[0]
+        node = helper.make_node("Conv", inputs, [out])
+        node.attribute.extend(conv.attribute)
+        restored.append(node)
+        count += 1
+        i += 4 if has_bias else 3
+    del graph.node[:]
+    graph.node.extend(restored)
+    used = {name for node in graph.node for name in node.input}
+    for t in [t for t in graph.initializer if t.name not in used]:  # the int8 weights, scales and [1, C, 1, 1] biases
+        graph.initializer.remove(t)
+    return count
 
 
 def main():

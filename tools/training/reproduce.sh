@@ -12,7 +12,7 @@
 #   5. continues it into WORK/continued for K = 3 more epochs at lower rates (half an hour): run 23, the network of
 #      this command (--continuations 0 or --continue-epochs 0 stops at run 19); with --continuations 2, continues
 #      that into WORK/continued2 at lower rates still: run 24. Writes the last network's ATTRIBUTION.md;
-#   6. scores both on the held-out libraries and the network on the shared assets (g2p eval seg), as
+#   6. scores every network on the held-out libraries and the last one on the shared assets (g2p eval seg), as
 #      docs/training.md does;
 #   7. with --ensemble, joins the network to the shipped one (ensemble.py, the shipped weights recovered from its
 #      ONNX file) in WORK/ensemble and scores that too.

@@ -14,8 +14,9 @@
 #      that into WORK/continued2 at lower rates still: run 24. Writes the last network's ATTRIBUTION.md;
 #   6. scores every network on the held-out libraries and the last one on the shared assets (g2p eval seg), as
 #      docs/training.md does;
-#   7. with --ensemble, joins the network to the shipped one (ensemble.py, the shipped weights recovered from its
-#      ONNX file) in WORK/ensemble and scores that too.
+#   7. with --ensemble, joins the network to the shipped ensemble's first member, run 14b (ensemble.py; its weights
+#      recovered from the shipped ONNX file), in WORK/ensemble and scores that too: runs 14b + 23, where the shipped
+#      ensemble is runs 14b + 24 (run 23 continued once more; docs/training.md).
 #
 # --max-minutes limits each training step; --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p
 # and g2p_make_dataset are. Steps that are already done (an unpacked library, a fetched package, a dataset whose
@@ -155,15 +156,15 @@ else
   echo "reproduce.sh: $shared not found; the shared assets were not scored" >&2
 fi
 
-# 7. The shipped network and this one as one ensemble (int8 weights), scored held out like the network alone. An
-#    ensemble already in WORK/ensemble is kept only if it was built with this network.
+# 7. The shipped ensemble's first member and this network as one ensemble (int8 weights), scored held out like the
+#    network alone. An ensemble already in WORK/ensemble is kept only if it was built with this network.
 if [ $ensemble = 1 ]; then
   built_with() {
     "$python" -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["ensemble"]["members"][-1] != sys.argv[2])' \
       "$work/ensemble/training.json" "$1" 2>/dev/null
   }
   if [ ! -f "$work/ensemble/g2p-materials.json" ] || ! built_with "$network"; then
-    "$python" "$here/ensemble.py" "$work/ensemble" "$root/libg2p/data/models" "$network" --context "$models" \
+    "$python" "$here/ensemble.py" "$work/ensemble" "$root/libg2p/data/models#0" "$network" --context "$models" \
       --dataset "$dataset"
   fi
   "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$work/ensemble/g2p-materials.json" \

@@ -14,9 +14,9 @@
 #      that into WORK/continued2 at lower rates still: run 24. Writes the last network's ATTRIBUTION.md;
 #   6. scores every network on the held-out libraries and the last one on the shared assets (g2p eval seg), as
 #      docs/training.md does;
-#   7. with --ensemble, joins the network to the shipped ensemble's first member, run 14b (ensemble.py; its weights
-#      recovered from the shipped ONNX file), in WORK/ensemble and scores that too: runs 14b + 23, where the shipped
-#      ensemble is runs 14b + 24 (run 23 continued once more; docs/training.md).
+#   7. with --ensemble, joins the last network to the shipped ensemble's first member, run 14b (ensemble.py; its
+#      weights recovered from the shipped ONNX file), in WORK/ensemble and scores that too: with --continuations 2,
+#      runs 14b + 24, the shipped ensemble itself (docs/training.md).
 #
 # --max-minutes limits each training step; --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p
 # and g2p_make_dataset are. Steps that are already done (an unpacked library, a fetched package, a dataset whose

@@ -86,7 +86,6 @@ def read_runs(spec):
             if only is not None and k != only:
                 continue
             member = dict(member, weights_from=os.path.abspath(paths["g2p-materials.onnx"]), member=k)
-            member.pop("ensemble_members", None)
             member["ensemble_members"] = [dict(m) for m in members]
             runs.append((f"{folder}#{k}", member, None))
         return runs

@@ -161,12 +161,19 @@ class EnsembleRecoverTest(unittest.TestCase):
     into its members' weights: exported again, they give the same file."""
 
     def test_the_members_come_back_with_the_rounded_weights(self):
+        self.check_members_come_back("logits")
+
+    def test_members_of_an_older_export_averaging_log_softmax_come_back(self):
+        self.check_members_come_back("log_softmax")
+
+    def check_members_come_back(self, combine):
         import onnx  # python3-onnx
         from onnx import numpy_helper
         originals = [context_network(1), context_network(2)]
         with tempfile.TemporaryDirectory() as tmp:
             path, again = os.path.join(tmp, "ensemble.onnx"), os.path.join(tmp, "again.onnx")
-            quantised = ensemble.export_ensemble(ensemble.Ensemble(originals).eval(), 6, 32, path)
+            quantised = ensemble.export_ensemble(ensemble.Ensemble(originals, combine).eval(), 6, 32, path)
+            self.assertEqual(onnx_weights.combine_of(path), combine)
             self.assertGreater(quantised["convolutions"], 30)
             states = onnx_weights.recover_members([context_network(3), context_network(4)], path, 6, 32)
             self.assertEqual(len(states), 2)
@@ -191,7 +198,7 @@ class EnsembleRecoverTest(unittest.TestCase):
                     assert_same_function(got, rounded.eval()(x))
                     self.assertGreater((members[1 - k](x) - got).abs().max().item(), 0.1 * expected.abs().max().item())
             # Exported again as ensemble.py exports, the recovered members give the file they came from.
-            ensemble.export_ensemble(ensemble.Ensemble(members).eval(), 6, 32, again)
+            ensemble.export_ensemble(ensemble.Ensemble(members, combine).eval(), 6, 32, again)
             first, second = onnx.load(path).graph, onnx.load(again).graph
             with self.assertRaisesRegex(ValueError, "not this network's export .*an ensemble read as one network"):
                 onnx_weights.recover_state(context_network(3), path, 6, 32)

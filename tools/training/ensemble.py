@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Combines networks trained by train.py into one ONNX model whose output is their averaged log-probabilities.
+"""Combines networks trained by train.py into one ONNX model whose output is their averaged logits.
 
     python3 tools/training/ensemble.py OUT RUN RUN [RUN ...] [--context MODELS] [--float-weights] [--threads 2]
 
@@ -7,7 +7,7 @@ Each RUN is a train.py output folder (best.pt and training.json; without best.pt
 whose weights onnx_weights.py recovers) or an ensemble.py output folder, which stands for all its members
 ("FOLDER#K": member K alone, from 0); the shipped libg2p/data/models/ is either kind. Every member is rebuilt with the settings its
 training.json records, its exported logit adjustment (tau) folded in, and the ensemble outputs the mean of the
-members' log-softmax (the normalised geometric mean of their probabilities; Lakshminarayanan et al. 2017,
+members' logits, whose softmax is the normalised geometric mean of their probabilities (Lakshminarayanan et al. 2017,
 "Simple and scalable predictive uncertainty estimation using deep ensembles", average independently trained
 networks). Unlike a weight average (a "model soup"), the members need not share a lineage: networks that
 started from different weights make different errors, and averaging their predictions cancels part of them.
@@ -38,16 +38,32 @@ import train  # noqa: E402  (tools/training/train.py)
 SPLIT_KEYS = ("split_seed", "val_share", "val_library")
 
 
-class Ensemble(nn.Module):
-    """The mean of the members' log-softmax: a logit vector whose softmax is the normalised geometric mean of the
-    members' class probabilities."""
+# How an Ensemble averages its members, as training.json records it. Both give logits whose softmax is the normalised
+# geometric mean of the members' probabilities: log-softmax only subtracts a constant per pixel, which no softmax sees.
+# "logits" saves OpenCV two ops per member (a log-softmax, which opset 11 exports between two transposes, and a
+# stack averaged along a new axis): 14 % of a two-member ensemble's time per view (docs/performance.md). Ensembles
+# exported before 2026-11-24 (the shipped one until then) average log-softmax; onnx_weights.py reads both.
+COMBINES = {"logits": "mean of logits", "log_softmax": "mean of log-softmax"}
 
-    def __init__(self, members):
+
+class Ensemble(nn.Module):
+    """A logit vector whose softmax is the normalised geometric mean of the members' class probabilities: the mean of
+    their logits, or with combine="log_softmax" (the older exports) of their log-softmax."""
+
+    def __init__(self, members, combine="logits"):
         super().__init__()
+        if combine not in COMBINES:
+            raise ValueError(f"combine must be one of {', '.join(COMBINES)}, not {combine!r}")
         self.members = nn.ModuleList(members)
+        self.combine = combine
 
     def forward(self, x):
-        return torch.stack([F.log_softmax(m(x), 1) for m in self.members]).mean(0)
+        if self.combine == "log_softmax":
+            return torch.stack([F.log_softmax(m(x), 1) for m in self.members]).mean(0)
+        total = self.members[0](x)
+        for m in self.members[1:]:
+            total = total + m(x)
+        return total * (1.0 / len(self.members))
 
 
 def split_member(spec):
@@ -201,13 +217,13 @@ def main():
     ap.add_argument("--float-weights", action="store_true", help="keep the weights in float (4x the size)")
     ap.add_argument("--threads", type=int, default=2)
     a = ap.parse_args()
-    if len(a.runs) < 2:
-        ap.error("an ensemble needs at least two RUN folders")
     torch.set_num_threads(a.threads)
     try:
         runs = [member for spec in a.runs for member in read_runs(spec)]
     except ValueError as e:
         ap.error(str(e))
+    if len(runs) < 2:  # one ensemble folder alone is enough: it is exported again (with today's combine)
+        ap.error(f"an ensemble needs at least two members; {' '.join(a.runs)} has one")
     labels = [label for label, _, _ in runs]
     records = [r for _, r, _ in runs]
     first = records[0]["settings"]
@@ -254,7 +270,7 @@ def main():
         train.write_model_card(stage, size, inputs == 6,
                                list(dict.fromkeys(k for r in records for k in train.context_kinds(r["settings"]))))
         with open(os.path.join(stage, "training.json"), "w") as f:
-            json.dump({"ensemble": {"members": labels, "combine": "mean of log-softmax", "int8_weights": quantised,
+            json.dump({"ensemble": {"members": labels, "combine": COMBINES[model.combine], "int8_weights": quantised,
                                     "dataset": dataset,
                                     "manifest_sha256": sha, "validation_images": len(val_rows),
                                     "validation_miou": scores},

@@ -145,12 +145,25 @@ def recover_state(model, onnx_path, inputs, size):
     return whole
 
 
+def combine_of(onnx_path):
+    """How the ensemble.py export `onnx_path` averages its members (an ensemble.COMBINES key): older exports
+    average log-softmax, which leaves LogSoftmax nodes in the graph. An unreadable file reads as "logits" here;
+    recover_state then names what is wrong with it."""
+    import onnx  # python3-onnx
+    try:
+        graph = onnx.load(onnx_path).graph
+    except Exception:  # onnx raises its own DecodeError and OSError subclasses
+        return "logits"
+    return "log_softmax" if any(n.op_type == "LogSoftmax" for n in graph.node) else "logits"
+
+
 def recover_members(members, onnx_path, inputs, size):
     """The state dicts of the members of an ensemble.py export `onnx_path`, `members` being networks built with the
     members' settings in the ensemble's order (their weights do not matter). Each computes, in evaluation mode, what
-    it computes inside the file: its logit adjustment folded in, its int8 weights as rounded."""
+    it computes inside the file: its logit adjustment folded in, its int8 weights as rounded. Both of ensemble.py's
+    combines are read: the probe averages as the file does (log-softmax in exports before 2026-11-24)."""
     import ensemble  # tools/training/ensemble.py
-    state = recover_state(ensemble.Ensemble(members), onnx_path, inputs, size)
+    state = recover_state(ensemble.Ensemble(members, combine_of(onnx_path)), onnx_path, inputs, size)
     states = []
     for k in range(len(members)):
         prefix = f"members.{k}."

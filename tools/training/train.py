@@ -21,9 +21,9 @@ random resized crops. Pixels labelled 255 (unlabelled materials, background) are
 
 `--teacher RUN ...` distils (Hinton et al. 2015, "Distilling the knowledge in a neural network") from earlier runs:
 the loss becomes (1 - w) x cross-entropy + w x T^2 x KL(teacher || network) at temperature T, the teacher being the
-runs' ensemble (mean log-softmax, as ensemble.py builds it, before their logit adjustment). The KL term covers every
-object pixel, the unlabelled materials' too (the object mask comes from DATASET/normals), so one network can learn
-what an ensemble knows at the cost of one.
+runs' ensemble (the mean of their logits, as ensemble.py builds it, before their logit adjustment; its log-softmax
+is that of the mean of their log-softmax). The KL term covers every object pixel, the unlabelled materials' too (the
+object mask comes from DATASET/normals), so one network can learn what an ensemble knows at the cost of one.
 
 `--init` continues an earlier run: from its checkpoint (checkpoint.pt, best.pt) or, where the checkpoints are gone,
 from its exported g2p-materials.onnx (the shipped one included), whose weights onnx_weights.py recovers; an

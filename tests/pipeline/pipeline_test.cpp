@@ -204,6 +204,12 @@ TEST(Pipeline, BadBackendsAndOptionsFailBeforeAnyWork) {
   o.completer.settings["resolution"] = "-4";
   EXPECT_EQ(Pipeline(o).prepare().code(), StatusCode::kInvalidArgument);
   o = quick_options();
+  o.refiner = {"vlm", {{"url", "http://127.0.0.1:9/v1"}}};  // no model named: nothing to ask
+  s = Pipeline(o).prepare();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("refine backend 'vlm'"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("model=NAME"), std::string::npos) << s.message();
+  o = quick_options();
   o.formats = {"mjcf", "usd"};
   s = Pipeline(o).prepare();
   EXPECT_NE(s.message().find("usd"), std::string::npos);

@@ -241,9 +241,11 @@ TEST(VlmRefiner, UnreachableServerAndBadSettings) {
                                                                                    {"max_views", "0"}})
     EXPECT_EQ(make_refiner("vlm", {{"model", "m"}, {key, value}}).status().code(), StatusCode::kInvalidArgument)
         << key << "=" << value;
-  auto unconfigured = std::move(*make_refiner("vlm"));
-  RefineInput in{&s.model.mesh, nullptr, nullptr, &s.labels, &s.views, &MaterialTable::paper_default()};
-  EXPECT_EQ(unconfigured->refine(in).status().code(), StatusCode::kInvalidArgument);  // no model named
+  // No model named: refused when made (as the pipeline is prepared), not when it is first asked.
+  Result<std::unique_ptr<Refiner>> unconfigured = make_refiner("vlm", {{"url", "http://127.0.0.1:9/v1"}});
+  ASSERT_FALSE(unconfigured.ok());
+  EXPECT_EQ(unconfigured.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(unconfigured.status().message().find("model=NAME"), std::string::npos) << unconfigured.status().to_string();
 }
 
 TEST(VlmHelpers, JsonExtractionAndBase64) {

@@ -54,11 +54,15 @@ class VlmRefiner final : public Refiner {
         return Status::InvalidArgument("vlm: bad setting " + key + "=" + value +
                                        " (known: " + detail::kOpenAiOptionKeys + ", prompt_file, max_views)");
     }
-    if (!injected_ && !options_.model.empty()) {
-      Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
-      if (!c.ok()) return c.status();
-      client_ = std::move(*c);
-    }
+    if (injected_) return Status::Ok();
+    // Without a model there is nothing to ask: said here, when the pipeline is
+    // prepared, rather than after rendering, segmenting and projecting.
+    if (options_.model.empty())
+      return Status::InvalidArgument(
+          "vlm: needs the setting model=NAME (and url=URL unless the server listens on http://127.0.0.1:8080/v1)");
+    Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
+    if (!c.ok()) return c.status();
+    client_ = std::move(*c);
     return Status::Ok();
   }
 

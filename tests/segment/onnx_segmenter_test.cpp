@@ -292,6 +292,25 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
   // By default authored PBR counts: these boxes are dielectric (metallic 0, not glTF's default 1),
   // so every pixel follows pbr.
   EXPECT_EQ(labels("learned", {{"model_card", card}}), labels("pbr", {}));
+  {
+    // Then the network is not run at all: a view without the RGB image it needs is labelled, with
+    // pbr's probabilities; with one material left to the network (pbr=off), the same view fails.
+    View no_rgb = views[0];
+    no_rgb.rgb.clear();
+    Result<std::unique_ptr<Segmenter>> learned = make_segmenter("learned", {{"model_card", card}});
+    Result<std::unique_ptr<Segmenter>> pbr = make_segmenter("pbr");
+    ASSERT_TRUE(learned.ok() && pbr.ok());
+    ASSERT_TRUE((*learned)->set_model(model, table).ok() && (*pbr)->set_model(model, table).ok());
+    Result<LabelMap> a = (*learned)->segment(no_rgb), b = (*pbr)->segment(no_rgb);
+    ASSERT_TRUE(a.ok()) << a.status().to_string();
+    ASSERT_TRUE(b.ok()) << b.status().to_string();
+    EXPECT_TRUE(a->labels == b->labels);
+    EXPECT_TRUE(a->probabilities == b->probabilities);
+    EXPECT_FALSE(a->labels.empty());
+    Result<std::unique_ptr<Segmenter>> names_only = make_segmenter("learned", {{"model_card", card}, {"pbr", "off"}});
+    ASSERT_TRUE(names_only.ok() && (*names_only)->set_model(model, table).ok());
+    EXPECT_FALSE((*names_only)->segment(no_rgb).ok());
+  }
 
   // Unconfigured it runs the network libg2p ships (libg2p/data/models); bad settings fail at once.
   Result<std::unique_ptr<Segmenter>> shipped = make_segmenter("learned");

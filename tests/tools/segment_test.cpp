@@ -191,7 +191,7 @@ TEST(ToolEval, ShippedNetworkBeatsPbrWithoutNamesOrPbr) {
     const std::string json = dir + (k ? "/learned.json" : "/pbr.json");
     test::ToolRun r = run_tool(std::string("eval seg --assets ") + quote(test::source_path("../shared/assets")) +
                                " --anonymize-names --base-color-only --views 6 --resolution 256 --json " + quote(json) +
-                               (k ? " --segmenter learned" : ""));
+                               (k ? " --segmenter learned" : " --segmenter pbr"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     miou[k] = nlohmann::json::parse(test::read_file(json))["total_3d_per_model"]["miou"].get<double>();
   }

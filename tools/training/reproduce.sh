@@ -137,7 +137,7 @@ done
 #    trained network, each continuation paired against the network it continued (g2p eval compare:
 #    continued_vs_model.txt, continued2_vs_continued.txt), and the shared assets for the last network.
 held=(--assets "$work/sh3d" --truth "$dataset/labels.json" --split test --anonymize-names --base-color-only --soft)
-"$bin/g2p" eval seg "${held[@]}" --json "$work/held_pbr.json" > "$work/held_pbr.txt"
+"$bin/g2p" eval seg "${held[@]}" --segmenter pbr --json "$work/held_pbr.json" > "$work/held_pbr.txt"
 "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$card" --json "$work/held_model.json" \
   > "$work/held_model.txt"
 previous=model

@@ -8,7 +8,9 @@
 // 1), the pixel takes `pbr`'s labels and probabilities; otherwise the
 // network's. Names and authored PBR, where present, are right far more often
 // than the network (docs/accuracy.md); image-to-3D meshes carry neither, and
-// then the network decides everything.
+// then the network decides everything. A model whose every material is named
+// or authored is labelled by `pbr` alone: the network is not run, so such
+// models cost what `pbr` costs.
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
 // $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
@@ -81,8 +83,8 @@ class LearnedSegmenter final : public Segmenter {
   Status set_model(const Model& model, const MaterialTable& table) override {
     if (!configured_)
       return Status::InvalidArgument(
-          "learned: no network: give its card (setting model_card=FILE) or put the shipped g2p-materials.json in "
-          "$G2P_MODEL_DIR");
+          "learned: no network: give its card (setting model_card=FILE), put the shipped g2p-materials.json and "
+          "g2p-materials.onnx in $G2P_MODEL_DIR, or choose the weight-free segmenter pbr");
     G2P_RETURN_IF_ERROR(network_->set_model(model, table));
     G2P_RETURN_IF_ERROR(names_->set_model(model, table));
     model_ = &model;
@@ -100,11 +102,20 @@ class LearnedSegmenter final : public Segmenter {
                                                mat.metallic < 1.f || mat.roughness < 1.f);
       named_[m] = named || authored_pbr;
     }
+    // Every face has a named or authored material: the network's labels would
+    // be replaced everywhere (faces without a material keep the network's).
+    const std::vector<FaceSource>& sources = model.mesh.face_source;
+    all_named_ = !sources.empty() && static_cast<int>(sources.size()) == model.mesh.num_faces() &&
+                 std::all_of(sources.begin(), sources.end(), [&](const FaceSource& f) {
+                   return f.material >= 0 && f.material < static_cast<int>(named_.size()) &&
+                          named_[static_cast<std::size_t>(f.material)] != 0;
+                 });
     return Status::Ok();
   }
 
   Status segment_into(const View& view, LabelMap& out) const override {
     if (model_ == nullptr) return Status::InvalidArgument("learned: set_model first");
+    if (all_named_) return names_->segment_into(view, out);  // the network would be overwritten everywhere
     G2P_RETURN_IF_ERROR(network_->segment_into(view, out));
     if (std::none_of(named_.begin(), named_.end(), [](char n) { return n != 0; })) return Status::Ok();
     LabelMap by_name;
@@ -134,6 +145,7 @@ class LearnedSegmenter final : public Segmenter {
   bool trust_pbr_ = true;
   const Model* model_ = nullptr;
   std::vector<char> named_;  // per source material: its name names a class
+  bool all_named_ = false;   // every material is: `pbr` labels the whole model
 };
 
 }  // namespace

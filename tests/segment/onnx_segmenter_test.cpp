@@ -312,6 +312,26 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
     EXPECT_FALSE((*names_only)->segment(no_rgb).ok());
   }
 
+  {
+    // Names are read as pbr reads them: a prefix every material name shares (the object's name)
+    // counts a quarter, so "WoodenCrate_steel" names Metal although "wooden" names Wood. glTF's
+    // default metallic and roughness (1, 1) are not authored, so the other two boxes, whose names
+    // say only "WoodenCrate", are the network's (red Wood, green Metal; it says Glass for blue).
+    const Model crate = test::boxes({{"WoodenCrate_a", {1, 0, 0, 1}, 1.f, 1.f},
+                                     {"WoodenCrate_b", {0, 1, 0, 1}, 1.f, 1.f},
+                                     {"WoodenCrate_steel", {0, 0, 1, 1}, 1.f, 1.f}},
+                                    "LearnedSegmenter.crate");
+    const std::vector<View> crate_views = test::render(crate, 2, 96);
+    Result<std::unique_ptr<Segmenter>> s = make_segmenter("learned", {{"model_card", card}});
+    ASSERT_TRUE(s.ok() && (*s)->set_model(crate, table).ok());
+    std::vector<LabelMap> maps(crate_views.size());
+    for (std::size_t i = 0; i < crate_views.size(); ++i) ASSERT_TRUE((*s)->segment_into(crate_views[i], maps[i]).ok());
+    EXPECT_EQ((std::vector<int>{test::majority_label(crate, crate_views, maps, 0),
+                                test::majority_label(crate, crate_views, maps, 1),
+                                test::majority_label(crate, crate_views, maps, 2)}),
+              (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Metal")}));
+  }
+
   // Unconfigured it runs the network libg2p ships (libg2p/data/models); bad settings fail at once.
   Result<std::unique_ptr<Segmenter>> shipped = make_segmenter("learned");
   ASSERT_TRUE(shipped.ok()) << shipped.status().to_string();

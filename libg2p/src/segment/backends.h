@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "g2p/segment.h"
 
@@ -12,5 +13,20 @@ std::unique_ptr<Segmenter> make_pbr_segmenter();
 std::unique_ptr<Segmenter> make_onnx_segmenter();
 std::unique_ptr<Segmenter> make_oracle_segmenter();
 std::unique_ptr<Segmenter> make_learned_segmenter();
+
+namespace detail {
+
+// The name evidence the `pbr` backend adds to its class scores, in its score
+// units, per class of the table: per source material, 4 x the evidence of its
+// name and its textures' file names (a prefix all material names share counts
+// a quarter); per source mesh, 0.7 of that weight for the mesh and node names
+// (same prefix rule). `learned` reads it to decide where names speak.
+struct NameScores {
+  std::vector<std::vector<float>> material;  // [material][class]
+  std::vector<std::vector<float>> mesh;      // [source mesh][class]; empty rows for meshes no primitive names
+};
+NameScores pbr_name_scores(const Model& model, const MaterialTable& table);
+
+}  // namespace detail
 
 }  // namespace g2p

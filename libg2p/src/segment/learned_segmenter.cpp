@@ -1,16 +1,19 @@
 // The `learned` segmenter: a trained network (the `onnx` backend) where the
 // model's names and PBR channels say nothing, the `pbr` backend where they
-// do. Rule, per pixel: the face seen there has a source material; when that
-// material's name (or its base-colour texture's file name) names a material
-// class outright (material_name_evidence >= `names` threshold for one class,
-// none other above 0.5), or its PBR values were authored (a metallic-roughness
-// texture, transmission, or metallic/roughness other than glTF's defaults of
-// 1), the pixel takes `pbr`'s labels and probabilities; otherwise the
-// network's. Names and authored PBR, where present, are right far more often
-// than the network (docs/accuracy.md); image-to-3D meshes carry neither, and
-// then the network decides everything. A model whose every material is named
-// or authored is labelled by `pbr` alone: the network is not run, so such
-// models cost what `pbr` costs.
+// do. Rule, per pixel: the face seen there takes `pbr`'s labels and
+// probabilities when its names name a class outright, or when its material's
+// PBR values were authored (a metallic-roughness texture, transmission, or
+// metallic/roughness other than glTF's defaults of 1); otherwise the
+// network's. Names are read as `pbr` reads them (pbr_name_scores: the
+// material's name and texture file names, a prefix shared by every material
+// name counting a quarter, the mesh and node names at 0.7 of that weight); a
+// face's names name a class when its summed name score reaches 4 x `names`
+// (the score of that much evidence in the material's name) and no other
+// class exceeds 4 x 0.5. Names and authored PBR, where present, are right far
+// more often than the network (docs/accuracy.md); image-to-3D meshes carry
+// neither, and then the network decides everything. A model whose every face
+// is named or authored is labelled by `pbr` alone: the network is not run, so
+// such models cost what `pbr` costs.
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
 // $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
@@ -28,6 +31,7 @@ namespace g2p {
 namespace {
 
 constexpr const char* kShippedCard = "g2p-materials.json";
+constexpr float kNameScore = 4.f;  // `pbr`'s score per unit of name evidence (pbr_segmenter.cpp)
 
 // The shipped network's card, or "" when none is found.
 std::string shipped_model_card() {
@@ -88,28 +92,47 @@ class LearnedSegmenter final : public Segmenter {
     G2P_RETURN_IF_ERROR(network_->set_model(model, table));
     G2P_RETURN_IF_ERROR(names_->set_model(model, table));
     model_ = &model;
-    named_.assign(model.materials.size(), 0);
+    // Where names speak, read as `pbr` reads them: the material's name and its
+    // textures' file names (a prefix every material name shares counts a
+    // quarter), plus 0.7 of that weight for the mesh and node names, in
+    // `pbr`'s score units (4 per unit of evidence). A face is named when one
+    // class reaches 4 x `names` and no other exceeds 4 x 0.5.
+    const detail::NameScores scores = detail::pbr_name_scores(model, table);
+    std::vector<char> authored(model.materials.size(), 0);
     for (std::size_t m = 0; m < model.materials.size(); ++m) {
       const SourceMaterial& mat = model.materials[m];
-      std::string text = mat.name;
-      if (!mat.base_color_texture.uri.empty()) text += " " + mat.base_color_texture.uri;
-      std::vector<float> e = material_name_evidence(text, table);
-      std::sort(e.begin(), e.end(), std::greater<float>());
-      const bool named = !e.empty() && e[0] >= threshold_ && (e.size() < 2 || e[1] <= 0.5f);
       // PBR values an author set (not glTF's defaults): a metallic-roughness
       // texture, transmission, or metallic/roughness other than (1, 1).
-      const bool authored_pbr = trust_pbr_ && (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f ||
-                                               mat.metallic < 1.f || mat.roughness < 1.f);
-      named_[m] = named || authored_pbr;
+      authored[m] = trust_pbr_ && (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f ||
+                                   mat.metallic < 1.f || mat.roughness < 1.f);
     }
-    // Every face has a named or authored material: the network's labels would
-    // be replaced everywhere (faces without a material keep the network's).
-    const std::vector<FaceSource>& sources = model.mesh.face_source;
-    all_named_ = !sources.empty() && static_cast<int>(sources.size()) == model.mesh.num_faces() &&
-                 std::all_of(sources.begin(), sources.end(), [&](const FaceSource& f) {
-                   return f.material >= 0 && f.material < static_cast<int>(named_.size()) &&
-                          named_[static_cast<std::size_t>(f.material)] != 0;
-                 });
+    const Mesh& mesh = model.mesh;
+    const int k = table.size();
+    std::vector<float> sum(static_cast<std::size_t>(k));
+    named_.assign(mesh.face_source.size() == static_cast<std::size_t>(mesh.num_faces()) ? mesh.face_source.size() : 0,
+                  0);
+    for (std::size_t f = 0; f < named_.size(); ++f) {
+      const FaceSource& src = mesh.face_source[f];
+      const bool has_material = src.material >= 0 && src.material < static_cast<int>(model.materials.size());
+      if (has_material && authored[static_cast<std::size_t>(src.material)]) {
+        named_[f] = 1;
+        continue;
+      }
+      std::fill(sum.begin(), sum.end(), 0.f);
+      if (has_material)
+        for (int c = 0; c < k; ++c) sum[c] += scores.material[static_cast<std::size_t>(src.material)][c];
+      if (src.mesh >= 0 && static_cast<std::size_t>(src.mesh) < scores.mesh.size() &&
+          scores.mesh[static_cast<std::size_t>(src.mesh)].size() == sum.size())
+        for (int c = 0; c < k; ++c) sum[c] += scores.mesh[static_cast<std::size_t>(src.mesh)][c];
+      const auto top = std::max_element(sum.begin(), sum.end());
+      if (top == sum.end() || *top < kNameScore * threshold_) continue;
+      bool alone = true;
+      for (auto c = sum.begin(); c != sum.end(); ++c) alone &= c == top || *c <= kNameScore * 0.5f;
+      named_[f] = alone;
+    }
+    // Every face named or authored: the network's labels would be replaced
+    // everywhere.
+    all_named_ = !named_.empty() && std::all_of(named_.begin(), named_.end(), [](char n) { return n != 0; });
     return Status::Ok();
   }
 
@@ -120,15 +143,12 @@ class LearnedSegmenter final : public Segmenter {
     if (std::none_of(named_.begin(), named_.end(), [](char n) { return n != 0; })) return Status::Ok();
     LabelMap by_name;
     G2P_RETURN_IF_ERROR(names_->segment_into(view, by_name));
-    const Mesh& mesh = model_->mesh;
     const bool probabilities = !out.probabilities.empty() && !by_name.probabilities.empty() &&
                                out.probabilities.channels() == by_name.probabilities.channels();
     for (int y = 0; y < view.face_id.height(); ++y)
       for (int x = 0; x < view.face_id.width(); ++x) {
         const int f = view.face_id.at(x, y);
-        if (f < 0 || mesh.face_source.empty()) continue;
-        const int m = mesh.face_source[static_cast<std::size_t>(f)].material;
-        if (m < 0 || m >= static_cast<int>(named_.size()) || !named_[static_cast<std::size_t>(m)]) continue;
+        if (f < 0 || f >= static_cast<int>(named_.size()) || !named_[static_cast<std::size_t>(f)]) continue;
         out.labels.at(x, y) = by_name.labels.at(x, y);
         if (probabilities)
           std::copy_n(by_name.probabilities.pixel(x, y), by_name.probabilities.channels(),
@@ -144,8 +164,8 @@ class LearnedSegmenter final : public Segmenter {
   double threshold_ = 0.9;
   bool trust_pbr_ = true;
   const Model* model_ = nullptr;
-  std::vector<char> named_;  // per source material: its name names a class
-  bool all_named_ = false;   // every material is: `pbr` labels the whole model
+  std::vector<char> named_;  // per face: its names name a class, or its material's PBR was authored
+  bool all_named_ = false;   // every face is: `pbr` labels the whole model
 };
 
 }  // namespace

@@ -187,9 +187,6 @@ class PbrSegmenter final : public Segmenter {
 
     // Per source material: name evidence and texture statistics, once.
     material_scores_.assign(model.materials.size(), std::vector<float>(static_cast<std::size_t>(table.size()), 0.f));
-    std::vector<std::string> material_names;
-    for (const SourceMaterial& mat : model.materials) material_names.push_back(mat.name);
-    const std::string material_prefix = split_common_prefix(material_names);
     for (std::size_t m = 0; m < model.materials.size(); ++m) {
       const SourceMaterial& mat = model.materials[m];
       Scores s{};
@@ -201,38 +198,14 @@ class PbrSegmenter final : public Segmenter {
         s[kWood] += 0.6f * g, s[kStone] += 0.5f * g, s[kFabric] += 0.4f * g, s[kOrganic] += 0.3f * g;
         s[kPlastic] += 0.3f * (1.f - g), s[kMetal] += 0.2f * (1.f - g);
       }
-      std::vector<float>& out = material_scores_[m];
-      scatter(s, out);
-      if (use_names_) {
-        std::string text = material_names[m];
-        for (const Texture* t : {&mat.base_color_texture, &mat.metallic_roughness_texture})
-          if (!t->uri.empty() && t->uri[0] != '*') text += " " + std::filesystem::path(t->uri).stem().string();
-        const std::vector<float> e = detail::name_evidence(text, table);
-        const std::vector<float> shared = detail::name_evidence(material_prefix, table);
-        for (std::size_t c = 0; c < out.size(); ++c)
-          out[c] += kNameWeight * std::max(e[c], kSharedPrefixShare * shared[c]);
-      }
+      scatter(s, material_scores_[m]);
     }
     mesh_scores_.clear();
     if (use_names_) {
-      std::vector<std::string> mesh_names, node_names;
-      for (const SourcePrimitive& p : model.primitives) {
-        mesh_names.push_back(p.mesh_name);
-        node_names.push_back(p.node_name);
-      }
-      const std::string mesh_prefix = split_common_prefix(mesh_names);
-      const std::string node_prefix = split_common_prefix(node_names);
-      const std::vector<float> shared = detail::name_evidence(mesh_prefix + " " + node_prefix, table);
-      for (std::size_t i = 0; i < model.primitives.size(); ++i) {
-        const SourcePrimitive& p = model.primitives[i];
-        if (p.mesh < 0) continue;
-        if (static_cast<std::size_t>(p.mesh) >= mesh_scores_.size()) mesh_scores_.resize(p.mesh + 1);
-        const std::vector<float> e = detail::name_evidence(mesh_names[i] + " " + node_names[i], table);
-        std::vector<float>& out = mesh_scores_[static_cast<std::size_t>(p.mesh)];
-        out.assign(e.size(), 0.f);
-        for (std::size_t c = 0; c < e.size(); ++c)
-          out[c] = kNameWeight * kMeshNameShare * std::max(e[c], kSharedPrefixShare * shared[c]);
-      }
+      detail::NameScores evidence = detail::pbr_name_scores(model, table);
+      for (std::size_t m = 0; m < model.materials.size(); ++m)
+        for (std::size_t c = 0; c < material_scores_[m].size(); ++c) material_scores_[m][c] += evidence.material[m][c];
+      mesh_scores_ = std::move(evidence.mesh);
     }
     return Status::Ok();
   }
@@ -320,6 +293,42 @@ class PbrSegmenter final : public Segmenter {
 };
 
 }  // namespace
+
+detail::NameScores detail::pbr_name_scores(const Model& model, const MaterialTable& table) {
+  const std::size_t k = static_cast<std::size_t>(table.size());
+  NameScores out;
+  std::vector<std::string> material_names;
+  for (const SourceMaterial& mat : model.materials) material_names.push_back(mat.name);
+  const std::vector<float> material_shared = name_evidence(split_common_prefix(material_names), table);
+  for (std::size_t m = 0; m < model.materials.size(); ++m) {
+    const SourceMaterial& mat = model.materials[m];
+    std::string text = material_names[m];
+    for (const Texture* t : {&mat.base_color_texture, &mat.metallic_roughness_texture})
+      if (!t->uri.empty() && t->uri[0] != '*') text += " " + std::filesystem::path(t->uri).stem().string();
+    const std::vector<float> e = name_evidence(text, table);
+    std::vector<float>& row = out.material.emplace_back(k, 0.f);
+    for (std::size_t c = 0; c < k; ++c) row[c] = kNameWeight * std::max(e[c], kSharedPrefixShare * material_shared[c]);
+  }
+  std::vector<std::string> mesh_names, node_names;
+  for (const SourcePrimitive& p : model.primitives) {
+    mesh_names.push_back(p.mesh_name);
+    node_names.push_back(p.node_name);
+  }
+  const std::string mesh_prefix = split_common_prefix(mesh_names);
+  const std::string node_prefix = split_common_prefix(node_names);
+  const std::vector<float> shared = name_evidence(mesh_prefix + " " + node_prefix, table);
+  for (std::size_t i = 0; i < model.primitives.size(); ++i) {
+    const SourcePrimitive& p = model.primitives[i];
+    if (p.mesh < 0) continue;
+    if (static_cast<std::size_t>(p.mesh) >= out.mesh.size()) out.mesh.resize(static_cast<std::size_t>(p.mesh) + 1);
+    const std::vector<float> e = name_evidence(mesh_names[i] + " " + node_names[i], table);
+    std::vector<float>& row = out.mesh[static_cast<std::size_t>(p.mesh)];
+    row.assign(k, 0.f);
+    for (std::size_t c = 0; c < k; ++c)
+      row[c] = kNameWeight * kMeshNameShare * std::max(e[c], kSharedPrefixShare * shared[c]);
+  }
+  return out;
+}
 
 std::unique_ptr<Segmenter> make_pbr_segmenter() { return std::make_unique<PbrSegmenter>(); }
 

@@ -178,6 +178,8 @@ void bind_core(py::module_& m) {
       .def_readonly("double_sided", &SourceMaterial::double_sided)
       .def_readonly("base_color_texture", &SourceMaterial::base_color_texture)
       .def_readonly("metallic_roughness_texture", &SourceMaterial::metallic_roughness_texture)
+      .def_readonly("pbr_from_file", &SourceMaterial::pbr_from_file,
+                    "False for formats without PBR materials (OBJ, PLY, STL, DAE): metallic and roughness derived")
       .def("__repr__", [](const SourceMaterial& s) { return "<g2p.SourceMaterial '" + s.name + "'>"; });
   py::class_<SourcePrimitive>(m, "SourcePrimitive")
       .def_readonly("mesh_name", &SourcePrimitive::mesh_name)

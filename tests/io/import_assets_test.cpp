@@ -109,6 +109,7 @@ TEST(SharedAssets, MaterialsCarryPbrFactorsAndDecodedTextures) {
   const SourceMaterial& metal = chair->materials[2];
   EXPECT_FLOAT_EQ(metal.metallic, 1.f);
   EXPECT_NEAR(metal.roughness, 0.3f, 1e-6f);
+  EXPECT_TRUE(metal.pbr_from_file);
 
   Result<Model> candle = load_model(test::asset_path("GlassHurricaneCandleHolder"));
   ASSERT_TRUE(candle.ok()) << candle.status().to_string();

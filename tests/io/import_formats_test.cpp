@@ -25,6 +25,7 @@ TEST(ImportObj, PolygonsKeepTheirSourceFaceIndex) {
   EXPECT_EQ(model->materials[1].name, "steel_head");
   EXPECT_FLOAT_EQ(model->materials[1].base_color[2], 0.58f);  // Kd
   EXPECT_FLOAT_EQ(model->materials[1].metallic, 0.f);         // Phong: dielectric
+  EXPECT_FALSE(model->materials[1].pbr_from_file);            // ... by the importer, not the author
 
   const Mesh& mesh = model->mesh;
   EXPECT_EQ(mesh.num_faces(), 24 * 2 + 2 * 22 + 6 * 2);

@@ -2,6 +2,7 @@
 // (make_tiny_onnx.py): each pixel's class is its strongest colour channel.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -330,6 +331,74 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
                                 test::majority_label(crate, crate_views, maps, 1),
                                 test::majority_label(crate, crate_views, maps, 2)}),
               (std::vector<int>{table.find("Wood"), table.find("Metal"), table.find("Metal")}));
+  }
+
+  {
+    // `auto` decides per model: with one face named ("oak") `pbr` labels the whole model, where
+    // `learned` gives the unnamed boxes to the network; with nothing named or authored the network
+    // labels every box.
+    const Model one_named =
+        test::boxes({{"a", {1, 0, 0, 1}, 1.f, 1.f}, {"b", {0, 1, 0, 1}, 1.f, 1.f}, {"oak", {0, 0, 1, 1}, 1.f, 1.f}},
+                    "AutoSegmenter.one_named");
+    const Model unnamed =
+        test::boxes({{"a", {1, 0, 0, 1}, 1.f, 1.f}, {"b", {0, 1, 0, 1}, 1.f, 1.f}, {"c", {0, 0, 1, 1}, 1.f, 1.f}},
+                    "AutoSegmenter.unnamed");
+    auto majority = [&](const Model& m, const std::string& backend) {
+      const std::vector<View> v = test::render(m, 2, 96);
+      Result<std::unique_ptr<Segmenter>> seg =
+          make_segmenter(backend, backend == "pbr" ? BackendSettings{} : BackendSettings{{"model_card", card}});
+      EXPECT_TRUE(seg.ok() && (*seg)->set_model(m, table).ok());
+      std::vector<LabelMap> maps(v.size());
+      for (std::size_t i = 0; i < v.size(); ++i) EXPECT_TRUE((*seg)->segment_into(v[i], maps[i]).ok());
+      return std::vector<int>{test::majority_label(m, v, maps, 0), test::majority_label(m, v, maps, 1),
+                              test::majority_label(m, v, maps, 2)};
+    };
+    const std::vector<int> network{table.find("Wood"), table.find("Metal"), table.find("Glass")};
+    EXPECT_EQ(majority(one_named, "auto"), majority(one_named, "pbr"));
+    EXPECT_EQ(majority(one_named, "learned"),
+              (std::vector<int>{network[0], network[1], majority(one_named, "pbr")[2]}));
+    EXPECT_NE(majority(one_named, "pbr")[0], network[0]);  // pbr says Metal (metallic 1): the checks can fail
+    EXPECT_EQ(majority(unnamed, "auto"), network);
+    EXPECT_EQ(majority(unnamed, "learned"), network);
+  }
+
+  {
+    // An OBJ's metallic 0 and Phong roughness are the importer's, not the author's: three unnamed
+    // OBJ boxes go to the network (red Wood, green Metal, blue Glass) with `learned` and `auto`.
+    const std::string obj_dir = test::scratch_dir("LearnedSegmenter.obj");
+    std::string obj = "mtllib boxes.mtl\n", mtl;
+    const char* colours[3] = {"1 0 0", "0 1 0", "0 0 1"};
+    for (int b = 0; b < 3; ++b) {
+      mtl += "newmtl m" + std::to_string(b) + "\nKd " + colours[b] + "\nNs 10\n";
+      const float x = 1.5f * static_cast<float>(b);
+      for (int c = 0; c < 8; ++c)
+        obj += "v " + std::to_string(x + float(c & 1)) + " " + std::to_string(float((c >> 1) & 1)) + " " +
+               std::to_string(float((c >> 2) & 1)) + "\n";
+      obj += "usemtl m" + std::to_string(b) + "\n";
+      const int o = 8 * b + 1;  // the box's first vertex, 1-based
+      for (const auto& q : std::vector<std::array<int, 4>>{
+               {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
+        obj += "f " + std::to_string(o + q[0]) + " " + std::to_string(o + q[1]) + " " + std::to_string(o + q[2]) + " " +
+               std::to_string(o + q[3]) + "\n";
+    }
+    test::write_file(obj_dir + "/boxes.obj", obj);
+    test::write_file(obj_dir + "/boxes.mtl", mtl);
+    Result<Model> boxes = load_model(obj_dir + "/boxes.obj");
+    ASSERT_TRUE(boxes.ok()) << boxes.status().to_string();
+    ASSERT_EQ(boxes->materials.size(), 3u);
+    const std::vector<View> v = test::render(*boxes, 2, 96);
+    auto majority = [&](const std::string& backend, const BackendSettings& settings) {
+      Result<std::unique_ptr<Segmenter>> seg = make_segmenter(backend, settings);
+      EXPECT_TRUE(seg.ok() && (*seg)->set_model(*boxes, table).ok());
+      std::vector<LabelMap> maps(v.size());
+      for (std::size_t i = 0; i < v.size(); ++i) EXPECT_TRUE((*seg)->segment_into(v[i], maps[i]).ok());
+      return std::vector<int>{test::majority_label(*boxes, v, maps, 0), test::majority_label(*boxes, v, maps, 1),
+                              test::majority_label(*boxes, v, maps, 2)};
+    };
+    const std::vector<int> network{table.find("Wood"), table.find("Metal"), table.find("Glass")};
+    EXPECT_EQ(majority("learned", {{"model_card", card}}), network);
+    EXPECT_EQ(majority("auto", {{"model_card", card}}), network);
+    EXPECT_NE(majority("pbr", {}), network);  // pbr reads them otherwise: the checks above can fail
   }
 
   // Unconfigured it runs the network libg2p ships (libg2p/data/models); bad settings fail at once.

@@ -44,6 +44,10 @@ struct SourceMaterial {
   bool double_sided = false;
   Texture base_color_texture;          // sRGB colour (times base_color)
   Texture metallic_roughness_texture;  // glTF packing: G = roughness, B = metallic
+  // False when the format has no PBR materials (OBJ, PLY, STL, DAE): metallic
+  // and roughness were then derived by the importer (metallic 0, roughness
+  // from the Phong exponent), not set by the author.
+  bool pbr_from_file = true;
 };
 
 // One placement of a source mesh in the scene: a node instancing a mesh.

@@ -172,6 +172,7 @@ std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::s
       // alpha = sqrt(2 / (n + 2)) (Walter et al. 2007, "Microfacet models for
       // refraction through rough surfaces").
       m.metallic = 0.f;
+      m.pbr_from_file = false;
       float shininess = 0.f;
       m.roughness = mat.Get(AI_MATKEY_SHININESS, shininess) == AI_SUCCESS && shininess > 0.f
                         ? std::clamp(std::sqrt(2.f / (shininess + 2.f)), 0.f, 1.f)

@@ -13,6 +13,7 @@ std::unique_ptr<Segmenter> make_pbr_segmenter();
 std::unique_ptr<Segmenter> make_onnx_segmenter();
 std::unique_ptr<Segmenter> make_oracle_segmenter();
 std::unique_ptr<Segmenter> make_learned_segmenter();
+std::unique_ptr<Segmenter> make_auto_segmenter();
 
 namespace detail {
 

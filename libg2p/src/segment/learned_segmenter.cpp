@@ -2,9 +2,10 @@
 // model's names and PBR channels say nothing, the `pbr` backend where they
 // do. Rule, per pixel: the face seen there takes `pbr`'s labels and
 // probabilities when its names name a class outright, or when its material's
-// PBR values were authored (a metallic-roughness texture, transmission, or
-// metallic/roughness other than glTF's defaults of 1); otherwise the
-// network's. Names are read as `pbr` reads them (pbr_name_scores: the
+// PBR values were authored (read from a format with PBR materials, and a
+// metallic-roughness texture, transmission, or metallic/roughness other than
+// glTF's defaults of 1; not an OBJ's, which the importer derives); otherwise
+// the network's. Names are read as `pbr` reads them (pbr_name_scores: the
 // material's name and texture file names, a prefix shared by every material
 // name counting a quarter, the mesh and node names at 0.7 of that weight); a
 // face's names name a class when its summed name score reaches 4 x `names`
@@ -14,6 +15,12 @@
 // neither, and then the network decides everything. A model whose every face
 // is named or authored is labelled by `pbr` alone: the network is not run, so
 // such models cost what `pbr` costs.
+//
+// `auto` decides per model instead of per face: `pbr` for a model with any
+// face named or authored, the network everywhere on a model with none, as
+// image-to-3D meshes arrive (docs/training.md, "A default that decides per
+// model"). It is the default segmenter. Neither backend needs the network for
+// a model that `pbr` labels alone.
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
 // $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
@@ -53,6 +60,8 @@ std::string shipped_model_card() {
 
 class LearnedSegmenter final : public Segmenter {
  public:
+  explicit LearnedSegmenter(bool per_model) : per_model_(per_model), name_(per_model ? "auto" : "learned") {}
+
   Status configure(const BackendSettings& settings) override {
     BackendSettings network;
     for (const auto& [key, value] : settings) {
@@ -65,11 +74,11 @@ class LearnedSegmenter final : public Segmenter {
         else if (detail::parse_double(value, v) && v > 0 && v <= 1)
           threshold_ = v;
         else
-          return Status::InvalidArgument("learned: names needs a threshold in (0, 1] or 'off', got '" + value + "'");
+          return Status::InvalidArgument(name_ + ": names needs a threshold in (0, 1] or 'off', got '" + value + "'");
       } else if (key == "pbr" && (value == "on" || value == "off")) {
         trust_pbr_ = value == "on";
       } else {
-        return Status::InvalidArgument("learned: bad setting " + key + "=" + value +
+        return Status::InvalidArgument(name_ + ": bad setting " + key + "=" + value +
                                        " (known: model_card=FILE, flip=on|off, names=THRESHOLD|off, pbr=on|off)");
       }
     }
@@ -85,13 +94,8 @@ class LearnedSegmenter final : public Segmenter {
   }
 
   Status set_model(const Model& model, const MaterialTable& table) override {
-    if (!configured_)
-      return Status::InvalidArgument(
-          "learned: no network: give its card (setting model_card=FILE), put the shipped g2p-materials.json and "
-          "g2p-materials.onnx in $G2P_MODEL_DIR, or choose the weight-free segmenter pbr");
-    G2P_RETURN_IF_ERROR(network_->set_model(model, table));
+    model_ = nullptr;
     G2P_RETURN_IF_ERROR(names_->set_model(model, table));
-    model_ = &model;
     // Where names speak, read as `pbr` reads them: the material's name and its
     // textures' file names (a prefix every material name shares counts a
     // quarter), plus 0.7 of that weight for the mesh and node names, in
@@ -101,10 +105,13 @@ class LearnedSegmenter final : public Segmenter {
     std::vector<char> authored(model.materials.size(), 0);
     for (std::size_t m = 0; m < model.materials.size(); ++m) {
       const SourceMaterial& mat = model.materials[m];
-      // PBR values an author set (not glTF's defaults): a metallic-roughness
-      // texture, transmission, or metallic/roughness other than (1, 1).
-      authored[m] = trust_pbr_ && (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f ||
-                                   mat.metallic < 1.f || mat.roughness < 1.f);
+      // PBR values an author set: read from a file that has PBR materials, and
+      // not glTF's defaults (a metallic-roughness texture, transmission, or
+      // metallic/roughness other than (1, 1)). An OBJ's metallic 0 and its
+      // roughness from the Phong exponent are the importer's, not evidence.
+      authored[m] = trust_pbr_ && mat.pbr_from_file &&
+                    (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f || mat.metallic < 1.f ||
+                     mat.roughness < 1.f);
     }
     const Mesh& mesh = model.mesh;
     const int k = table.size();
@@ -131,13 +138,27 @@ class LearnedSegmenter final : public Segmenter {
       named_[f] = alone;
     }
     // Every face named or authored: the network's labels would be replaced
-    // everywhere.
-    all_named_ = !named_.empty() && std::all_of(named_.begin(), named_.end(), [](char n) { return n != 0; });
+    // everywhere. `auto`: any face is, and `pbr` labels the whole model; none
+    // is, and the network labels all of it.
+    const auto is_set = [](char n) { return n != 0; };
+    all_named_ = per_model_ ? std::any_of(named_.begin(), named_.end(), is_set)
+                            : !named_.empty() && std::all_of(named_.begin(), named_.end(), is_set);
+    if (per_model_ && !all_named_) std::fill(named_.begin(), named_.end(), 0);
+    if (!all_named_) {
+      if (!configured_)
+        return Status::InvalidArgument(
+            name_ +
+            ": no network for a model whose names and PBR say nothing: give its card (setting model_card=FILE), put "
+            "the shipped g2p-materials.json and g2p-materials.onnx in $G2P_MODEL_DIR, or choose the weight-free "
+            "segmenter pbr");
+      G2P_RETURN_IF_ERROR(network_->set_model(model, table));
+    }
+    model_ = &model;
     return Status::Ok();
   }
 
   Status segment_into(const View& view, LabelMap& out) const override {
-    if (model_ == nullptr) return Status::InvalidArgument("learned: set_model first");
+    if (model_ == nullptr) return Status::InvalidArgument(name_ + ": set_model first");
     if (all_named_) return names_->segment_into(view, out);  // the network would be overwritten everywhere
     G2P_RETURN_IF_ERROR(network_->segment_into(view, out));
     if (std::none_of(named_.begin(), named_.end(), [](char n) { return n != 0; })) return Status::Ok();
@@ -161,6 +182,8 @@ class LearnedSegmenter final : public Segmenter {
   std::unique_ptr<Segmenter> network_;
   std::unique_ptr<Segmenter> names_ = make_pbr_segmenter();
   bool configured_ = false;
+  bool per_model_ = false;  // `auto`
+  std::string name_;
   double threshold_ = 0.9;
   bool trust_pbr_ = true;
   const Model* model_ = nullptr;
@@ -170,6 +193,7 @@ class LearnedSegmenter final : public Segmenter {
 
 }  // namespace
 
-std::unique_ptr<Segmenter> make_learned_segmenter() { return std::make_unique<LearnedSegmenter>(); }
+std::unique_ptr<Segmenter> make_learned_segmenter() { return std::make_unique<LearnedSegmenter>(false); }
+std::unique_ptr<Segmenter> make_auto_segmenter() { return std::make_unique<LearnedSegmenter>(true); }
 
 }  // namespace g2p

@@ -24,6 +24,7 @@ Registry<Segmenter>& segmenter_registry() {
     (void)r->add("onnx", &make_onnx_segmenter);
     (void)r->add("oracle", &make_oracle_segmenter);
     (void)r->add("learned", &make_learned_segmenter);
+    (void)r->add("auto", &make_auto_segmenter);
     return r;
   }();
   return *registry;

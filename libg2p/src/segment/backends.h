@@ -17,6 +17,9 @@ std::unique_ptr<Segmenter> make_auto_segmenter();
 
 namespace detail {
 
+// `pbr`'s class score per unit of name evidence in a material's name.
+inline constexpr float kPbrNameWeight = 4.f;
+
 // The name evidence the `pbr` backend adds to its class scores, in its score
 // units, per class of the table: per source material, 4 x the evidence of its
 // name and its textures' file names (a prefix all material names share counts

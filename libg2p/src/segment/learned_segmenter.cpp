@@ -38,7 +38,6 @@ namespace g2p {
 namespace {
 
 constexpr const char* kShippedCard = "g2p-materials.json";
-constexpr float kNameScore = 4.f;  // `pbr`'s score per unit of name evidence (pbr_segmenter.cpp)
 
 // The shipped network's card, or "" when none is found.
 std::string shipped_model_card() {
@@ -132,9 +131,9 @@ class LearnedSegmenter final : public Segmenter {
           scores.mesh[static_cast<std::size_t>(src.mesh)].size() == sum.size())
         for (int c = 0; c < k; ++c) sum[c] += scores.mesh[static_cast<std::size_t>(src.mesh)][c];
       const auto top = std::max_element(sum.begin(), sum.end());
-      if (top == sum.end() || *top < kNameScore * threshold_) continue;
+      if (top == sum.end() || *top < detail::kPbrNameWeight * threshold_) continue;
       bool alone = true;
-      for (auto c = sum.begin(); c != sum.end(); ++c) alone &= c == top || *c <= kNameScore * 0.5f;
+      for (auto c = sum.begin(); c != sum.end(); ++c) alone &= c == top || *c <= detail::kPbrNameWeight * 0.5f;
       named_[f] = alone;
     }
     // Every face named or authored: the network's labels would be replaced

@@ -49,7 +49,7 @@ constexpr int kPaperClasses = 12;
 using Scores = std::array<float, kPaperClasses>;
 
 constexpr Scores kPrior = {0.4f, -0.6f, 0.3f, -0.6f, -0.4f, 0.3f, -0.6f, 0.4f, -0.3f, -0.3f, -0.5f, -1.0f};
-constexpr float kNameWeight = 4.f;
+constexpr float kNameWeight = detail::kPbrNameWeight;
 constexpr float kMeshNameShare = 0.7f;
 constexpr float kSharedPrefixShare = 0.25f;
 

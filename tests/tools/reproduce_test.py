@@ -26,7 +26,8 @@ class ReproduceCommandLineTest(unittest.TestCase):
     def test_usage_names_every_option(self):
         done = reproduce()
         self.assertEqual(done.returncode, 2)
-        for option in ("WORK", "--data-only", "--ensemble", "--epochs N", "--continuations C", "--continue-epochs K", "--max-minutes M"):
+        for option in ("WORK", "--data-only", "--ensemble", "--epochs N", "--continuations C", "--continue-epochs K", "--seeds S",
+                       "--max-minutes M"):
             self.assertIn(option, done.stderr)
 
     def test_unknown_and_incomplete_options_are_refused_before_any_work(self):
@@ -39,6 +40,12 @@ class ReproduceCommandLineTest(unittest.TestCase):
         done = reproduce(self.work, "--continuations", "3")
         self.assertEqual(done.returncode, 2)
         self.assertIn("--continuations takes 0, 1 or 2, not 3", done.stderr)
+        done = reproduce(self.work, "--seeds", "3")
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("--seeds takes 1 or 2, not 3", done.stderr)
+        done = reproduce(self.work, "--seeds", "2", "--continuations", "0")  # nothing for the seeds to differ in
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("--seeds 2 needs a continuation", done.stderr)
         self.assertFalse(os.path.exists(self.work))  # nothing created
 
     def test_a_missing_build_is_named(self):

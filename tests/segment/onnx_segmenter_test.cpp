@@ -411,6 +411,46 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
   EXPECT_FALSE(make_segmenter("learned", {{"colour", "blue"}}).ok());
 }
 
+// `learned` and `auto` load their network for the first model that needs it:
+// a model `pbr` labels alone never loads it, so a network OpenCV cannot read
+// fails only there. The card and the network file's presence are checked at
+// once, as the `onnx` backend, which loads when configured, does.
+TEST(LearnedSegmenter, LoadsItsNetworkOnlyForAModelThatNeedsIt) {
+  const std::string dir = make_model_dir();
+  test::write_file(dir + "/broken.onnx", "not an ONNX file");
+  test::write_file(dir + "/card_broken.json", R"({"model": "broken.onnx", "input": {"width": 32, "height": 32},
+                                                  "classes": ["Wood", "Metal", "Glass"]})");
+  const std::string card = dir + "/card_broken.json";
+  const MaterialTable& table = MaterialTable::paper_default();
+  Status eager = make_segmenter("onnx", {{"model_card", card}}).status();
+  EXPECT_EQ(eager.code(), StatusCode::kParseError);  // the file is unreadable: the checks below can fail
+  EXPECT_NE(eager.message().find("OpenCV cannot load the ONNX model"), std::string::npos) << eager.message();
+
+  const Model authored = rgb_boxes();  // dielectric PBR (metallic 0): every face is pbr's
+  const Model unnamed = test::boxes({{"a", {1, 0, 0, 1}, 1.f, 1.f}, {"b", {0, 1, 0, 1}, 1.f, 1.f}},
+                                    "LearnedSegmenter.unnamed");  // glTF's defaults: the network's
+  const std::vector<View> views = test::render(authored, 1, 32);
+  for (const char* backend : {"learned", "auto"}) {
+    Result<std::unique_ptr<Segmenter>> s = make_segmenter(backend, {{"model_card", card}});
+    ASSERT_TRUE(s.ok()) << backend << ": " << s.status().to_string();
+    ASSERT_TRUE((*s)->set_model(authored, table).ok()) << backend;
+    Result<LabelMap> map = (*s)->segment(views[0]);
+    ASSERT_TRUE(map.ok()) << backend << ": " << map.status().to_string();
+    Status needs = (*s)->set_model(unnamed, table);
+    EXPECT_EQ(needs.code(), StatusCode::kParseError) << backend;
+    EXPECT_NE(needs.message().find(dir + "/broken.onnx: OpenCV cannot load the ONNX model"), std::string::npos)
+        << needs.message();
+  }
+
+  // A card whose network file is missing fails when configured, naming the file.
+  test::write_file(dir + "/card_missing.json", R"({"model": "nowhere.onnx", "input": {"width": 32, "height": 32},
+                                                   "classes": ["Wood"]})");
+  Status missing = make_segmenter("learned", {{"model_card", dir + "/card_missing.json"}}).status();
+  EXPECT_EQ(missing.code(), StatusCode::kNotFound);
+  EXPECT_NE(missing.message().find(dir + "/nowhere.onnx: the model card's network file is missing"), std::string::npos)
+      << missing.message();
+}
+
 }  // namespace
 }  // namespace g2p
 

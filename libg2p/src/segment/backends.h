@@ -17,6 +17,13 @@ std::unique_ptr<Segmenter> make_auto_segmenter();
 
 namespace detail {
 
+// The `onnx` backend with its network loaded by the first set_model instead of
+// by configure, which still reads and checks the card and that the network
+// file exists. `learned` and `auto` use it: a model that `pbr` labels alone
+// then costs neither the load (about 0.2 s for the shipped network) nor its
+// memory.
+std::unique_ptr<Segmenter> make_deferred_onnx_segmenter();
+
 // `pbr`'s class score per unit of name evidence in a material's name.
 inline constexpr float kPbrNameWeight = 4.f;
 

@@ -13,8 +13,8 @@
 // class exceeds 4 x 0.5. Names and authored PBR, where present, are right far
 // more often than the network (docs/accuracy.md); image-to-3D meshes carry
 // neither, and then the network decides everything. A model whose every face
-// is named or authored is labelled by `pbr` alone: the network is not run, so
-// such models cost what `pbr` costs.
+// is named or authored is labelled by `pbr` alone: the network is not run,
+// nor loaded until a model needs it, so such models cost what `pbr` costs.
 //
 // `auto` decides per model instead of per face: `pbr` for a model with any
 // face named or authored, the network everywhere on a model with none, as
@@ -87,7 +87,7 @@ class LearnedSegmenter final : public Segmenter {
       if (card.empty()) return Status::Ok();  // set_model says what is missing
       network["model_card"] = card;
     }
-    network_ = make_onnx_segmenter();
+    network_ = detail::make_deferred_onnx_segmenter();  // loaded by set_model, for the first model that needs it
     G2P_RETURN_IF_ERROR(network_->configure(network));
     configured_ = true;
     return Status::Ok();

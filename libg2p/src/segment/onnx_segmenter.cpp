@@ -138,6 +138,10 @@ cv::Mat normals_input(const View& view, cv::Size size) {
 
 class OnnxSegmenter final : public Segmenter {
  public:
+  // `deferred`: configure reads and checks the card, and the network is
+  // loaded by the first set_model (see make_deferred_onnx_segmenter).
+  explicit OnnxSegmenter(bool deferred = false) : deferred_(deferred) {}
+
   Status configure(const BackendSettings& settings) override {
     for (const auto& [k, v] : settings) {
       if (k == "flip") {
@@ -149,21 +153,22 @@ class OnnxSegmenter final : public Segmenter {
         return Status::InvalidArgument("onnx: unknown setting '" + k + "' (known: model_card, flip)");
       Result<ModelCard> card = read_card(v);
       if (!card.ok()) return card.status();
-      try {
-        net_ = cv::dnn::readNetFromONNX(card->model_path);
-      } catch (const cv::Exception& e) {
-        return Status::ParseError(card->model_path + ": OpenCV cannot load the ONNX model: " + e.what());
-      }
-      if (net_.empty()) return Status::ParseError(card->model_path + ": OpenCV loaded an empty network");
-      net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-      net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
       card_ = std::move(*card);
+      net_ = cv::dnn::Net();
+      if (deferred_) {
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(card_.model_path, ec))
+          return Status::NotFound(card_.model_path + ": the model card's network file is missing");
+        continue;
+      }
+      G2P_RETURN_IF_ERROR(load_network());
     }
     return Status::Ok();
   }
 
   Status set_model(const Model&, const MaterialTable& table) override {
     if (card_.classes.empty()) return Status::InvalidArgument("onnx: needs the setting model_card=CARD.json");
+    if (net_.empty()) G2P_RETURN_IF_ERROR(load_network());
     num_classes_ = table.size();
     channel_class_.clear();
     bool any = false;
@@ -279,6 +284,21 @@ class OnnxSegmenter final : public Segmenter {
   }
 
  private:
+  // Reads card_.model_path into net_ (OpenCV's dnn module, on the CPU).
+  Status load_network() {
+    try {
+      net_ = cv::dnn::readNetFromONNX(card_.model_path);
+    } catch (const cv::Exception& e) {
+      net_ = cv::dnn::Net();
+      return Status::ParseError(card_.model_path + ": OpenCV cannot load the ONNX model: " + e.what());
+    }
+    if (net_.empty()) return Status::ParseError(card_.model_path + ": OpenCV loaded an empty network");
+    net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+    net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    return Status::Ok();
+  }
+
+  bool deferred_ = false;
   ModelCard card_;
   bool flip_ = false;  // test-time mirroring (setting flip)
   mutable cv::dnn::Net net_;
@@ -290,5 +310,6 @@ class OnnxSegmenter final : public Segmenter {
 }  // namespace
 
 std::unique_ptr<Segmenter> make_onnx_segmenter() { return std::make_unique<OnnxSegmenter>(); }
+std::unique_ptr<Segmenter> detail::make_deferred_onnx_segmenter() { return std::make_unique<OnnxSegmenter>(true); }
 
 }  // namespace g2p

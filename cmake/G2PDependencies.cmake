@@ -33,6 +33,10 @@ g2p_require(nlohmann_json_FOUND nlohmann-json3-dev)
 
 find_package(Threads REQUIRED)
 
+# Convex hulls of the collision geometry (decompose stage): Qhull, reentrant.
+find_package(Qhull QUIET)
+g2p_require(Qhull_FOUND libqhull-dev)
+
 # URDF export goes through urdfdom's model and writer (which print with TinyXML 2.6).
 find_package(urdfdom QUIET)
 g2p_require(urdfdom_FOUND liburdfdom-dev)

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "g2p/complete.h"
+#include "g2p/decompose.h"
 #include "g2p/eval.h"
 #include "g2p/exporters.h"
 #include "g2p/image.h"

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -16,6 +17,10 @@
 #include "g2p/status.h"
 
 namespace g2p {
+
+// Backend settings, key = value (keys are documented per backend in docs/,
+// one page per stage).
+using BackendSettings = std::map<std::string, std::string>;
 
 template <typename Interface>
 class Registry {

@@ -30,9 +30,6 @@ struct LabelMap {
                          // empty when the backend gives no probabilities
 };
 
-// Backend settings, key = value (keys are documented per backend in docs/segment.md).
-using BackendSettings = std::map<std::string, std::string>;
-
 // The segment stage's interface.
 class G2P_API Segmenter {
  public:

@@ -1,0 +1,93 @@
+// decompose: the collision geometry an engine wants. Physics engines collide
+// meshes as convex shapes (MuJoCo, PhysX and Bullet take the convex hull of a
+// mesh geom, at most 255 vertices in PhysX and Bullet), so a concave part (a
+// bowl, a chair's seat and backrest) needs an approximate convex
+// decomposition: a few convex hulls whose union stays close to the part's
+// closed volume. This step runs after `complete`; the exporters write one
+// collision shape per hull and the input's own faces as the visual mesh,
+// while the mass properties stay those of the closed volume.
+//
+// Backends are swappable through decomposer_registry(): `voxel-cut` (the
+// default: a voxel grid split recursively by the axis-aligned planes that most
+// reduce concavity, after V-HACD, Mamou 2016) and `hull` (one convex hull per
+// part). docs/decompose.md compares them.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "g2p/export.h"
+#include "g2p/mesh.h"
+#include "g2p/registry.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// What every backend honours.
+struct DecomposeOptions {
+  int max_hulls = 16;              // per part, 1..256; a part that is already convex gets one
+  int max_vertices_per_hull = 64;  // 4..255; engines cap a hull at 255 (PhysX, Bullet)
+  // Fidelity is measured on a voxel grid with this many cells along the part's
+  // longest side: the distance below is exact to half a cell.
+  int measure_resolution = 64;  // 16..512
+};
+
+// The collision geometry of one part.
+struct ConvexDecomposition {
+  // Closed, outward, convex triangle meshes, each with at most
+  // max_vertices_per_hull vertices, in the part's frame (metres).
+  std::vector<Mesh> hulls;
+  std::string backend;  // the caller's name for the backend (the pipeline: its registry name); "hull" after a fallback
+  bool fell_back = false;  // the backend failed and the part got its single convex hull (see notes)
+  // Fidelity, measured the same way for every backend.
+  double part_volume_m3 = 0.0;   // the closed volume's
+  double hulls_volume_m3 = 0.0;  // sum over hulls (overlaps counted twice)
+  // How far the hulls' surfaces stand outside the part's closed volume: the
+  // mean and the largest over surface samples, in metres (0 where a sample
+  // lies inside the volume). Contacts happen up to this far from the part.
+  double mean_distance_m = 0.0;
+  double max_distance_m = 0.0;
+  double seconds = 0.0;            // wall time of the decomposition and its measurement
+  std::vector<std::string> notes;  // fallbacks, degenerate input, budgets that bound the result
+};
+
+class G2P_API Decomposer {
+ public:
+  virtual ~Decomposer();
+  // Backend settings, key = value; unknown keys are errors.
+  virtual Status configure(const BackendSettings& settings);
+  // Splits one closed, outward mesh (a completed part) into convex pieces:
+  // fills `hulls` (at most options.max_hulls, each within the vertex budget
+  // after convex_hull's reduction) and may add notes. decompose_part() below
+  // measures the result and handles failure.
+  virtual Status decompose(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) const = 0;
+};
+
+// Backends by name; libg2p registers "voxel-cut" (the default) and "hull".
+G2P_API Registry<Decomposer>& decomposer_registry();
+G2P_API Result<std::unique_ptr<Decomposer>> make_decomposer(const std::string& name,
+                                                            const BackendSettings& settings = {});
+G2P_API Status validate(const DecomposeOptions& options);  // ranges above; names the field's CLI flag
+
+// Runs `decomposer` on one part and measures the result. When the backend
+// fails or returns an invalid set (no hulls, too many, a hull over the vertex
+// budget), the part gets its single convex hull instead, with a note saying
+// why. Fails only when not even a hull exists (fewer than 4 points not on one
+// plane: a flat or empty part); the message says so.
+G2P_API Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer& decomposer,
+                                                   const DecomposeOptions& options = {});
+
+// The convex hull of `points` as a closed, outward triangle mesh. With
+// max_vertices > 0 and a hull of more vertices, the hull is rebuilt from a
+// subset chosen greedily (each step adds the point farthest outside the hull
+// so far), so it stays inside the full hull and loses as little as the budget
+// allows. Fails for fewer than 4 points or points on one plane.
+G2P_API Result<Mesh> convex_hull(const std::vector<Eigen::Vector3d>& points, int max_vertices = 0);
+
+// The volume a closed, outward mesh encloses, in m^3 (divergence theorem).
+G2P_API double enclosed_volume(const Mesh& mesh);
+
+}  // namespace g2p

@@ -1,0 +1,187 @@
+// The Decomposer base class, the registry, and decompose_part(): the
+// backend's result checked, replaced by the single hull when it fails, and
+// measured the same way for every backend.
+#include <chrono>
+#include <cmath>
+
+#include "decompose/backends.h"
+#include "decompose/voxel_grid.h"
+
+namespace g2p {
+
+Decomposer::~Decomposer() = default;
+
+Status Decomposer::configure(const BackendSettings& settings) {
+  if (settings.empty()) return Status::Ok();
+  return Status::InvalidArgument("this decomposer takes no settings (got '" + settings.begin()->first + "')");
+}
+
+Registry<Decomposer>& decomposer_registry() {
+  static Registry<Decomposer>* registry = [] {
+    auto* r = new Registry<Decomposer>();  // never destroyed: usable during static destruction
+    (void)r->add("voxel-cut", &make_voxel_cut_decomposer);
+    (void)r->add("hull", &make_hull_decomposer);
+    return r;
+  }();
+  return *registry;
+}
+
+Result<std::unique_ptr<Decomposer>> make_decomposer(const std::string& name, const BackendSettings& settings) {
+  Result<std::unique_ptr<Decomposer>> r = decomposer_registry().create(name);
+  if (!r.ok()) return r.status();
+  G2P_RETURN_IF_ERROR((*r)->configure(settings).with_context("decomposer '" + name + "'"));
+  return r;
+}
+
+Status validate(const DecomposeOptions& o) {
+  if (o.max_hulls < 1 || o.max_hulls > 256)
+    return Status::InvalidArgument("--max-hulls must be 1..256 (got " + std::to_string(o.max_hulls) + ")");
+  if (o.max_vertices_per_hull < 4 || o.max_vertices_per_hull > 255)
+    return Status::InvalidArgument("--hull-vertices must be 4..255 (got " + std::to_string(o.max_vertices_per_hull) +
+                                   ")");
+  if (o.measure_resolution < 16 || o.measure_resolution > 512)
+    return Status::InvalidArgument("the measuring grid's resolution must be 16..512 cells (got " +
+                                   std::to_string(o.measure_resolution) + ")");
+  return Status::Ok();
+}
+
+double enclosed_volume(const Mesh& mesh) {
+  double six_v = 0.0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(t[0])].cast<double>();
+    const Eigen::Vector3d b = mesh.positions[static_cast<std::size_t>(t[1])].cast<double>();
+    const Eigen::Vector3d c = mesh.positions[static_cast<std::size_t>(t[2])].cast<double>();
+    six_v += a.dot(b.cross(c));
+  }
+  return six_v / 6.0;
+}
+
+namespace {
+
+// A hull is usable by an engine: at least a tetrahedron, within the vertex
+// budget, finite, enclosing a positive volume.
+std::string hull_problem(const Mesh& hull, const DecomposeOptions& options) {
+  if (hull.num_vertices() < 4 || hull.num_faces() < 4) return "a hull with fewer than 4 vertices";
+  if (hull.num_vertices() > options.max_vertices_per_hull)
+    return "a hull of " + std::to_string(hull.num_vertices()) + " vertices (budget " +
+           std::to_string(options.max_vertices_per_hull) + ")";
+  if (!validate(hull).ok()) return "an invalid hull mesh";
+  if (!(enclosed_volume(hull) > 0)) return "a hull without volume";
+  return {};
+}
+
+// Single hull of the part's vertices; a flat part is given a thickness of
+// 1 % of its size (at least 1 mm) so that it still collides.
+Status single_hull(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(closed.positions.size());
+  for (const Eigen::Vector3f& p : closed.positions) points.push_back(p.cast<double>());
+  Result<Mesh> hull = convex_hull(points, options.max_vertices_per_hull);
+  if (!hull.ok() && points.size() >= 3) {
+    const Eigen::AlignedBox3d box = bounds(closed);
+    int axis = 0;
+    box.sizes().minCoeff(&axis);
+    const double half = 0.5 * std::max(1e-3, 0.01 * box.sizes().maxCoeff());
+    const std::size_t n = points.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      Eigen::Vector3d q = points[i];
+      q[axis] += half;
+      points.push_back(q);
+      points[i][axis] -= half;
+    }
+    hull = convex_hull(points, options.max_vertices_per_hull);
+    if (hull.ok())
+      out.notes.push_back("the part is flat; its hull was given " + std::to_string(2 * half) + " m of thickness");
+  }
+  if (!hull.ok())
+    return Status::InvalidArgument("no convex hull: the part has fewer than 4 points off one line (" +
+                                   hull.status().message() + ")");
+  out.hulls = {std::move(*hull)};
+  return Status::Ok();
+}
+
+// Mean and largest distance from hull-surface samples to the part's voxels.
+void measure(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) {
+  const detail::VoxelGrid grid = detail::voxelize(closed, options.measure_resolution, 2);
+  if (grid.occupied.empty()) return;
+  const std::vector<float> distance = detail::distance_to_occupied(grid);
+  double area = 0.0;
+  for (const Mesh& h : out.hulls) area += surface_area(h);
+  if (!(area > 0)) return;
+  const double per_m2 = 20000.0 / area;  // about 20k samples over all hulls
+  double sum = 0.0, largest = 0.0;
+  long samples = 0;
+  auto distance_at = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d q = (p - grid.origin) / grid.cell_m;
+    Eigen::Vector3i c;
+    double outside = 0.0;  // beyond the grid: add the way to its border
+    for (int a = 0; a < 3; ++a) {
+      const double f = std::floor(q[a]);
+      c[a] = static_cast<int>(std::clamp(f, 0.0, grid.size[a] - 1.0));
+      if (q[a] < 0) outside = std::max(outside, -q[a] * grid.cell_m);
+      if (q[a] > grid.size[a]) outside = std::max(outside, (q[a] - grid.size[a]) * grid.cell_m);
+    }
+    return distance[grid.index(c.x(), c.y(), c.z())] + outside;
+  };
+  for (const Mesh& h : out.hulls)
+    for (int f = 0; f < h.num_faces(); ++f) {
+      const Eigen::Vector3i& t = h.triangles[static_cast<std::size_t>(f)];
+      const Eigen::Vector3d a = h.positions[static_cast<std::size_t>(t[0])].cast<double>();
+      const Eigen::Vector3d b = h.positions[static_cast<std::size_t>(t[1])].cast<double>();
+      const Eigen::Vector3d c = h.positions[static_cast<std::size_t>(t[2])].cast<double>();
+      // A regular pattern of barycentric samples, denser on larger faces.
+      const int n = std::max(1, static_cast<int>(std::ceil(std::sqrt(face_area(h, f) * per_m2))));
+      for (int u = 0; u < n; ++u)
+        for (int v = 0; u + v < n; ++v) {
+          const double s = (u + 1.0 / 3.0) / n, r = (v + 1.0 / 3.0) / n;
+          const double d = distance_at(a + s * (b - a) + r * (c - a));
+          sum += d;
+          largest = std::max(largest, d);
+          ++samples;
+        }
+    }
+  if (samples > 0) out.mean_distance_m = sum / samples;
+  out.max_distance_m = largest;
+}
+
+}  // namespace
+
+Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer& decomposer,
+                                           const DecomposeOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  G2P_RETURN_IF_ERROR(validate(options));
+  G2P_RETURN_IF_ERROR(validate(closed).with_context("decompose"));
+  if (closed.num_faces() == 0) return Status::InvalidArgument("decompose: the part's closed volume is empty");
+  ConvexDecomposition out;
+  std::string problem;
+  try {
+    Status s = decomposer.decompose(closed, options, out);
+    if (!s.ok()) problem = s.message();
+  } catch (const std::exception& e) {
+    problem = std::string("the backend threw: ") + e.what();
+  }
+  if (problem.empty() && out.hulls.empty()) problem = "the backend returned no hull";
+  if (problem.empty() && static_cast<int>(out.hulls.size()) > options.max_hulls)
+    problem = "the backend returned " + std::to_string(out.hulls.size()) + " hulls (budget " +
+              std::to_string(options.max_hulls) + ")";
+  for (std::size_t i = 0; problem.empty() && i < out.hulls.size(); ++i) {
+    const std::string p = hull_problem(out.hulls[i], options);
+    if (!p.empty()) problem = "hull " + std::to_string(i) + ": " + p;
+  }
+  if (!problem.empty()) {
+    std::vector<std::string> notes = std::move(out.notes);
+    out = ConvexDecomposition{};
+    out.notes = std::move(notes);
+    out.notes.push_back("decomposition failed (" + problem + "); the part collides as its single convex hull");
+    out.fell_back = true;
+    out.backend = "hull";
+    G2P_RETURN_IF_ERROR(single_hull(closed, options, out).with_context("decompose"));
+  }
+  out.part_volume_m3 = enclosed_volume(closed);
+  for (const Mesh& h : out.hulls) out.hulls_volume_m3 += enclosed_volume(h);
+  measure(closed, options, out);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace g2p

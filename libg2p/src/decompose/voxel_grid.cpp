@@ -1,0 +1,176 @@
+// Voxelisation of closed meshes and the Euclidean distance transform.
+#include "decompose/voxel_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace g2p::detail {
+
+VoxelGrid voxelize(const Mesh& closed, int resolution, int pad) {
+  VoxelGrid g;
+  const Eigen::AlignedBox3d box = bounds(closed);
+  if (box.isEmpty() || resolution < 1) return g;
+  const double longest = std::max(box.sizes().maxCoeff(), 1e-9);
+  g.cell_m = longest / resolution;
+  for (int a = 0; a < 3; ++a) g.size[a] = std::max(1, static_cast<int>(std::ceil(box.sizes()[a] / g.cell_m))) + 2 * pad;
+  // Centre the occupied cells in the grid.
+  g.origin = box.center() - 0.5 * g.cell_m * g.size.cast<double>();
+  g.occupied.assign(static_cast<std::size_t>(g.size.prod()), 0);
+
+  // Interior: signed crossings of the +z line through each column's centre.
+  // The column centres are nudged off the cell lattice so that they do not
+  // pass exactly through vertices and edges of grid-aligned meshes.
+  const double nudge_x = 1.3e-4 * g.cell_m, nudge_y = 0.7e-4 * g.cell_m;
+  std::vector<std::vector<std::pair<double, int>>> crossings(static_cast<std::size_t>(g.size.x()) * g.size.y());
+  for (const Eigen::Vector3i& t : closed.triangles) {
+    const Eigen::Vector3d a = closed.positions[static_cast<std::size_t>(t[0])].cast<double>();
+    const Eigen::Vector3d b = closed.positions[static_cast<std::size_t>(t[1])].cast<double>();
+    const Eigen::Vector3d c = closed.positions[static_cast<std::size_t>(t[2])].cast<double>();
+    const double nz = (b - a).cross(c - a).z();
+    if (nz == 0) continue;  // vertical: the column line misses it
+    const double lo_x = std::min({a.x(), b.x(), c.x()}), hi_x = std::max({a.x(), b.x(), c.x()});
+    const double lo_y = std::min({a.y(), b.y(), c.y()}), hi_y = std::max({a.y(), b.y(), c.y()});
+    const int i0 = std::max(0, static_cast<int>(std::ceil((lo_x - g.origin.x() - nudge_x) / g.cell_m - 0.5)));
+    const int i1 =
+        std::min(g.size.x() - 1, static_cast<int>(std::floor((hi_x - g.origin.x() - nudge_x) / g.cell_m - 0.5)));
+    const int j0 = std::max(0, static_cast<int>(std::ceil((lo_y - g.origin.y() - nudge_y) / g.cell_m - 0.5)));
+    const int j1 =
+        std::min(g.size.y() - 1, static_cast<int>(std::floor((hi_y - g.origin.y() - nudge_y) / g.cell_m - 0.5)));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const double x = g.origin.x() + (i + 0.5) * g.cell_m + nudge_x;
+        const double y = g.origin.y() + (j + 0.5) * g.cell_m + nudge_y;
+        // Barycentric coordinates of (x, y) in the projected triangle.
+        const double w0 = (b.x() - x) * (c.y() - y) - (b.y() - y) * (c.x() - x);
+        const double w1 = (c.x() - x) * (a.y() - y) - (c.y() - y) * (a.x() - x);
+        const double w2 = (a.x() - x) * (b.y() - y) - (a.y() - y) * (b.x() - x);
+        const bool inside = (w0 >= 0 && w1 >= 0 && w2 >= 0) || (w0 <= 0 && w1 <= 0 && w2 <= 0);
+        if (!inside) continue;
+        const double sum = w0 + w1 + w2;
+        if (sum == 0) continue;
+        const double z = (w0 * a.z() + w1 * b.z() + w2 * c.z()) / sum;
+        // Going up, a face whose outward normal points down is an entry.
+        crossings[static_cast<std::size_t>(i) + static_cast<std::size_t>(g.size.x()) * j].emplace_back(z,
+                                                                                                       nz < 0 ? 1 : -1);
+      }
+  }
+  for (int j = 0; j < g.size.y(); ++j)
+    for (int i = 0; i < g.size.x(); ++i) {
+      auto& column = crossings[static_cast<std::size_t>(i) + static_cast<std::size_t>(g.size.x()) * j];
+      if (column.empty()) continue;
+      std::sort(column.begin(), column.end());
+      int winding = 0;
+      std::size_t next = 0;
+      for (int k = 0; k < g.size.z(); ++k) {
+        const double z = g.origin.z() + (k + 0.5) * g.cell_m;
+        while (next < column.size() && column[next].first < z) winding += column[next++].second;
+        if (winding > 0) g.occupied[g.index(i, j, k)] = 1;
+      }
+    }
+
+  // Surface: every cell a triangle passes through, sampled at half a cell.
+  auto mark = [&g](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d q = (p - g.origin) / g.cell_m;
+    const int i = std::clamp(static_cast<int>(std::floor(q.x())), 0, g.size.x() - 1);
+    const int j = std::clamp(static_cast<int>(std::floor(q.y())), 0, g.size.y() - 1);
+    const int k = std::clamp(static_cast<int>(std::floor(q.z())), 0, g.size.z() - 1);
+    g.occupied[g.index(i, j, k)] = 1;
+  };
+  for (const Eigen::Vector3i& t : closed.triangles) {
+    const Eigen::Vector3d a = closed.positions[static_cast<std::size_t>(t[0])].cast<double>();
+    const Eigen::Vector3d b = closed.positions[static_cast<std::size_t>(t[1])].cast<double>();
+    const Eigen::Vector3d c = closed.positions[static_cast<std::size_t>(t[2])].cast<double>();
+    const double longest_edge = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int steps = std::min(4096, static_cast<int>(std::ceil(2.0 * longest_edge / g.cell_m)));
+    if (steps <= 1) {
+      mark(a), mark(b), mark(c);
+      continue;
+    }
+    for (int u = 0; u <= steps; ++u)
+      for (int v = 0; u + v <= steps; ++v) {
+        const double s = static_cast<double>(u) / steps, r = static_cast<double>(v) / steps;
+        mark(a + s * (b - a) + r * (c - a));
+      }
+  }
+  return g;
+}
+
+namespace {
+
+// Squared distance transform of one line (f: 0 at sites, +inf elsewhere).
+void transform_line(std::vector<double>& f, std::vector<double>& d, std::vector<int>& v, std::vector<double>& z) {
+  const int n = static_cast<int>(f.size());
+  const double inf = std::numeric_limits<double>::infinity();
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (f[q] == inf) continue;
+    for (;;) {
+      if (k < 0) {
+        v[0] = q;
+        z[0] = -inf;
+        z[1] = inf;
+        k = 0;
+        break;
+      }
+      const double s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * (q - v[k]));
+      if (s <= z[k]) {
+        --k;
+        continue;
+      }
+      ++k;
+      v[k] = q;
+      z[k] = s;
+      z[k + 1] = inf;
+      break;
+    }
+  }
+  if (k < 0) {
+    std::fill(d.begin(), d.end(), inf);
+    return;
+  }
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[j + 1] < q) ++j;
+    d[q] = (q - v[j]) * (q - v[j]) + f[v[j]];
+  }
+}
+
+}  // namespace
+
+std::vector<float> distance_to_occupied(const VoxelGrid& g) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::size_t total = g.occupied.size();
+  std::vector<double> sq(total);
+  for (std::size_t c = 0; c < total; ++c) sq[c] = g.occupied[c] ? 0.0 : inf;
+  const int n_max = g.size.maxCoeff();
+  std::vector<double> f(static_cast<std::size_t>(n_max)), d(static_cast<std::size_t>(n_max)), z(n_max + 1);
+  std::vector<int> v(static_cast<std::size_t>(n_max));
+  for (int axis = 0; axis < 3; ++axis) {
+    const int n = g.size[axis];
+    f.resize(static_cast<std::size_t>(n));
+    d.resize(static_cast<std::size_t>(n));
+    const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+    for (int p = 0; p < g.size[a1]; ++p)
+      for (int q = 0; q < g.size[a2]; ++q) {
+        Eigen::Vector3i c;
+        c[a1] = p;
+        c[a2] = q;
+        for (int t = 0; t < n; ++t) {
+          c[axis] = t;
+          f[static_cast<std::size_t>(t)] = sq[g.index(c.x(), c.y(), c.z())];
+        }
+        transform_line(f, d, v, z);
+        for (int t = 0; t < n; ++t) {
+          c[axis] = t;
+          sq[g.index(c.x(), c.y(), c.z())] = d[static_cast<std::size_t>(t)];
+        }
+      }
+  }
+  std::vector<float> out(total);
+  for (std::size_t c = 0; c < total; ++c) out[c] = static_cast<float>(std::sqrt(sq[c]) * g.cell_m);
+  return out;
+}
+
+}  // namespace g2p::detail

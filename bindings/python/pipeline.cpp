@@ -199,6 +199,7 @@ void bind_pipeline(py::module_& m) {
       .value("REFINE", Stage::kRefine)
       .value("COMPLETE", Stage::kComplete)
       .value("PROPERTIES", Stage::kProperties)
+      .value("DECOMPOSE", Stage::kDecompose)
       .value("EXPORT", Stage::kExport)
       .def("__str__", [](Stage s) { return to_string(s); });
 

@@ -79,7 +79,7 @@ double hinge_acceleration(const SimulationAsset& asset, const std::string& dir, 
   EXPECT_TRUE(write_asset(dir, asset, {"mjcf"}).ok());
   std::string xml = test::read_file(dir + "/hammer.xml");
   Eigen::AlignedBox3d box;
-  for (const AssetPart& p : asset.parts) box.extend(bounds(p.collision));
+  for (const AssetPart& p : asset.parts) box.extend(bounds(p.closed));
   const Eigen::Vector3d hinge = box.center();
   char joint[256];
   std::snprintf(joint, sizeof joint, "<joint name=\"hinge\" type=\"hinge\" axis=\"0 1 0\" pos=\"%.9g %.9g %.9g\"/>",
@@ -133,7 +133,15 @@ TEST(Exporters, UrdfdomAndCheckUrdfReadTheUrdf) {
   ASSERT_NE(link->inertial, nullptr);
   expect_relative(link->inertial->mass, asset.total.mass_kg, 1e-6, "URDF mass");
   EXPECT_EQ(link->visual_array.size(), asset.parts.size());
-  EXPECT_EQ(link->collision_array.size(), asset.parts.size());
+  std::size_t hulls = 0;
+  for (const AssetPart& p : asset.parts) hulls += p.collision.hulls.size();
+  EXPECT_GE(hulls, asset.parts.size());
+  EXPECT_EQ(link->collision_array.size(), hulls);  // one collision element per convex hull
+  for (const auto& c : link->collision_array) {
+    auto mesh = std::dynamic_pointer_cast<urdf::Mesh>(c->geometry);
+    ASSERT_NE(mesh, nullptr);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + mesh->filename)) << mesh->filename;
+  }
   for (const auto& v : link->visual_array) {
     auto mesh = std::dynamic_pointer_cast<urdf::Mesh>(v->geometry);
     ASSERT_NE(mesh, nullptr);
@@ -157,7 +165,9 @@ TEST(Exporters, SdfIsWellFormedWithTheSameInertial) {
                   asset.total.mass_kg, 1e-6, "SDF mass");
   int collisions = 0;
   for (TiXmlElement* c = link->FirstChildElement("collision"); c; c = c->NextSiblingElement("collision")) ++collisions;
-  EXPECT_EQ(collisions, static_cast<int>(asset.parts.size()));
+  std::size_t hulls = 0;
+  for (const AssetPart& p : asset.parts) hulls += p.collision.hulls.size();
+  EXPECT_EQ(collisions, static_cast<int>(hulls));
 }
 
 TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
@@ -167,17 +177,18 @@ TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
   const std::string path = test::scratch_dir("ExportGlb") + "/hammer.glb";
   ASSERT_TRUE(write_glb(path, model, parts, asset).ok());
   // libg2p's own strict glTF import reads it back: the input's faces plus the
-  // closed volumes, the input's materials, the same place in space.
+  // convex hulls, the input's materials, the same place in space.
   Result<Model> back = load_model(path);
   ASSERT_TRUE(back.ok()) << back.status().to_string();
-  int collision_faces = 0;
-  for (const AssetPart& p : asset.parts) collision_faces += p.collision.num_faces();
+  int collision_faces = 0, hulls = 0;
+  for (const AssetPart& p : asset.parts)
+    for (const Mesh& h : p.collision.hulls) collision_faces += h.num_faces(), ++hulls;
   EXPECT_EQ(back->mesh.num_faces(), model.mesh.num_faces() + collision_faces);
   ASSERT_EQ(back->materials.size(), model.materials.size());
   EXPECT_EQ(back->materials[0].name, model.materials[0].name);
   EXPECT_FLOAT_EQ(back->materials[0].metallic, model.materials[0].metallic);
   const Eigen::AlignedBox3d a = bounds(model.mesh), b = bounds(back->mesh);
-  EXPECT_LT((a.min() - b.min()).norm(), 2e-3);  // the closed volumes reach a little past the input
+  EXPECT_LT((a.min() - b.min()).norm(), 2e-3);  // the hulls of the closed volumes reach a little past the input
   EXPECT_LT((a.max() - b.max()).norm(), 2e-3);
   // The JSON chunk: properties in the nodes' extras, in glTF's +Y-up frame.
   const std::string bytes = test::read_file(path);
@@ -195,7 +206,7 @@ TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
     collision_nodes += g.value("collision", false);
   }
   EXPECT_EQ(parts_with_density, 2);
-  EXPECT_EQ(collision_nodes, 2);
+  EXPECT_EQ(collision_nodes, hulls);
 }
 
 TEST(Exporters, BadInputIsRefused) {

@@ -54,10 +54,10 @@ TEST(Pipeline, TurnsTheHammerIntoAWoodenHandleAndASteelHead) {
   EXPECT_NEAR(r->asset.total.mass_kg, r->properties.object.mass_kg, 1e-9);
 
   // Every stage ran, in order, and was timed and measured.
-  const Stage order[] = {Stage::kLoad,   Stage::kRender,   Stage::kSegment,    Stage::kProject,
-                         Stage::kRefine, Stage::kComplete, Stage::kProperties, Stage::kExport};
-  ASSERT_EQ(r->stages.size(), 8u);
-  for (std::size_t i = 0; i < 8; ++i) {
+  const Stage order[] = {Stage::kLoad,     Stage::kRender,     Stage::kSegment,   Stage::kProject, Stage::kRefine,
+                         Stage::kComplete, Stage::kProperties, Stage::kDecompose, Stage::kExport};
+  ASSERT_EQ(r->stages.size(), 9u);
+  for (std::size_t i = 0; i < 9; ++i) {
     EXPECT_EQ(r->stages[i].stage, order[i]);
     EXPECT_TRUE(r->stages[i].ok);
     EXPECT_GE(r->stages[i].seconds, 0.0);
@@ -270,7 +270,7 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
   EXPECT_EQ(run["format"], "g2p-run");
   EXPECT_EQ(run["parts"].size(), 2u);
   EXPECT_NEAR(run["object"]["mass_kg"].get<double>(), r->properties.object.mass_kg, 1e-9);
-  EXPECT_EQ(run["stages"].size(), 8u);
+  EXPECT_EQ(run["stages"].size(), 9u);
   const std::string html = test::read_file(dir + "/summary.html");
   EXPECT_NE(html.find("Metal"), std::string::npos);
   EXPECT_NE(html.find("Wood"), std::string::npos);

@@ -154,7 +154,8 @@ class HammerPipelineTest(unittest.TestCase):
     def test_stage_reports_progress_and_summary(self):
         r = self.result
         self.assertEqual([s["stage"] for s in r.stages],
-                         ["load", "render", "segment", "project", "refine", "complete", "properties", "export"])
+                         ["load", "render", "segment", "project", "refine", "complete", "properties", "decompose",
+                          "export"])
         for s in r.stages:
             self.assertTrue(s["ok"], s)
             self.assertGreaterEqual(s["seconds"], 0.0)

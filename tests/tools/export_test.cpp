@@ -20,8 +20,8 @@ TEST(ToolExport, WritesAssetsThatValidateInMujoco) {
   ToolRun r = run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
                        quote(dir + "/labels.json") + " -o " + quote(dir + "/out"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  for (const char* f :
-       {"hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb", "report.json", "meshes/part_1_Metal.stl"})
+  for (const char* f : {"hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb", "report.json",
+                        "meshes/part_1_Metal_hull_0.obj", "meshes/part_1_Metal_visual.obj"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/out/" + f)) << f;
   // Relocatable: validate a moved copy.
   std::filesystem::rename(dir + "/out", dir + "/moved");
@@ -48,7 +48,11 @@ TEST(ToolExport, StartsFromAPropertiesOutput) {
     return nlohmann::json::parse(test::read_file(report))["object"]["mass_kg"].get<double>();
   };
   EXPECT_NEAR(mass(dir + "/assets/report.json"), mass(dir + "/props/report.json"), 1e-9);
-  EXPECT_NE(test::read_file(dir + "/assets/report.json").find("convex hull"), std::string::npos);
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(dir + "/assets/report.json"));
+  for (const auto& part : report["parts"]) {
+    EXPECT_GE(part["geometry"]["collision"]["hulls"].get<int>(), 1);
+    EXPECT_EQ(part["geometry"]["collision"]["backend"], "voxel-cut");
+  }
   r = run_tool("validate " + quote(dir + "/assets"));
   if (r.err.find("without MuJoCo") != std::string::npos) GTEST_SKIP() << "libg2p built without MuJoCo";
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;

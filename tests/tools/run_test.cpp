@@ -40,10 +40,13 @@ TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   EXPECT_EQ(r.err.find("\r"), std::string::npos);  // not a terminal: plain progress lines
   EXPECT_NE(r.err.find("g2p run: complete done"), std::string::npos) << r.err;
 
-  // The folder is a source for the single-stage commands: export reuses its parts and properties.
+  // The folder is a source for the single-stage commands: export closes its
+  // parts again (a run keeps completed/ only with --save-intermediates) and
+  // weighs them the same.
+  EXPECT_FALSE(fs::exists(dir + "/out/completed"));
   r = test::run_tool("export " + test::quote(dir + "/out") + " -o " + test::quote(dir + "/again") + " --format mjcf");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("using the closed parts and properties"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("using the closed parts and properties"), std::string::npos) << r.out;
   EXPECT_EQ(nlohmann::json::parse(test::read_file(dir + "/again/report.json"))["object"]["mass_kg"],
             j["object"]["mass_kg"]);
 

@@ -21,6 +21,7 @@ namespace {
 struct ExportArgs {
   LabelledSourceArgs source;
   CompleterArgs completer;
+  DecomposerArgs decomposer;
   EstimatorArgs estimator;
   std::string out, name;
   std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
@@ -63,8 +64,24 @@ int run_export(const ExportArgs& args) {
     name = fs::path(object->model.info.path).stem().string();  // the model file's stem
     if (name.empty()) name = "object";
   }
+  Result<BackendSettings> settings = parse_settings(args.decomposer.settings);
+  if (!settings.ok()) {
+    std::cerr << "g2p export: error: --decompose-set: " << settings.status().message() << "\n";
+    return kExitUsage;
+  }
+  if (Status valid = validate(args.decomposer.options); !valid.ok()) {
+    std::cerr << "g2p export: error: " << valid.message() << "\n";
+    return kExitUsage;
+  }
+  Result<std::unique_ptr<Decomposer>> decomposer = make_decomposer(args.decomposer.name, *settings);
+  if (!decomposer.ok()) {
+    std::cerr << "g2p export: error: --decomposer: " << decomposer.status().to_string() << "\n";
+    return kExitUsage;
+  }
+  const std::vector<ConvexDecomposition> collision =
+      decompose_parts(*done, **decomposer, args.decomposer.options, args.decomposer.name);
   Result<SimulationAsset> asset =
-      make_asset(name, object->model.mesh, object->faces.parts, *done, *report, object->table);
+      make_asset(name, object->model.mesh, object->faces.parts, *done, *report, object->table, collision);
   if (!asset.ok()) {
     std::cerr << "g2p export: error: " << asset.status().to_string() << "\n";
     return kExitFailure;
@@ -81,7 +98,7 @@ int run_export(const ExportArgs& args) {
   }
   Status s = write_asset(args.out, *asset, engine_formats, options);
   if (s.ok() && glb) s = write_glb(args.out + "/" + asset->name + ".glb", object->model, object->faces.parts, *asset);
-  if (s.ok()) s = write_report(args.out + "/report.json", with_export_notes(*report, *asset), object->table);
+  if (s.ok()) s = write_asset_report(args.out + "/report.json", *report, *asset, object->table);
   if (!s.ok()) {
     std::cerr << "g2p export: error: " << s.to_string() << "\n";
     return kExitFailure;
@@ -169,6 +186,7 @@ void add_export_command(CLI::App& app, Command& run) {
       ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
   cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
   add_completer_flags(cmd, args->completer);
+  add_decomposer_flags(cmd, args->decomposer);
   add_estimator_flags(cmd, args->estimator);
   cmd->callback([args, &run] { run = [args] { return run_export(*args); }; });
 

@@ -29,6 +29,7 @@ struct RunArgs {
   RefineArgs refiner;
   CompleterArgs completer;
   EstimatorArgs estimator;
+  DecomposerArgs decomposer;
   std::string vlm_url, vlm_model;
   std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
   bool soft = false;  // soft votes in the project stage
@@ -101,7 +102,8 @@ int run_pipeline(const RunArgs& args) {
   const StageFlags stages[] = {{&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
                                {&o.refiner, &args.refiner.name, &args.refiner.settings, "--refine-set"},
                                {&o.completer, &args.completer.name, &args.completer.settings, "--complete-set"},
-                               {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"}};
+                               {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"},
+                               {&o.decomposer, &args.decomposer.name, &args.decomposer.settings, "--decompose-set"}};
   for (const StageFlags& s : stages) {
     Result<BackendSettings> settings = parse_settings(*s.settings);
     if (!settings.ok()) return usage(std::string(s.flag) + ": " + settings.status().message());
@@ -119,6 +121,8 @@ int run_pipeline(const RunArgs& args) {
     if (!used) return usage("--vlm-url and --vlm-model need --refiner vlm or --estimator vlm");
   }
   o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
+  o.decompose = args.decomposer.options;
+  if (Status valid = validate(o.decompose); !valid.ok()) return usage(valid.message());
   o.formats = args.formats;
   o.name = args.name;
   o.export_options.free_joint = !args.fixed;
@@ -208,6 +212,7 @@ void add_run_command(CLI::App& app, Command& run) {
   add_refiner_flags(cmd, args->refiner, "smooth");
   add_completer_flags(cmd, args->completer);
   add_estimator_flags(cmd, args->estimator);
+  add_decomposer_flags(cmd, args->decomposer);
   cmd->footer(
       "Exit codes: 0 success, 1 the run failed (bad input file, a stage error), 2 bad command line, 130 cancelled "
       "(Ctrl-C). Nothing is written unless the run succeeds.");

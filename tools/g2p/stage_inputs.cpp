@@ -131,7 +131,10 @@ Status write_properties_manifest(const std::string& out, const LabelledSourceArg
 }
 
 bool is_properties_folder(const std::string& dir) {
-  return std::filesystem::exists(dir + "/properties.json") && std::filesystem::exists(dir + "/report.json");
+  // A `g2p run` folder holds completed/ only with --save-intermediates;
+  // without it, the closed parts are made again from its labels.
+  return std::filesystem::exists(dir + "/properties.json") && std::filesystem::exists(dir + "/report.json") &&
+         std::filesystem::exists(dir + "/completed/completion.json");
 }
 
 Result<PropertiesOutput> load_properties_output(const std::string& command, const std::string& dir, int& exit_code) {
@@ -281,6 +284,16 @@ void add_completer_flags(CLI::App* cmd, CompleterArgs& args) {
                   "Stage 5 backend: partition (default), external, alpha-wrap and fill (CGAL builds)");
   cmd->add_option("--complete-set", args.settings, "Completer setting KEY=VALUE (repeatable), e.g. resolution=200");
   cmd->add_option("--fallback", args.fallback, "Backend for parts the completer fails, or 'none' (default partition)");
+}
+
+void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
+  cmd->add_option("--decomposer", args.name,
+                  "Collision geometry: voxel-cut (default: convex decomposition), hull (one convex hull per part)");
+  cmd->add_option("--decompose-set", args.settings,
+                  "Decomposer setting KEY=VALUE (repeatable), e.g. resolution=96 (voxel-cut: resolution, error, cuts)");
+  cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256, default 16)");
+  cmd->add_option("--hull-vertices", args.options.max_vertices_per_hull,
+                  "Vertices per convex hull at most (4-255, default 64; engines cap hulls at 255)");
 }
 
 Result<Completion> run_completion(const std::string& command, const CompleterArgs& args, const LabelledObject& object,

@@ -8,6 +8,7 @@
 
 #include "common.h"
 #include "g2p/complete.h"
+#include "g2p/decompose.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/project.h"
@@ -47,6 +48,15 @@ void add_completer_flags(CLI::App* cmd, CompleterArgs& args);
 // error and sets exit_code. Prints the result unless `quiet`.
 Result<Completion> run_completion(const std::string& command, const CompleterArgs& args, const LabelledObject& object,
                                   int& exit_code);
+
+// --decomposer, --decompose-set, --max-hulls and --hull-vertices: the
+// collision geometry (decompose stage).
+struct DecomposerArgs {
+  std::string name = "voxel-cut";
+  std::vector<std::string> settings;
+  DecomposeOptions options;
+};
+void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args);
 
 // --estimator and --estimate-set.
 struct EstimatorArgs {

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 
+#include "g2p/complete.h"
 #include "g2p/export.h"
 #include "g2p/mesh.h"
 #include "g2p/registry.h"
@@ -62,7 +63,8 @@ class G2P_API Decomposer {
   // Splits one closed, outward mesh (a completed part) into convex pieces:
   // fills `hulls` (at most options.max_hulls, each within the vertex budget
   // after convex_hull's reduction) and may add notes. decompose_part() below
-  // measures the result and handles failure.
+  // measures the result and handles failure. decompose_parts() calls it from
+  // several threads at once.
   virtual Status decompose(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) const = 0;
 };
 
@@ -79,6 +81,13 @@ G2P_API Status validate(const DecomposeOptions& options);  // ranges above; name
 // plane: a flat or empty part); the message says so.
 G2P_API Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer& decomposer,
                                                    const DecomposeOptions& options = {});
+
+// Every part of a completion, in parallel; `backend` names the decomposer
+// in the results. A part that cannot be decomposed at all (no closed volume,
+// flat) gets no hulls and a note saying why; the call itself never fails.
+G2P_API std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
+                                                         const DecomposeOptions& options = {},
+                                                         const std::string& backend = "custom");
 
 // The convex hull of `points` as a closed, outward triangle mesh. With
 // max_vertices > 0 and a hull of more vertices, the hull is rebuilt from a

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "g2p/complete.h"
+#include "g2p/decompose.h"
 #include "g2p/export.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
@@ -25,8 +26,10 @@ struct AssetPart {
   std::string name;      // "part_3_Metal", unique, safe in file and XML names
   std::string material;  // class name
   std::array<double, 4> rgba{0.5, 0.5, 0.5, 1.0};
-  Mesh collision;  // the closed volume (complete stage)
-  Mesh visual;     // the part's own surface from the input
+  // Three geometries with distinct roles (docs/formats.md):
+  Mesh closed;                    // the closed volume (complete stage): the mass properties come from it
+  Mesh visual;                    // the part's own surface from the input: what a viewer draws
+  ConvexDecomposition collision;  // convex hulls (decompose stage): what an engine collides
   PartProperties properties;
   MassProperties mass;
 };
@@ -40,25 +43,46 @@ struct SimulationAsset {
 };
 
 // Gathers the stages' results. Parts without a closed volume are left out
-// (noted); at least one must remain.
+// (noted); at least one must remain. `collision` holds each part's convex
+// decomposition (same order as `parts`); when it is empty, every part is
+// decomposed here with the default backend (`voxel-cut`, default options).
+// A part whose decomposition failed outright collides as its single convex
+// hull, and one without even that is left out; both are noted.
 G2P_API Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, const std::vector<Part>& parts,
                                            const Completion& completion, const PropertiesReport& report,
-                                           const MaterialTable& table);
+                                           const MaterialTable& table,
+                                           const std::vector<ConvexDecomposition>& collision = {});
 
 struct ExportOptions {
   bool free_joint = true;  // MJCF: the body floats (a free joint); false: fixed to the world
   // MuJoCo has one friction coefficient per geom (plus torsional and rolling):
   // the class's dynamic (sliding) coefficient by default, else the static one.
   bool use_static_friction = false;
+  // Also write each part's closed volume (meshes/NAME_closed.obj). It can be
+  // dense (a grid-based completion of a 12-triangle cube has a million
+  // triangles) and no format references it; for inspection only.
+  bool write_closed_volumes = false;
 };
 
 // The properties report as written beside an asset (report.json): the
-// estimate's notes plus the export's (parts left out, the MuJoCo convex-hull
-// caveat for contacts).
+// estimate's notes plus the export's (parts left out, decompositions that
+// fell back).
 G2P_API PropertiesReport with_export_notes(const PropertiesReport& report, const SimulationAsset& asset);
 
-// The texts of the three formats; meshes are referenced as meshes/NAME.stl
-// (collision) and meshes/NAME_visual.stl.
+// report.json beside an asset: report_json() with each exported part's three
+// geometries under "geometry" (docs/report-schema.md): the closed volume
+// (triangles, volume), the visual mesh (triangles, file) and the collision
+// hulls (backend, count, vertices, files, volume against the closed volume,
+// mean and largest distance from the part, seconds, fallback and notes).
+G2P_API std::string asset_report_json(const PropertiesReport& report, const SimulationAsset& asset,
+                                      const MaterialTable& table);
+G2P_API Status write_asset_report(const std::string& path, const PropertiesReport& report, const SimulationAsset& asset,
+                                  const MaterialTable& table);
+
+// The texts of the three formats. Each part has one collision shape per
+// convex hull, meshes/NAME_hull_K.obj, and one visual mesh,
+// meshes/NAME_visual.obj, that does not collide (MJCF: contype and
+// conaffinity 0, geom group 2; hulls in group 3).
 G2P_API std::string mjcf_text(const SimulationAsset& asset, const ExportOptions& options = {});
 G2P_API Result<std::string> urdf_text(const SimulationAsset& asset);  // through urdfdom's model and writer
 G2P_API std::string sdf_text(const SimulationAsset& asset);
@@ -73,8 +97,9 @@ G2P_API Status write_asset(const std::string& dir, const SimulationAsset& asset,
 // part with the input's own meshes, UVs and materials (base colour and
 // metallic-roughness factors and textures, alpha mode), the part's physical
 // properties in the node's `extras.g2p`, the object's totals in the root
-// node's, and each part's closed volume as a separate node named
-// NAME_collision (extras.g2p.collision = true). glTF's frame is +Y up:
+// node's, and each part's convex hulls as nodes named NAME_hull_K
+// (extras.g2p: collision = true, part, hull) without a material. The glTF
+// physics extensions are not ratified yet, so none is written. glTF's frame is +Y up:
 // positions, centres of mass and inertia tensors are rotated from libg2p's
 // +Z up (x, y, z) -> (x, z, -y). docs/formats.md lists the fields.
 G2P_API Status write_glb(const std::string& path, const Model& model, const std::vector<Part>& parts,

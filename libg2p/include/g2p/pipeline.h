@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "g2p/complete.h"
+#include "g2p/decompose.h"
 #include "g2p/export.h"
 #include "g2p/exporters.h"
 #include "g2p/io.h"
@@ -34,9 +35,9 @@
 namespace g2p {
 
 // The steps of one run, in order. kLoad only runs in Pipeline::run_file.
-enum class Stage { kLoad, kRender, kSegment, kProject, kRefine, kComplete, kProperties, kExport };
-constexpr int kNumStages = 8;
-G2P_API const char* to_string(Stage stage);  // "load", "render", ... "export"
+enum class Stage { kLoad, kRender, kSegment, kProject, kRefine, kComplete, kProperties, kDecompose, kExport };
+constexpr int kNumStages = 9;
+G2P_API const char* to_string(Stage stage);  // "load", "render", ... "decompose", "export"
 
 // ---- Progress and cancellation ------------------------------------------------
 
@@ -107,6 +108,11 @@ struct PipelineOptions {
   // 6. properties: "table" (default) or "vlm" (falls back to the table per part).
   BackendChoice estimator{"table", {}};
 
+  // 7. decompose: each part's collision geometry, convex hulls sized for
+  //    engines: "voxel-cut" (default), "hull" (one per part), or a user's.
+  BackendChoice decomposer{"voxel-cut", {}};
+  DecomposeOptions decompose;
+
   // Export: the asset's name ("" = the model file's stem, else "object"),
   // MJCF joint choice, and the formats write_pipeline_output writes.
   std::string name;
@@ -149,6 +155,7 @@ struct G2P_API PipelineResult {
                                       // fell back (fell_back) its labels are the projected ones
   Completion completion;
   PropertiesReport properties;
+  std::vector<ConvexDecomposition> collision;  // per part (same order as completion.parts)
   SimulationAsset asset;
   std::vector<StageReport> stages;    // in run order
   std::vector<std::string> warnings;  // degraded optional stages, in words
@@ -177,6 +184,7 @@ class G2P_API Pipeline {
   void set_refiner(std::shared_ptr<Refiner> refiner);
   void set_completer(std::shared_ptr<Completer> completer);
   void set_estimator(std::shared_ptr<PropertyEstimator> estimator);
+  void set_decomposer(std::shared_ptr<Decomposer> decomposer);
   void set_material_table(MaterialTable table);  // default: MaterialTable::paper_default()
 
   // Creates and configures every named backend now: unknown names or settings

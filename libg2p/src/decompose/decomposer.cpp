@@ -1,6 +1,8 @@
 // The Decomposer base class, the registry, and decompose_part(): the
 // backend's result checked, replaced by the single hull when it fails, and
 // measured the same way for every backend.
+#include <tbb/parallel_for.h>
+
 #include <chrono>
 #include <cmath>
 
@@ -181,6 +183,26 @@ Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer&
   for (const Mesh& h : out.hulls) out.hulls_volume_m3 += enclosed_volume(h);
   measure(closed, options, out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
+                                                 const DecomposeOptions& options, const std::string& backend) {
+  std::vector<ConvexDecomposition> out(completion.parts.size());
+  tbb::parallel_for(std::size_t{0}, out.size(), [&](std::size_t i) {
+    const Mesh& closed = completion.parts[i].mesh;
+    if (closed.num_faces() == 0) {
+      out[i].notes.push_back("no closed volume to decompose");
+      return;
+    }
+    Result<ConvexDecomposition> d = decompose_part(closed, decomposer, options);
+    if (!d.ok()) {
+      out[i].notes.push_back(d.status().message());
+      return;
+    }
+    out[i] = std::move(*d);
+    if (out[i].backend.empty()) out[i].backend = backend;
+  });
   return out;
 }
 

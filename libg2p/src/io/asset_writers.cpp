@@ -2,11 +2,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/file_util.h"
 #include "g2p/exporters.h"
 #include "g2p/io.h"
+#include "io/asset_names.h"
 
 namespace g2p {
 namespace {
@@ -50,9 +53,18 @@ std::string xml_escape(const std::string& s) {
 
 Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, const std::vector<Part>& parts,
                                    const Completion& completion, const PropertiesReport& report,
-                                   const MaterialTable& table) {
+                                   const MaterialTable& table, const std::vector<ConvexDecomposition>& collision) {
   if (parts.size() != completion.parts.size() || parts.size() != report.parts.size())
     return Status::InvalidArgument("make_asset: parts, completion and report disagree in length");
+  if (!collision.empty() && collision.size() != parts.size())
+    return Status::InvalidArgument("make_asset: " + std::to_string(collision.size()) + " decompositions for " +
+                                   std::to_string(parts.size()) + " parts");
+  std::unique_ptr<Decomposer> default_decomposer;
+  if (collision.empty()) {
+    Result<std::unique_ptr<Decomposer>> d = make_decomposer("voxel-cut");
+    if (!d.ok()) return d.status();
+    default_decomposer = std::move(*d);
+  }
   SimulationAsset a;
   a.name = safe_name(name);
   std::vector<MassProperties> masses;
@@ -70,8 +82,24 @@ Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, 
     if (table.valid_label(parts[i].label))
       for (int k = 0; k < 3; ++k)
         p.rgba[static_cast<std::size_t>(k)] = table[parts[i].label].color[static_cast<std::size_t>(k)] / 255.0;
-    p.collision = c.mesh;
+    p.closed = c.mesh;
     p.visual = part_patch(object, parts[i]);
+    if (!collision.empty()) {
+      p.collision = collision[i];
+    } else {
+      Result<ConvexDecomposition> d = decompose_part(c.mesh, *default_decomposer);
+      if (d.ok()) {
+        p.collision = std::move(*d);
+        p.collision.backend = p.collision.fell_back ? "hull" : "voxel-cut";
+      } else {
+        p.collision.notes.push_back(d.status().message());
+      }
+    }
+    if (p.collision.hulls.empty())
+      a.notes.push_back(p.name + " has no collision shape (" +
+                        (p.collision.notes.empty() ? std::string("no hull") : p.collision.notes.back()) +
+                        "); it is exported for its mass and looks only");
+    if (p.collision.fell_back) a.notes.push_back(p.name + " collides as its single convex hull (decomposition failed)");
     p.properties = r.properties;
     p.mass = r.mass;
     if (!c.ok) a.notes.push_back(p.name + " failed its completion checks; exported as it is");
@@ -85,11 +113,46 @@ Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, 
 
 PropertiesReport with_export_notes(const PropertiesReport& report, const SimulationAsset& asset) {
   PropertiesReport out = report;
-  out.notes.push_back(
-      "export: MuJoCo collides each mesh geom as its convex hull, so contacts on concave parts are approximate "
-      "(no convex decomposition yet); the mass properties are exact");
   for (const std::string& n : asset.notes) out.notes.push_back("export: " + n);
   return out;
+}
+
+std::string asset_report_json(const PropertiesReport& report, const SimulationAsset& asset,
+                              const MaterialTable& table) {
+  using nlohmann::json;
+  json doc = json::parse(report_json(with_export_notes(report, asset), table));
+  for (const AssetPart& p : asset.parts) {
+    if (p.part < 0 || p.part >= static_cast<int>(doc["parts"].size())) continue;
+    const ConvexDecomposition& c = p.collision;
+    json files = json::array(), vertices = json::array();
+    for (std::size_t k = 0; k < c.hulls.size(); ++k) {
+      files.push_back("meshes/" + detail::hull_name(p, k) + ".obj");
+      vertices.push_back(c.hulls[k].num_vertices());
+    }
+    json collision = {
+        {"backend", c.backend},
+        {"hulls", c.hulls.size()},
+        {"hull_vertices", vertices},
+        {"files", files},
+        {"hulls_volume_m3", c.hulls_volume_m3},
+        {"closed_volume_m3", c.part_volume_m3},
+        {"volume_ratio", c.part_volume_m3 > 0 ? json(c.hulls_volume_m3 / c.part_volume_m3) : json(nullptr)},
+        {"mean_distance_m", c.mean_distance_m},
+        {"max_distance_m", c.max_distance_m},
+        {"seconds", c.seconds},
+        {"fell_back", c.fell_back},
+        {"notes", c.notes}};
+    doc["parts"][static_cast<std::size_t>(p.part)]["geometry"] = {
+        {"closed", {{"triangles", p.closed.num_faces()}, {"volume_m3", enclosed_volume(p.closed)}}},
+        {"visual", {{"triangles", p.visual.num_faces()}, {"file", "meshes/" + p.name + "_visual.obj"}}},
+        {"collision", collision}};
+  }
+  return doc.dump(2) + "\n";
+}
+
+Status write_asset_report(const std::string& path, const PropertiesReport& report, const SimulationAsset& asset,
+                          const MaterialTable& table) {
+  return write_text_file(path, asset_report_json(report, asset, table));
 }
 
 std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
@@ -97,14 +160,22 @@ std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
   const MassProperties& m = a.total;
   x << "<mujoco model=\"" << a.name << "\">\n"
     << "  <!-- Written by libg2p (Gen2Physics). Metres, kilograms, seconds; +Z up. The body's inertial is\n"
-    << "       libg2p's exact mass properties of the completed parts; geoms carry no mass. MuJoCo collides\n"
-    << "       non-convex mesh geoms as their convex hulls: contacts on concave parts are approximate until a\n"
-    << "       convex decomposition is added. -->\n";
+    << "       libg2p's exact mass properties of the completed parts; geoms carry no mass. Each part collides\n"
+    << "       as a set of convex hulls (class g2p_collision, group 3) and is drawn with its own surface\n"
+    << "       (class g2p_visual, group 2), which does not collide. -->\n";
   for (const std::string& n : a.notes) x << "  <!-- " << xml_escape(n) << " -->\n";
   x << "  <compiler angle=\"radian\" meshdir=\"meshes\" inertiafromgeom=\"false\"/>\n"
-    << "  <option gravity=\"0 0 -9.81\"/>\n  <asset>\n";
-  // OBJ: MuJoCo 2.2 reads at most 200000 triangles from an STL file.
-  for (const AssetPart& p : a.parts) x << "    <mesh name=\"" << p.name << "\" file=\"" << p.name << ".obj\"/>\n";
+    << "  <option gravity=\"0 0 -9.81\"/>\n"
+    << "  <default>\n"
+    << "    <default class=\"g2p_collision\"><geom type=\"mesh\" group=\"3\" contype=\"1\" "
+       "conaffinity=\"1\"/></default>\n"
+    << "    <default class=\"g2p_visual\"><geom type=\"mesh\" group=\"2\" contype=\"0\" conaffinity=\"0\"/></default>\n"
+    << "  </default>\n  <asset>\n";
+  for (const AssetPart& p : a.parts) {
+    for (std::size_t k = 0; k < p.collision.hulls.size(); ++k)
+      x << "    <mesh name=\"" << detail::hull_name(p, k) << "\" file=\"" << detail::hull_name(p, k) << ".obj\"/>\n";
+    x << "    <mesh name=\"" << p.name << "_visual\" file=\"" << p.name << "_visual.obj\"/>\n";
+  }
   x << "  </asset>\n  <worldbody>\n    <body name=\"" << a.name << "\">\n";
   if (options.free_joint) x << "      <freejoint name=\"" << a.name << "_free\"/>\n";
   const Eigen::Matrix3d& I = m.inertia;
@@ -114,13 +185,17 @@ std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
   for (const AssetPart& p : a.parts) {
     const PartProperties& pp = p.properties;
     const double mu = options.use_static_friction ? pp.friction_static : pp.friction_dynamic;
+    const std::string rgba = num(p.rgba[0]) + " " + num(p.rgba[1]) + " " + num(p.rgba[2]) + " " + num(p.rgba[3]);
     x << "      <!-- " << p.name << ": " << to_string(pp.structure) << ", " << num(pp.density_kg_m3) << " kg/m^3, "
-      << num(p.mass.mass_kg) << " kg -->\n"
-      << "      <geom name=\"" << p.name << "\" type=\"mesh\" mesh=\"" << p.name << "\" rgba=\"" << num(p.rgba[0])
-      << " " << num(p.rgba[1]) << " " << num(p.rgba[2]) << " " << num(p.rgba[3]) << "\" friction=\"" << num(mu)
-      << " 0.005 0.0001\" solref=\"" << num(pp.solref[0]) << " " << num(pp.solref[1]) << "\" solimp=\""
-      << num(pp.solimp[0]) << " " << num(pp.solimp[1]) << " " << num(pp.solimp[2]) << " " << num(pp.solimp[3]) << " "
-      << num(pp.solimp[4]) << "\"/>\n";
+      << num(p.mass.mass_kg) << " kg, " << p.collision.hulls.size() << " convex hulls -->\n";
+    for (std::size_t k = 0; k < p.collision.hulls.size(); ++k)
+      x << "      <geom name=\"" << detail::hull_name(p, k) << "\" class=\"g2p_collision\" mesh=\""
+        << detail::hull_name(p, k) << "\" rgba=\"" << rgba << "\" friction=\"" << num(mu) << " 0.005 0.0001\" solref=\""
+        << num(pp.solref[0]) << " " << num(pp.solref[1]) << "\" solimp=\"" << num(pp.solimp[0]) << " "
+        << num(pp.solimp[1]) << " " << num(pp.solimp[2]) << " " << num(pp.solimp[3]) << " " << num(pp.solimp[4])
+        << "\"/>\n";
+    x << "      <geom name=\"" << p.name << "_visual\" class=\"g2p_visual\" mesh=\"" << p.name << "_visual\" rgba=\""
+      << rgba << "\"/>\n";
   }
   x << "    </body>\n  </worldbody>\n</mujoco>\n";
   return x.str();
@@ -139,13 +214,14 @@ std::string sdf_text(const SimulationAsset& a) {
     << "</izz>\n        </inertia>\n      </inertial>\n";
   for (const AssetPart& p : a.parts) {
     const PartProperties& pp = p.properties;
-    x << "      <collision name=\"" << p.name << "\">\n        <geometry><mesh><uri>meshes/" << p.name
-      << ".stl</uri></mesh></geometry>\n        <surface>\n          <friction><ode><mu>" << num(pp.friction_static)
-      << "</mu><mu2>" << num(pp.friction_static)
-      << "</mu2></ode></friction>\n          <bounce><restitution_coefficient>" << num(pp.restitution)
-      << "</restitution_coefficient></bounce>\n        </surface>\n      </collision>\n"
-      << "      <visual name=\"" << p.name << "_visual\">\n        <geometry><mesh><uri>meshes/" << p.name
-      << "_visual.stl</uri></mesh></geometry>\n        <material><diffuse>" << num(p.rgba[0]) << " " << num(p.rgba[1])
+    for (std::size_t k = 0; k < p.collision.hulls.size(); ++k)
+      x << "      <collision name=\"" << detail::hull_name(p, k) << "\">\n        <geometry><mesh><uri>meshes/"
+        << detail::hull_name(p, k) << ".obj</uri></mesh></geometry>\n        <surface>\n          <friction><ode><mu>"
+        << num(pp.friction_static) << "</mu><mu2>" << num(pp.friction_static)
+        << "</mu2></ode></friction>\n          <bounce><restitution_coefficient>" << num(pp.restitution)
+        << "</restitution_coefficient></bounce>\n        </surface>\n      </collision>\n";
+    x << "      <visual name=\"" << p.name << "_visual\">\n        <geometry><mesh><uri>meshes/" << p.name
+      << "_visual.obj</uri></mesh></geometry>\n        <material><diffuse>" << num(p.rgba[0]) << " " << num(p.rgba[1])
       << " " << num(p.rgba[2]) << " " << num(p.rgba[3]) << "</diffuse></material>\n      </visual>\n";
   }
   x << "    </link>\n  </model>\n</sdf>\n";
@@ -166,10 +242,11 @@ Status write_asset(const std::string& dir, const SimulationAsset& a, const std::
     }
   G2P_RETURN_IF_ERROR(detail::ensure_directory(dir + "/meshes"));
   for (const AssetPart& p : a.parts) {
-    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + ".stl", p.collision));
-    if (std::find(formats.begin(), formats.end(), "mjcf") != formats.end())
-      G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + ".obj", p.collision));
-    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_visual.stl", p.visual));
+    for (std::size_t k = 0; k < p.collision.hulls.size(); ++k)
+      G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + detail::hull_name(p, k) + ".obj", p.collision.hulls[k]));
+    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_visual.obj", p.visual));
+    if (options.write_closed_volumes)
+      G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_closed.obj", p.closed));
   }
   for (const std::string& f : formats) {
     if (f == "mjcf") G2P_RETURN_IF_ERROR(write_text_file(dir + "/" + a.name + ".xml", mjcf_text(a, options)));

@@ -5,6 +5,7 @@
 
 #include "core/file_util.h"
 #include "g2p/exporters.h"
+#include "io/asset_names.h"
 #include "io/image_io.h"
 
 namespace g2p {
@@ -191,21 +192,25 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
     nodes.push_back(
         {{"name", p.name}, {"mesh", static_cast<int>(g.doc["meshes"].size()) - 1}, {"extras", {{"g2p", extras}}}});
 
-    // The closed volume as its own node.
-    std::vector<float> cpos;
-    std::vector<std::uint32_t> cidx;
-    for (const auto& v : p.collision.positions) {
-      const Eigen::Vector3d q = r * v.cast<double>();
-      cpos.insert(cpos.end(), {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z())});
+    // The convex hulls, each a node of its own.
+    for (std::size_t k = 0; k < p.collision.hulls.size(); ++k) {
+      const Mesh& hull = p.collision.hulls[k];
+      std::vector<float> hpos;
+      std::vector<std::uint32_t> hidx;
+      for (const auto& v : hull.positions) {
+        const Eigen::Vector3d q = r * v.cast<double>();
+        hpos.insert(hpos.end(), {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z())});
+      }
+      for (const auto& t : hull.triangles)
+        for (int c = 0; c < 3; ++c) hidx.push_back(static_cast<std::uint32_t>(t[c]));
+      const std::string name = detail::hull_name(p, k);
+      g.doc["meshes"].push_back({{"name", name},
+                                 {"primitives", json::array({{{"attributes", {{"POSITION", g.accessor(hpos, 3, true)}}},
+                                                              {"indices", g.indices(hidx)}}})}});
+      nodes.push_back({{"name", name},
+                       {"mesh", static_cast<int>(g.doc["meshes"].size()) - 1},
+                       {"extras", {{"g2p", {{"collision", true}, {"part", p.name}, {"hull", k}}}}}});
     }
-    for (const auto& t : p.collision.triangles)
-      for (int c = 0; c < 3; ++c) cidx.push_back(static_cast<std::uint32_t>(t[c]));
-    g.doc["meshes"].push_back({{"name", p.name + "_collision"},
-                               {"primitives", json::array({{{"attributes", {{"POSITION", g.accessor(cpos, 3, true)}}},
-                                                            {"indices", g.indices(cidx)}}})}});
-    nodes.push_back({{"name", p.name + "_collision"},
-                     {"mesh", static_cast<int>(g.doc["meshes"].size()) - 1},
-                     {"extras", {{"g2p", {{"collision", true}, {"part", p.name}}}}}});
   }
   g.doc["nodes"] = json::array({root});
   for (json& n : nodes) {

@@ -16,11 +16,12 @@
 namespace g2p {
 namespace {
 
-// Lowest height of any mesh vertex of the model's geoms in the current state.
+// Lowest height of any mesh vertex of the model's colliding geoms (not the
+// visual meshes, which collide with nothing) in the current state.
 double lowest_vertex(const mjModel* m, const mjData* d) {
   double lowest = std::numeric_limits<double>::infinity();
   for (int g = 0; g < m->ngeom; ++g) {
-    if (m->geom_type[g] != mjGEOM_MESH) continue;
+    if (m->geom_type[g] != mjGEOM_MESH || (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0)) continue;
     const int mesh = m->geom_dataid[g];
     const float* v = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
     const mjtNum* pos = d->geom_xpos + 3 * g;

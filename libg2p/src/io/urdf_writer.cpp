@@ -1,6 +1,7 @@
 // urdf_text: the asset as a URDF, built with urdfdom's model types and written
 // by its exporter (so what ROS tools parse is what urdfdom writes). One link
-// with the combined inertial and a visual and a collision element per part.
+// with the combined inertial, a visual element per part and a collision
+// element per convex hull.
 #include <tinyxml.h>
 #include <urdf_model/model.h>
 #include <urdf_parser/urdf_parser.h>
@@ -8,6 +9,7 @@
 #include <memory>
 
 #include "g2p/exporters.h"
+#include "io/asset_names.h"
 
 namespace g2p {
 
@@ -37,22 +39,24 @@ Result<std::string> urdf_text(const SimulationAsset& a) {
     model.materials_[material->name] = material;
 
     auto visual_mesh = std::make_shared<urdf::Mesh>();
-    visual_mesh->filename = "meshes/" + p.name + "_visual.stl";
+    visual_mesh->filename = "meshes/" + p.name + "_visual.obj";
     visual_mesh->scale = urdf::Vector3(1, 1, 1);
     auto visual = std::make_shared<urdf::Visual>();
-    visual->name = p.name;
+    visual->name = p.name + "_visual";
     visual->geometry = visual_mesh;
     visual->material_name = material->name;
     visual->material = material;
     link->visual_array.push_back(visual);
 
-    auto collision_mesh = std::make_shared<urdf::Mesh>();
-    collision_mesh->filename = "meshes/" + p.name + ".stl";
-    collision_mesh->scale = urdf::Vector3(1, 1, 1);
-    auto collision = std::make_shared<urdf::Collision>();
-    collision->name = p.name;
-    collision->geometry = collision_mesh;
-    link->collision_array.push_back(collision);
+    for (std::size_t k = 0; k < p.collision.hulls.size(); ++k) {
+      auto hull_mesh = std::make_shared<urdf::Mesh>();
+      hull_mesh->filename = "meshes/" + detail::hull_name(p, k) + ".obj";
+      hull_mesh->scale = urdf::Vector3(1, 1, 1);
+      auto collision = std::make_shared<urdf::Collision>();
+      collision->name = detail::hull_name(p, k);
+      collision->geometry = hull_mesh;
+      link->collision_array.push_back(collision);
+    }
   }
   if (!link->visual_array.empty()) link->visual = link->visual_array.front();
   if (!link->collision_array.empty()) link->collision = link->collision_array.front();

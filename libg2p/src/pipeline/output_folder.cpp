@@ -112,7 +112,8 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
     refine_json["changed_faces"] = r.refinement.changes.size();
   }
   G2P_RETURN_IF_ERROR(write_text_file(tmp + "/refine.json", refine_json.dump(2) + "\n"));
-  G2P_RETURN_IF_ERROR(write_completion(tmp + "/completed", r.completion, r.table, {"obj"}));
+  // The closed volumes can be dense (grid-based): only on request.
+  if (out.intermediates) G2P_RETURN_IF_ERROR(write_completion(tmp + "/completed", r.completion, r.table, {"obj"}));
   std::vector<std::string> engine_formats;
   bool glb = false;
   for (const std::string& f : o.formats) {
@@ -123,7 +124,7 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
   }
   G2P_RETURN_IF_ERROR(write_asset(tmp, r.asset, engine_formats, o.export_options));
   if (glb) G2P_RETURN_IF_ERROR(write_glb(tmp + "/" + r.asset.name + ".glb", r.model, r.projection.parts, r.asset));
-  G2P_RETURN_IF_ERROR(write_report(tmp + "/report.json", with_export_notes(r.properties, r.asset), r.table));
+  G2P_RETURN_IF_ERROR(write_asset_report(tmp + "/report.json", r.properties, r.asset, r.table));
   if (!r.model.info.path.empty()) G2P_RETURN_IF_ERROR(write_manifests(tmp, final_dir, r, o));
   if (out.intermediates) G2P_RETURN_IF_ERROR(write_intermediates(tmp + "/intermediates", r));
   G2P_RETURN_IF_ERROR(write_text_file(tmp + "/run.json", pipeline_summary_json(r, o) + "\n"));

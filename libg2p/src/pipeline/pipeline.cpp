@@ -58,6 +58,7 @@ struct Pipeline::Impl {
   Slot<Completer> completer;
   Slot<Completer> fallback;
   Slot<PropertyEstimator> estimator;
+  Slot<Decomposer> decomposer;
 
   Status run_stages(PipelineResult& r, RunContext& context);
 };
@@ -75,6 +76,7 @@ void Pipeline::set_segmenter(std::shared_ptr<Segmenter> s) { impl_->segmenter.cu
 void Pipeline::set_refiner(std::shared_ptr<Refiner> r) { impl_->refiner.custom = std::move(r); }
 void Pipeline::set_completer(std::shared_ptr<Completer> c) { impl_->completer.custom = std::move(c); }
 void Pipeline::set_estimator(std::shared_ptr<PropertyEstimator> e) { impl_->estimator.custom = std::move(e); }
+void Pipeline::set_decomposer(std::shared_ptr<Decomposer> d) { impl_->decomposer.custom = std::move(d); }
 void Pipeline::set_material_table(MaterialTable table) { impl_->table = std::move(table); }
 
 Status Pipeline::prepare() {
@@ -102,6 +104,9 @@ Status Pipeline::prepare() {
   }
   G2P_RETURN_IF_ERROR(prepare_slot(m.estimator, o.estimator, "properties",
                                    [](const BackendChoice& c) { return make_estimator(c.name, c.settings); }));
+  G2P_RETURN_IF_ERROR(prepare_slot(m.decomposer, o.decomposer, "decompose",
+                                   [](const BackendChoice& c) { return make_decomposer(c.name, c.settings); }));
+  G2P_RETURN_IF_ERROR(validate(o.decompose).with_context("pipeline"));
   if (o.last_stage == Stage::kLoad)
     return Status::InvalidArgument("pipeline: last_stage must be render or a later stage (load is not a stage of run)");
   const ViewOptions& v = o.views;
@@ -267,13 +272,40 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
 
   if (o.last_stage == Stage::kProperties) return Status::Ok();
 
+  // 7. decompose: every part's collision geometry, convex hulls for engines.
+  {
+    detail::StageClock clock(Stage::kDecompose, decomposer.backend(o.decomposer), reset);
+    G2P_RETURN_IF_ERROR(context.report(Stage::kDecompose, 0.0, std::to_string(r.completion.parts.size()) + " parts"));
+    r.collision = decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer));
+    int hulls = 0, fell_back = 0, none = 0;
+    for (std::size_t i = 0; i < r.collision.size(); ++i) {
+      const ConvexDecomposition& d = r.collision[i];
+      hulls += static_cast<int>(d.hulls.size());
+      fell_back += d.fell_back ? 1 : 0;
+      const bool weighed = i < r.properties.parts.size() && r.properties.parts[i].mass.mass_kg > 0;
+      if (d.hulls.empty() && weighed) ++none;
+      for (const std::string& n : d.notes) clock.report().notes.push_back("part " + std::to_string(i) + ": " + n);
+    }
+    clock.report().notes.push_back(std::to_string(hulls) + " convex hulls for " + std::to_string(r.collision.size()) +
+                                   " parts");
+    if (fell_back + none > 0)
+      r.warnings.push_back("decompose (" + clock.report().backend + "): " + std::to_string(fell_back) +
+                           " parts fell back to their single convex hull and " + std::to_string(none) +
+                           " have no collision shape (see report.json)");
+    G2P_RETURN_IF_ERROR(context.report(Stage::kDecompose, 1.0, std::to_string(hulls) + " hulls"));
+    finish(clock);
+  }
+
+  if (o.last_stage == Stage::kDecompose) return Status::Ok();
+
   // The simulation asset (written by write_pipeline_output).
   {
     detail::StageClock clock(Stage::kExport, "asset", reset);
     std::string name = o.name;
     if (name.empty()) name = std::filesystem::path(r.model.info.path).stem().string();
     if (name.empty()) name = "object";
-    Result<SimulationAsset> asset = make_asset(name, mesh, r.projection.parts, r.completion, r.properties, r.table);
+    Result<SimulationAsset> asset =
+        make_asset(name, mesh, r.projection.parts, r.completion, r.properties, r.table, r.collision);
     if (!asset.ok()) return asset.status().with_context("export");
     r.asset = std::move(*asset);
     clock.report().notes = r.asset.notes;

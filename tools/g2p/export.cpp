@@ -78,8 +78,8 @@ int run_export(const ExportArgs& args) {
     std::cerr << "g2p export: error: --decomposer: " << decomposer.status().to_string() << "\n";
     return kExitUsage;
   }
-  const std::vector<ConvexDecomposition> collision =
-      decompose_parts(*done, **decomposer, args.decomposer.options, args.decomposer.name);
+  const std::vector<ConvexDecomposition> collision = decompose_parts(
+      *done, **decomposer, args.decomposer.options, args.decomposer.name, &object->model.mesh, &object->faces.parts);
   Result<SimulationAsset> asset =
       make_asset(name, object->model.mesh, object->faces.parts, *done, *report, object->table, collision);
   if (!asset.ok()) {

@@ -31,6 +31,11 @@ namespace g2p {
 struct DecomposeOptions {
   int max_hulls = 16;              // per part, 1..256; a part that is already convex gets one
   int max_vertices_per_hull = 64;  // 4..255; engines cap a hull at 255 (PhysX, Bullet)
+  // Concavities shallower than this (metres) are left alone. 0: the
+  // backend's own tolerance relative to the part, and decompose_parts() with
+  // the object uses 0.5 % of the object's bounding-box diagonal, so that small
+  // parts are not cut for dents nothing could rest in.
+  double min_depth_m = 0.0;  // >= 0
   // Fidelity is measured on a voxel grid with this many cells along the part's
   // longest side: the distance below is exact to half a cell.
   int measure_resolution = 64;  // 16..512
@@ -85,9 +90,15 @@ G2P_API Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Dec
 // Every part of a completion, in parallel; `backend` names the decomposer
 // in the results. A part that cannot be decomposed at all (no closed volume,
 // flat) gets no hulls and a note saying why; the call itself never fails.
+// With the object and its parts (the completion's input), no hull gets more
+// vertices than the part's own faces have (at least 4), so that no
+// collision mesh is denser than the input it stands for, and min_depth_m
+// 0 means 0.5 % of the object's bounding-box diagonal.
 G2P_API std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
                                                          const DecomposeOptions& options = {},
-                                                         const std::string& backend = "custom");
+                                                         const std::string& backend = "custom",
+                                                         const Mesh* object = nullptr,
+                                                         const std::vector<Part>* parts = nullptr);
 
 // The convex hull of `points` as a closed, outward triangle mesh. With
 // max_vertices > 0 and a hull of more vertices, the hull is rebuilt from a

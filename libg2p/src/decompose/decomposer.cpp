@@ -3,8 +3,11 @@
 // measured the same way for every backend.
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <set>
 
 #include "decompose/backends.h"
 #include "decompose/voxel_grid.h"
@@ -41,6 +44,8 @@ Status validate(const DecomposeOptions& o) {
   if (o.max_vertices_per_hull < 4 || o.max_vertices_per_hull > 255)
     return Status::InvalidArgument("--hull-vertices must be 4..255 (got " + std::to_string(o.max_vertices_per_hull) +
                                    ")");
+  if (!(o.min_depth_m >= 0) || !std::isfinite(o.min_depth_m))
+    return Status::InvalidArgument("--min-concavity must be a length of 0 m or more");
   if (o.measure_resolution < 16 || o.measure_resolution > 512)
     return Status::InvalidArgument("the measuring grid's resolution must be 16..512 cells (got " +
                                    std::to_string(o.measure_resolution) + ")");
@@ -187,7 +192,8 @@ Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer&
 }
 
 std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
-                                                 const DecomposeOptions& options, const std::string& backend) {
+                                                 const DecomposeOptions& options, const std::string& backend,
+                                                 const Mesh* object, const std::vector<Part>* parts) {
   std::vector<ConvexDecomposition> out(completion.parts.size());
   tbb::parallel_for(std::size_t{0}, out.size(), [&](std::size_t i) {
     const Mesh& closed = completion.parts[i].mesh;
@@ -195,7 +201,19 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
       out[i].notes.push_back("no closed volume to decompose");
       return;
     }
-    Result<ConvexDecomposition> d = decompose_part(closed, decomposer, options);
+    DecomposeOptions own = options;
+    if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.005 * bounds(*object).diagonal().norm();
+    if (object != nullptr && parts != nullptr && i < parts->size()) {
+      std::set<std::array<float, 3>> corners;  // the part's distinct vertex positions
+      for (int f : (*parts)[i].faces)
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3f& p =
+              object->positions[static_cast<std::size_t>(object->triangles[static_cast<std::size_t>(f)][k])];
+          corners.insert({p.x(), p.y(), p.z()});
+        }
+      own.max_vertices_per_hull = std::clamp(static_cast<int>(corners.size()), 4, options.max_vertices_per_hull);
+    }
+    Result<ConvexDecomposition> d = decompose_part(closed, decomposer, own);
     if (!d.ok()) {
       out[i].notes.push_back(d.status().message());
       return;

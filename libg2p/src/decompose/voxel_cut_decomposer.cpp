@@ -208,7 +208,7 @@ class VoxelCutDecomposer : public Decomposer {
     for (float& d : distance) d = static_cast<float>(d / g.cell_m);
     Piece root = measure(g, distance, Box{Eigen::Vector3i::Zero(), g.size});
     if (root.cells == 0) return Status::InvalidArgument("voxel-cut: the part fills no cell");
-    const double tolerance = std::max(1.0, error_ * resolution_);  // in cells
+    const double tolerance = std::max({1.0, error_ * resolution_, options.min_depth_m / g.cell_m});  // in cells
 
     auto worse = [](const Piece& a, const Piece& b) { return a.depth < b.depth; };
     std::priority_queue<Piece, std::vector<Piece>, decltype(worse)> open(worse);

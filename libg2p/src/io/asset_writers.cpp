@@ -1,7 +1,9 @@
 // make_asset, MJCF and SDF texts, and write_asset.
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -49,6 +51,26 @@ std::string xml_escape(const std::string& s) {
   return out;
 }
 
+// The mesh with exactly coincident vertices merged: the input's vertices
+// split at UV and normal seams, which the exported visual meshes (positions
+// and triangles only) do not need.
+Mesh welded(const Mesh& mesh) {
+  Mesh out;
+  std::map<std::array<float, 3>, int> index;
+  std::vector<int> remap(mesh.positions.size());
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const Eigen::Vector3f& p = mesh.positions[v];
+    auto [it, added] = index.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, out.num_vertices());
+    if (added) out.positions.push_back(p);
+    remap[v] = it->second;
+  }
+  out.triangles.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& t : mesh.triangles)
+    out.triangles.emplace_back(remap[static_cast<std::size_t>(t[0])], remap[static_cast<std::size_t>(t[1])],
+                               remap[static_cast<std::size_t>(t[2])]);
+  return out;
+}
+
 }  // namespace
 
 Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, const std::vector<Part>& parts,
@@ -59,12 +81,13 @@ Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, 
   if (!collision.empty() && collision.size() != parts.size())
     return Status::InvalidArgument("make_asset: " + std::to_string(collision.size()) + " decompositions for " +
                                    std::to_string(parts.size()) + " parts");
-  std::unique_ptr<Decomposer> default_decomposer;
+  std::vector<ConvexDecomposition> made;  // with the default backend when none was given
   if (collision.empty()) {
     Result<std::unique_ptr<Decomposer>> d = make_decomposer("voxel-cut");
     if (!d.ok()) return d.status();
-    default_decomposer = std::move(*d);
+    made = decompose_parts(completion, **d, DecomposeOptions{}, "voxel-cut", &object, &parts);
   }
+  const std::vector<ConvexDecomposition>& hulls = collision.empty() ? made : collision;
   SimulationAsset a;
   a.name = safe_name(name);
   std::vector<MassProperties> masses;
@@ -84,17 +107,7 @@ Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, 
         p.rgba[static_cast<std::size_t>(k)] = table[parts[i].label].color[static_cast<std::size_t>(k)] / 255.0;
     p.closed = c.mesh;
     p.visual = part_patch(object, parts[i]);
-    if (!collision.empty()) {
-      p.collision = collision[i];
-    } else {
-      Result<ConvexDecomposition> d = decompose_part(c.mesh, *default_decomposer);
-      if (d.ok()) {
-        p.collision = std::move(*d);
-        p.collision.backend = p.collision.fell_back ? "hull" : "voxel-cut";
-      } else {
-        p.collision.notes.push_back(d.status().message());
-      }
-    }
+    p.collision = hulls[i];
     if (p.collision.hulls.empty())
       a.notes.push_back(p.name + " has no collision shape (" +
                         (p.collision.notes.empty() ? std::string("no hull") : p.collision.notes.back()) +
@@ -244,7 +257,7 @@ Status write_asset(const std::string& dir, const SimulationAsset& a, const std::
   for (const AssetPart& p : a.parts) {
     for (std::size_t k = 0; k < p.collision.hulls.size(); ++k)
       G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + detail::hull_name(p, k) + ".obj", p.collision.hulls[k]));
-    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_visual.obj", p.visual));
+    G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_visual.obj", welded(p.visual)));
     if (options.write_closed_volumes)
       G2P_RETURN_IF_ERROR(write_mesh(dir + "/meshes/" + p.name + "_closed.obj", p.closed));
   }

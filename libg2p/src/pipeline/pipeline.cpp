@@ -276,7 +276,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   {
     detail::StageClock clock(Stage::kDecompose, decomposer.backend(o.decomposer), reset);
     G2P_RETURN_IF_ERROR(context.report(Stage::kDecompose, 0.0, std::to_string(r.completion.parts.size()) + " parts"));
-    r.collision = decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer));
+    r.collision = decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer), &mesh,
+                                  &r.projection.parts);
     int hulls = 0, fell_back = 0, none = 0;
     for (std::size_t i = 0; i < r.collision.size(); ++i) {
       const ConvexDecomposition& d = r.collision[i];

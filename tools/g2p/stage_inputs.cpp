@@ -294,8 +294,9 @@ void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
   cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256, default 16)");
   cmd->add_option("--hull-vertices", args.options.max_vertices_per_hull,
                   "Vertices per convex hull at most (4-255, default 64; engines cap hulls at 255)");
-  cmd->add_option("--min-concavity", args.options.min_depth_m,
-                  "Leave concavities shallower than this alone, in metres (default 0: 0.5 % of the object's size)");
+  cmd->add_option(
+      "--min-concavity", args.options.min_depth_m,
+      "Leave concavities shallower than this alone, in metres (default 0: 1 % of the object's bounding-box diagonal)");
 }
 
 Result<Completion> run_completion(const std::string& command, const CompleterArgs& args, const LabelledObject& object,

@@ -33,7 +33,7 @@ struct DecomposeOptions {
   int max_vertices_per_hull = 64;  // 4..255; engines cap a hull at 255 (PhysX, Bullet)
   // Concavities shallower than this (metres) are left alone. 0: the
   // backend's own tolerance relative to the part, and decompose_parts() with
-  // the object uses 0.5 % of the object's bounding-box diagonal, so that small
+  // the object uses 1 % of the object's bounding-box diagonal, so that small
   // parts are not cut for dents nothing could rest in.
   double min_depth_m = 0.0;  // >= 0
   // Fidelity is measured on a voxel grid with this many cells along the part's
@@ -93,7 +93,7 @@ G2P_API Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Dec
 // With the object and its parts (the completion's input), no hull gets more
 // vertices than the part's own faces have (at least 4), so that no
 // collision mesh is denser than the input it stands for, and min_depth_m
-// 0 means 0.5 % of the object's bounding-box diagonal.
+// 0 means 1 % of the object's bounding-box diagonal.
 G2P_API std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
                                                          const DecomposeOptions& options = {},
                                                          const std::string& backend = "custom",

@@ -202,7 +202,7 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
       return;
     }
     DecomposeOptions own = options;
-    if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.005 * bounds(*object).diagonal().norm();
+    if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * bounds(*object).diagonal().norm();
     if (object != nullptr && parts != nullptr && i < parts->size()) {
       std::set<std::array<float, 3>> corners;  // the part's distinct vertex positions
       for (int f : (*parts)[i].faces)

@@ -2,7 +2,7 @@
 // cuts of a voxel grid, after V-HACD (Mamou, "Volumetric hierarchical
 // approximate convex decomposition", Game Engine Gems 3, 2016).
 //
-// The part is voxelised; the piece whose hull exceeds it most is cut by the
+// The part is voxelised and the cavities it encloses are filled; the piece whose hull exceeds it most is cut by the
 // axis-aligned plane that most reduces the summed excess of the two halves,
 // until every piece is within `error` of the part's volume or the hull budget
 // is spent. A piece's concavity is counted on the lattice itself: the cell
@@ -202,8 +202,11 @@ class VoxelCutDecomposer : public Decomposer {
   }
 
   Status decompose(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) const override {
-    const VoxelGrid g = detail::voxelize(closed, resolution_);
+    VoxelGrid g = detail::voxelize(closed, resolution_);
     if (g.occupied.empty()) return Status::InvalidArgument("voxel-cut: the part has no extent");
+    // A cavity the part closes in (the flesh inside a skin, the inside of a
+    // closed bottle) is no concavity for contacts: nothing can get there.
+    detail::fill_enclosed(g);
     std::vector<float> distance = detail::distance_to_occupied(g);
     for (float& d : distance) d = static_cast<float>(d / g.cell_m);
     Piece root = measure(g, distance, Box{Eigen::Vector3i::Zero(), g.size});

@@ -97,6 +97,37 @@ VoxelGrid voxelize(const Mesh& closed, int resolution, int pad) {
   return g;
 }
 
+long fill_enclosed(VoxelGrid& g) {
+  const Eigen::Vector3i n = g.size;
+  std::vector<std::uint8_t> outside(g.occupied.size(), 0);
+  std::vector<Eigen::Vector3i> stack;
+  auto visit = [&](int i, int j, int k) {
+    if (i < 0 || j < 0 || k < 0 || i >= n.x() || j >= n.y() || k >= n.z()) return;
+    const std::size_t c = g.index(i, j, k);
+    if (g.occupied[c] || outside[c]) return;
+    outside[c] = 1;
+    stack.emplace_back(i, j, k);
+  };
+  for (int k = 0; k < n.z(); ++k)
+    for (int j = 0; j < n.y(); ++j)
+      for (int i = 0; i < n.x(); ++i)
+        if (i == 0 || j == 0 || k == 0 || i == n.x() - 1 || j == n.y() - 1 || k == n.z() - 1) visit(i, j, k);
+  while (!stack.empty()) {
+    const Eigen::Vector3i c = stack.back();
+    stack.pop_back();
+    visit(c.x() - 1, c.y(), c.z());
+    visit(c.x() + 1, c.y(), c.z());
+    visit(c.x(), c.y() - 1, c.z());
+    visit(c.x(), c.y() + 1, c.z());
+    visit(c.x(), c.y(), c.z() - 1);
+    visit(c.x(), c.y(), c.z() + 1);
+  }
+  long filled = 0;
+  for (std::size_t c = 0; c < g.occupied.size(); ++c)
+    if (!g.occupied[c] && !outside[c]) g.occupied[c] = 1, ++filled;
+  return filled;
+}
+
 namespace {
 
 // Squared distance transform of one line (f: 0 at sites, +inf elsewhere).

@@ -32,6 +32,11 @@ struct VoxelGrid {
 // `resolution` cells along the longest side; `pad` empty cells around.
 VoxelGrid voxelize(const Mesh& closed, int resolution, int pad = 1);
 
+// Marks the empty cells that no path of face-adjacent empty cells links to
+// the grid's border (cavities enclosed by the part, which nothing outside
+// can touch) as occupied. Returns how many.
+long fill_enclosed(VoxelGrid& grid);
+
 // Per cell, the distance from its centre to the nearest occupied cell's
 // centre in metres (0 for occupied cells): an exact Euclidean distance
 // transform (Felzenszwalb and Huttenlocher 2012), separable along the axes.

@@ -8,13 +8,6 @@
 
 namespace g2p::test {
 
-Mesh box_mesh(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
-  std::vector<std::vector<std::vector<int>>> one{{{1}}};
-  Mesh m = cells_mesh(one, 1.0f);
-  for (Eigen::Vector3f& p : m.positions) p = lo + p.cwiseProduct(hi - lo);
-  return m;
-}
-
 Mesh cells_mesh(const std::vector<std::vector<std::vector<int>>>& cells, float cell_m) {
   const int nz = static_cast<int>(cells.size()), ny = static_cast<int>(cells[0].size()),
             nx = static_cast<int>(cells[0][0].size());
@@ -116,6 +109,25 @@ Mesh u_channel_mesh(float cell_m) {
     for (int x = 0; x < 5; ++x) cells[0][y][x] = 1;
   for (int z = 1; z < 4; ++z)
     for (int y = 0; y < 3; ++y) cells[z][y][0] = cells[z][y][4] = 1;
+  return cells_mesh(cells, cell_m);
+}
+
+Mesh cup_mesh(double radius_m, double height_m, double wall_m, double bottom_m, int segments) {
+  const double inner = radius_m - wall_m;
+  return revolve(
+      {{0.0, 0.0}, {radius_m, 0.0}, {radius_m, height_m}, {inner, height_m}, {inner, bottom_m}, {0.0, bottom_m}},
+      segments);
+}
+
+Mesh chair_mesh(float cell_m) {
+  std::vector<std::vector<std::vector<int>>> cells(17, std::vector<std::vector<int>>(8, std::vector<int>(8, 0)));
+  for (int z = 0; z < 8; ++z)  // legs at the corners
+    for (int y : {0, 7})
+      for (int x : {0, 7}) cells[z][y][x] = 1;
+  for (int y = 0; y < 8; ++y)  // the seat
+    for (int x = 0; x < 8; ++x) cells[8][y][x] = 1;
+  for (int z = 9; z < 17; ++z)  // the backrest
+    for (int x = 0; x < 8; ++x) cells[z][7][x] = 1;
   return cells_mesh(cells, cell_m);
 }
 

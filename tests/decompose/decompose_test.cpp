@@ -8,6 +8,7 @@
 #include "decompose/decompose_fixtures.h"
 #include "g2p/complete.h"
 #include "g2p/decompose.h"
+#include "support/gltf_builder.h"
 
 namespace g2p {
 namespace {

@@ -68,5 +68,31 @@ TEST(ToolExport, BadInputFailsWithAMessage) {
   EXPECT_EQ(r.exit_code, 2);
 }
 
+TEST(ToolValidate, ContactCheckDropsBallsAndWritesJson) {
+  const std::string dir = test::scratch_dir("ToolValidateContact");
+  test::write_file(dir + "/labels.json", R"({"models": {"hammer": {"labels": {"0": "Wood", "1": "Metal"}}}})");
+  ToolRun r = run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
+                       quote(dir + "/labels.json") + " --format mjcf -o " + quote(dir + "/out"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 2 --json " + quote(dir + "/contact.json"));
+  if (r.err.find("without MuJoCo") != std::string::npos) GTEST_SKIP() << "libg2p built without MuJoCo";
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("4 balls"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(dir + "/contact.json"));
+  ASSERT_EQ(j["balls"].size(), 4u);
+  for (const auto& b : j["balls"]) {
+    EXPECT_GT(b["radius_m"].get<double>(), 0.0);
+    EXPECT_TRUE(b["on_object"].get<bool>() || b["on_floor"].get<bool>()) << b;
+  }
+  EXPECT_TRUE(j["drop"]["object_above_plane"].get<bool>());
+
+  r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 0");
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("--balls"), std::string::npos) << r.err;
+  r = run_tool("validate " + quote(dir + "/missing"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no such folder"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace g2p

@@ -113,12 +113,78 @@ int run_export(const ExportArgs& args) {
 struct ValidateArgs {
   std::string dir;
   double height = 0.2, seconds = 2.0;
+  bool contact = false, fail_on_unstable = false;
+  ContactCheckOptions contact_options;
+  std::string json;
 };
+
+// `g2p validate DIR --contact`: the probe balls' table, optionally as JSON.
+int run_contact_check(const ValidateArgs& args, const std::string& mjcf) {
+  ContactCheckOptions options = args.contact_options;
+  options.drop_height_m = args.height;
+  Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, options);
+  if (!c.ok()) {
+    std::cerr << "g2p validate: error: " << c.status().to_string() << "\n";
+    return c.status().code() == StatusCode::kInvalidArgument ? kExitUsage : kExitFailure;
+  }
+  const Eigen::Vector3d lo = c->object_bounds.min(), hi = c->object_bounds.max();
+  int resting = 0, on_object = 0;
+  for (const BallProbe& b : c->balls) resting += b.at_rest ? 1 : 0, on_object += b.on_object ? 1 : 0;
+  std::printf("%s: %s, object fixed, collision geometry x %.4g..%.4g y %.4g..%.4g z %.4g..%.4g m\n", mjcf.c_str(),
+              c->engine.c_str(), lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z());
+  std::printf("  %zu balls of radius %.4g m dropped from %.4g m for %.3g s\n", c->balls.size(),
+              c->balls.empty() ? 0.0 : c->balls[0].radius_m,
+              hi.z() + 2 * (c->balls.empty() ? 0.0 : c->balls[0].radius_m), args.contact_options.seconds);
+  std::printf("  %9s %9s %12s %12s %11s  %s\n", "start x", "start y", "rests at z", "above floor", "speed m/s",
+              "where");
+  for (const BallProbe& b : c->balls)
+    std::printf("  %9.4f %9.4f %12.4f %12.4f %11.2e  %s%s\n", b.start.x(), b.start.y(), b.rest.z(),
+                b.height_above_floor_m, b.final_speed_m_s,
+                b.on_object  ? "on the object"
+                : b.on_floor ? "on the floor"
+                             : "touching nothing",
+                b.at_rest ? "" : ", still moving");
+  std::printf("  %d of %zu at rest, %d on the object\n", resting, c->balls.size(), on_object);
+  if (c->drop.dropped)
+    std::printf("  object dropped from %.3g m: rests %.4g m above the plane (%s)\n", args.height,
+                c->drop.resting_lowest_m, c->object_above_plane ? "above it" : "sunk into it");
+  else
+    std::printf("  object not dropped (the MJCF fixes it to the world)\n");
+  if (!args.json.empty()) {
+    nlohmann::json j = {{"mjcf", mjcf}, {"engine", c->engine}, {"balls", nlohmann::json::array()}};
+    j["object_bounds_m"] = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
+    for (const BallProbe& b : c->balls)
+      j["balls"].push_back({{"start_m", {b.start.x(), b.start.y()}},
+                            {"rest_m", {b.rest.x(), b.rest.y(), b.rest.z()}},
+                            {"radius_m", b.radius_m},
+                            {"height_above_floor_m", b.height_above_floor_m},
+                            {"final_speed_m_s", b.final_speed_m_s},
+                            {"at_rest", b.at_rest},
+                            {"on_object", b.on_object},
+                            {"on_floor", b.on_floor}});
+    j["drop"] = {{"dropped", c->drop.dropped},
+                 {"resting_lowest_m", c->drop.resting_lowest_m},
+                 {"final_speed_m_s", c->drop.final_speed_m_s},
+                 {"object_above_plane", c->object_above_plane}};
+    if (Status s = write_text_file(args.json, j.dump(2) + "\n"); !s.ok()) {
+      std::cerr << "g2p validate: error: --json: " << s.to_string() << "\n";
+      return kExitFailure;
+    }
+  }
+  const bool stable = resting == static_cast<int>(c->balls.size()) && c->object_above_plane;
+  if (!stable) std::printf("%s\n", args.fail_on_unstable ? "FAIL" : "note: not everything came to rest");
+  return stable || !args.fail_on_unstable ? kExitOk : kExitFailure;
+}
 
 int run_validate(const ValidateArgs& args) {
   namespace fs = std::filesystem;
   std::string mjcf;
   std::error_code ec;
+  if (!fs::is_directory(args.dir, ec)) {
+    std::cerr << "g2p validate: error: " << args.dir
+              << (fs::exists(args.dir, ec) ? ": not a folder (give a g2p export folder)\n" : ": no such folder\n");
+    return kExitFailure;
+  }
   for (const auto& e : fs::directory_iterator(args.dir, ec))
     if (e.path().extension() == ".xml") mjcf = e.path().string();
   if (ec || mjcf.empty()) {
@@ -129,6 +195,7 @@ int run_validate(const ValidateArgs& args) {
     std::cerr << "g2p validate: error: this libg2p was built without MuJoCo (G2P_WITH_MUJOCO=OFF)\n";
     return kExitFailure;
   }
+  if (args.contact) return run_contact_check(args, mjcf);
   Result<EngineCheck> c = check_in_mujoco(mjcf, args.height, args.seconds);
   if (!c.ok()) {
     std::cerr << "g2p validate: error: " << c.status().to_string() << "\n";
@@ -191,10 +258,20 @@ void add_export_command(CLI::App& app, Command& run) {
   cmd->callback([args, &run] { run = [args] { return run_export(*args); }; });
 
   auto vargs = std::make_shared<ValidateArgs>();
-  CLI::App* v = app.add_subcommand("validate", "Load an exported MJCF in MuJoCo, compare, and drop it on a plane");
+  CLI::App* v = app.add_subcommand(
+      "validate", "Load an exported MJCF in MuJoCo, compare, and drop it on a plane (--contact: drop balls onto it)");
   v->add_option("dir", vargs->dir, "Output folder of g2p export")->required();
   v->add_option("--drop-height", vargs->height, "Drop height above the plane, m (default 0.2)");
   v->add_option("--seconds", vargs->seconds, "Simulated time, s (default 2)");
+  v->add_flag("--contact", vargs->contact,
+              "Contact check: fix the object, drop probe balls onto a grid over it and report where they rest");
+  v->add_option("--balls", vargs->contact_options.grid, "--contact: balls per side of the grid (default 5)");
+  v->add_option("--ball-radius", vargs->contact_options.ball_radius_m,
+                "--contact: ball radius, m (default 2 % of the object's longest side, at least 5 mm)");
+  v->add_option("--contact-seconds", vargs->contact_options.seconds, "--contact: simulated time, s (default 3)");
+  v->add_option("--json", vargs->json, "--contact: also write the result as JSON to this file");
+  v->add_flag("--fail-on-unstable", vargs->fail_on_unstable,
+              "--contact: exit 1 when a ball is still moving at the end or the dropped object sank into the plane");
   v->callback([vargs, &run] { run = [vargs] { return run_validate(*vargs); }; });
 }
 

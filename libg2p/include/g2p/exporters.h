@@ -132,4 +132,49 @@ G2P_API bool have_mujoco();
 G2P_API Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_height_m = 0.2,
                                             double drop_seconds = 2.0);
 
+// ---- Contacts in a real engine ---------------------------------------------
+
+// Probe balls dropped onto the object, fixed in place, to see where an engine
+// lets things rest on it: in a bowl, on a seat, in a channel.
+struct ContactCheckOptions {
+  int grid = 5;  // balls per side of a grid over the object's top view (0: only `points`)
+  // Further start positions (x, y) in the object's frame, metres: a ball
+  // over a bowl's centre, say.
+  std::vector<Eigen::Vector2d> points;
+  double ball_radius_m = 0.0;          // 0: 2 % of the object's longest side, at least 5 mm
+  double ball_density_kg_m3 = 1000.0;  // water
+  double ball_friction = 0.5;          // sliding friction of the balls (MuJoCo combines with the max)
+  double seconds = 3.0;                // simulated time, s
+  double rest_speed_m_s = 0.005;       // a ball slower than this at the end is at rest
+  double drop_height_m = 0.2;          // the free object's drop onto a plane (check_in_mujoco)
+};
+
+// One ball: where it started and where it came to rest.
+struct BallProbe {
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();  // x, y over the object (its frame), m
+  Eigen::Vector3d rest = Eigen::Vector3d::Zero();   // centre at the end, in the object's frame, m
+  double radius_m = 0.0;
+  double height_above_floor_m = 0.0;  // of its lowest point; the floor is at the object's lowest point
+  double final_speed_m_s = 0.0;
+  bool at_rest = false;    // final speed under ContactCheckOptions::rest_speed_m_s
+  bool on_object = false;  // touching one of the object's collision geoms at the end
+  bool on_floor = false;   // touching the floor at the end
+};
+
+struct ContactCheck {
+  std::vector<BallProbe> balls;
+  Eigen::AlignedBox3d object_bounds;  // of the collision geometry, object's frame, m
+  EngineCheck drop;                   // the free object dropped onto a plane (not run when the MJCF is --fixed)
+  bool object_above_plane = false;    // after the drop, nothing of it more than 1 cm below the plane
+  std::string engine;                 // "MuJoCo 2.2.2"
+};
+
+// Loads an MJCF written by write_asset, fixes the body in place over a floor
+// at its lowest point, drops probe balls onto it (they collide with the
+// object's collision geoms and the floor, not with each other) and
+// simulates; then runs check_in_mujoco's drop of the free object. Nothing is
+// written beside the user's files. Unavailable without MuJoCo.
+G2P_API Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path,
+                                                      const ContactCheckOptions& options = {});
+
 }  // namespace g2p

@@ -12,6 +12,7 @@
 #include "core/file_util.h"
 #include "g2p/exporters.h"
 #include "g2p/io.h"
+#include "io/mujoco_support.h"
 
 namespace g2p {
 namespace {
@@ -20,35 +21,54 @@ namespace {
 // visual meshes, which collide with nothing) in the current state.
 double lowest_vertex(const mjModel* m, const mjData* d) {
   double lowest = std::numeric_limits<double>::infinity();
-  for (int g = 0; g < m->ngeom; ++g) {
-    if (m->geom_type[g] != mjGEOM_MESH || (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0)) continue;
-    const int mesh = m->geom_dataid[g];
-    const float* v = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
-    const mjtNum* pos = d->geom_xpos + 3 * g;
-    const mjtNum* rot = d->geom_xmat + 9 * g;  // row-major
-    for (int i = 0; i < m->mesh_vertnum[mesh]; ++i) {
-      const double z = pos[2] + rot[6] * v[3 * i] + rot[7] * v[3 * i + 1] + rot[8] * v[3 * i + 2];
-      lowest = std::min(lowest, z);
-    }
-  }
+  detail::for_each_collision_vertex(m, d, [&](double, double, double z) { lowest = std::min(lowest, z); });
   return lowest;
 }
 
 }  // namespace
 
-bool have_mujoco() { return true; }
+namespace detail {
 
-Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_height_m, double drop_seconds) {
+Result<std::string> mjcf_with_absolute_meshdir(const std::string& mjcf_path) {
   namespace fs = std::filesystem;
   std::ifstream in(mjcf_path, std::ios::binary);
   if (!in) return Status::NotFound(mjcf_path + ": cannot open");
   std::ostringstream text;
   text << in.rdbuf();
   std::string xml = text.str();
+  const fs::path source = fs::absolute(mjcf_path).parent_path();
+  const std::string meshdir = "meshdir=\"meshes\"";
+  const std::size_t at = xml.find(meshdir);
+  if (at != std::string::npos) xml.replace(at, meshdir.size(), "meshdir=\"" + (source / "meshes").string() + "\"");
+  return xml;
+}
+
+Result<mjModel*> load_mjcf_text(const std::string& xml, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::string tmpl = (fs::temp_directory_path() / "g2p-mujoco-XXXXXX").string();
+  if (mkdtemp(tmpl.data()) == nullptr) return Status::IoError(what + ": cannot create a temporary folder");
+  const std::string path = tmpl + "/model.xml";
+  Status s = write_text_file(path, xml);
+  char error[1000] = "";
+  mjModel* m = s.ok() ? mj_loadXML(path.c_str(), nullptr, error, sizeof error) : nullptr;
+  std::error_code ec;
+  fs::remove_all(tmpl, ec);
+  if (!s.ok()) return s;
+  if (m == nullptr) return Status::ParseError(what + ": MuJoCo: " + error);
+  return m;
+}
+
+}  // namespace detail
+
+bool have_mujoco() { return true; }
+
+Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_height_m, double drop_seconds) {
+  Result<std::string> text = detail::mjcf_with_absolute_meshdir(mjcf_path);
+  if (!text.ok()) return text.status();
+  std::string xml = *text;
 
   EngineCheck out;
-  out.engine = std::string("MuJoCo ") + std::to_string(mj_version() / 100) + "." +
-               std::to_string(mj_version() / 10 % 10) + "." + std::to_string(mj_version() % 10);
+  out.engine = detail::engine_name();
   char error[1000] = "";
   {
     mjModel* m = mj_loadXML(mjcf_path.c_str(), nullptr, error, sizeof error);
@@ -68,10 +88,6 @@ Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_he
 
   // The same model over a plane, in a temporary copy that reads the meshes
   // from the original folder (nothing is written beside the user's files).
-  const fs::path source = fs::absolute(mjcf_path).parent_path();
-  const std::string meshdir = "meshdir=\"meshes\"";
-  const std::size_t at = xml.find(meshdir);
-  if (at != std::string::npos) xml.replace(at, meshdir.size(), "meshdir=\"" + (source / "meshes").string() + "\"");
   mjModel* probe = mj_loadXML(mjcf_path.c_str(), nullptr, error, sizeof error);
   if (probe == nullptr) return Status::ParseError(mjcf_path + ": MuJoCo: " + error);
   mjData* pd = mj_makeData(probe);
@@ -86,15 +102,9 @@ Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_he
   std::snprintf(plane, sizeof plane, "    <geom name=\"g2p_floor\" type=\"plane\" size=\"0 0 1\" pos=\"0 0 %.9g\"/>\n",
                 floor_z);
   xml.insert(wb + body.size(), plane);
-  std::string tmpl = (fs::temp_directory_path() / "g2p-mujoco-XXXXXX").string();
-  if (mkdtemp(tmpl.data()) == nullptr) return Status::IoError("check_in_mujoco: cannot create a temporary folder");
-  const std::string dropped = tmpl + "/drop.xml";
-  Status s = write_text_file(dropped, xml);
-  mjModel* m = s.ok() ? mj_loadXML(dropped.c_str(), nullptr, error, sizeof error) : nullptr;
-  std::error_code ec;
-  fs::remove_all(tmpl, ec);
-  if (!s.ok()) return s;
-  if (m == nullptr) return Status::ParseError(mjcf_path + " over a plane: MuJoCo: " + error);
+  Result<mjModel*> loaded = detail::load_mjcf_text(xml, mjcf_path + " over a plane");
+  if (!loaded.ok()) return loaded.status();
+  mjModel* m = *loaded;
   mjData* d = mj_makeData(m);
   const int steps = static_cast<int>(std::ceil(drop_seconds / m->opt.timestep));
   out.dropped = true;

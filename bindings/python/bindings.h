@@ -193,6 +193,7 @@ T from_kwargs(const py::kwargs& kwargs) {
 void bind_core(py::module_& m);         // core.cpp: errors' enums, Mesh, Model, materials, io
 void bind_stage_types(py::module_& m);  // stage_types.cpp: cameras, views, label maps, parts, results
 void bind_stages(py::module_& m);       // stages.cpp: the stage interfaces, registries, stage functions
+void bind_decompose(py::module_& m);    // decompose.cpp: options, results, Decomposer, convex_hull
 void bind_pipeline(py::module_& m);     // pipeline.cpp: options, RunContext, Pipeline, PipelineResult
 
 }  // namespace g2p::python

@@ -138,6 +138,7 @@ PYBIND11_MODULE(g2p, m) {
   bind_core(m);
   bind_stage_types(m);
   bind_stages(m);
+  bind_decompose(m);
   bind_pipeline(m);
 
 #if defined(G2P_PYTHON_WITH_CGAL)

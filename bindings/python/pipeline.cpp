@@ -257,6 +257,8 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("completer", &PipelineOptions::completer)
       .def_readwrite("completion_fallback", &PipelineOptions::completion_fallback, "'' = none")
       .def_readwrite("estimator", &PipelineOptions::estimator)
+      .def_readwrite("decomposer", &PipelineOptions::decomposer, "decompose backend: voxel-cut (default), hull")
+      .def_readwrite("decompose", &PipelineOptions::decompose, "g2p.DecomposeOptions")
       .def_readwrite("name", &PipelineOptions::name, "the asset's name ('' = the file's stem)")
       .def_readwrite("export_options", &PipelineOptions::export_options)
       .def_readwrite("formats", &PipelineOptions::formats,
@@ -291,6 +293,7 @@ void bind_pipeline(py::module_& m) {
           "list of dicts: index, label, class, faces (int32), area_m2")
       .def_readonly("refinement", &PipelineResult::refinement)
       .def_readonly("completion", &PipelineResult::completion)
+      .def_readonly("collision", &PipelineResult::collision, "per part, its g2p.ConvexDecomposition")
       .def_readonly("properties_report", &PipelineResult::properties)
       .def_property_readonly(
           "properties", [](const PyPipelineResult& r) { return properties_list(r); },
@@ -393,6 +396,13 @@ void bind_pipeline(py::module_& m) {
             p.pipeline.set_estimator(hold_python_object<PropertyEstimator>(std::move(e)));
           },
           py::arg("estimator"))
+      .def(
+          "set_decomposer",
+          [](PyPipeline& p, py::object d) {
+            auto lock = p.lock("set_decomposer");
+            p.pipeline.set_decomposer(hold_python_object<Decomposer>(std::move(d)));
+          },
+          py::arg("decomposer"))
       .def(
           "set_material_table",
           [](PyPipeline& p, MaterialTable table) {

@@ -483,6 +483,78 @@ class ModelsAndStagesTest(unittest.TestCase):
         self.assertEqual(pipeline.options.views.width, 100)
         self.assertEqual(pipeline.options.refiner.name, "none")
 
+class OneHullPerPart(g2p.Decomposer):
+    """A Python decomposer: the convex hull of the part's vertices, as points."""
+
+    def __init__(self):
+        super().__init__()
+        self.calls = 0
+
+    def decompose(self, closed, options):
+        self.calls += 1
+        return [closed.positions]
+
+
+class Raises(g2p.Decomposer):
+    def decompose(self, closed, options):
+        raise RuntimeError("no hulls today")
+
+
+class DecomposeTest(unittest.TestCase):
+    def test_convex_hull_of_a_cube(self):
+        corners = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+        inside = np.random.default_rng(3).uniform(0.1, 0.9, size=(50, 3))
+        hull = g2p.convex_hull(np.vstack([corners, inside]))
+        self.assertEqual(hull.num_vertices, 8)
+        self.assertAlmostEqual(g2p.enclosed_volume(hull), 1.0, places=5)
+        with self.assertRaises(ValueError):
+            g2p.convex_hull(np.zeros((5, 3)))
+
+    def test_pipeline_decomposes_every_part(self):
+        r = g2p.Pipeline(quick_options()).run_file(HAMMER)
+        self.assertIn("decompose", [s["stage"] for s in r.stages])
+        self.assertEqual(len(r.collision), len(r.parts))
+        for d in r.collision:
+            self.assertEqual(d.backend, "voxel-cut")
+            self.assertGreaterEqual(len(d.hulls), 1)
+            for h in d.hulls:
+                self.assertLessEqual(h.num_vertices, 64)
+        one = quick_options()
+        one.decompose.max_hulls = 1
+        for d in g2p.Pipeline(one).run_file(HAMMER).collision:
+            self.assertEqual(len(d.hulls), 1)
+
+    def test_python_decomposer(self):
+        decomposer = OneHullPerPart()
+        pipeline = g2p.Pipeline(quick_options())
+        pipeline.set_decomposer(decomposer)
+        r = pipeline.run_file(HAMMER)
+        self.assertEqual(decomposer.calls, len(r.parts))
+        for d in r.collision:
+            self.assertEqual(d.backend, "custom")
+            self.assertFalse(d.fell_back)
+            self.assertEqual(len(d.hulls), 1)
+
+    def test_failing_python_decomposer_falls_back_to_the_single_hull(self):
+        pipeline = g2p.Pipeline(quick_options())
+        pipeline.set_decomposer(Raises())
+        r = pipeline.run_file(HAMMER)
+        for d in r.collision:
+            self.assertTrue(d.fell_back)
+            self.assertEqual(d.backend, "hull")
+            self.assertEqual(len(d.hulls), 1)
+            self.assertIn("no hulls today", d.notes[-1])
+
+    def test_names_and_bad_input(self):
+        self.assertIn("voxel-cut", g2p.decomposer_names())
+        self.assertIn("hull", g2p.decomposer_names())
+        with self.assertRaises(g2p.NotFoundError):
+            g2p.make_decomposer("no-such-decomposer")
+        with self.assertRaises(ValueError):
+            g2p.make_decomposer("voxel-cut", {"resolution": "2"})
+        with self.assertRaises(g2p.NotFoundError):
+            g2p.Pipeline(quick_options(decomposer=g2p.BackendChoice("no-such-decomposer"))).run_file(HAMMER)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -115,12 +115,22 @@ struct ValidateArgs {
   double height = 0.2, seconds = 2.0;
   bool contact = false, fail_on_unstable = false;
   ContactCheckOptions contact_options;
+  std::vector<std::string> at;  // --at X,Y
   std::string json;
 };
 
 // `g2p validate DIR --contact`: the probe balls' table, optionally as JSON.
 int run_contact_check(const ValidateArgs& args, const std::string& mjcf) {
   ContactCheckOptions options = args.contact_options;
+  for (const std::string& xy : args.at) {
+    double x = 0, y = 0;
+    char rest = 0;
+    if (std::sscanf(xy.c_str(), "%lf,%lf%c", &x, &y, &rest) != 2 || !std::isfinite(x) || !std::isfinite(y)) {
+      std::cerr << "g2p validate: error: --at " << xy << ": expected X,Y in metres (the object's frame)\n";
+      return kExitUsage;
+    }
+    options.points.emplace_back(x, y);
+  }
   options.drop_height_m = args.height;
   Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, options);
   if (!c.ok()) {
@@ -265,7 +275,9 @@ void add_export_command(CLI::App& app, Command& run) {
   v->add_option("--seconds", vargs->seconds, "Simulated time, s (default 2)");
   v->add_flag("--contact", vargs->contact,
               "Contact check: fix the object, drop probe balls onto a grid over it and report where they rest");
-  v->add_option("--balls", vargs->contact_options.grid, "--contact: balls per side of the grid (default 5)");
+  v->add_option("--balls", vargs->contact_options.grid,
+                "--contact: balls per side of a grid over the object (default 5; 0: only --at)");
+  v->add_option("--at", vargs->at, "--contact: also drop a ball over X,Y (metres, object's frame; repeatable)");
   v->add_option("--ball-radius", vargs->contact_options.ball_radius_m,
                 "--contact: ball radius, m (default 2 % of the object's longest side, at least 5 mm)");
   v->add_option("--contact-seconds", vargs->contact_options.seconds, "--contact: simulated time, s (default 3)");

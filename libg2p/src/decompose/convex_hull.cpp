@@ -94,6 +94,11 @@ int farthest(const std::vector<Eigen::Vector3d>& p, const std::vector<int>& ids,
 }  // namespace
 
 Result<Mesh> convex_hull(const std::vector<Eigen::Vector3d>& points, int max_vertices) {
+  return detail::convex_hull_keeping(points, max_vertices, {});
+}
+
+Result<Mesh> detail::convex_hull_keeping(const std::vector<Eigen::Vector3d>& points, int max_vertices,
+                                         const std::vector<int>& keep) {
   for (const Eigen::Vector3d& p : points)
     if (!p.allFinite()) return Status::InvalidArgument("convex_hull: a point is not finite");
   std::vector<int> all(points.size());
@@ -118,6 +123,14 @@ Result<Mesh> convex_hull(const std::vector<Eigen::Vector3d>& points, int max_ver
     }));
     const Eigen::Vector3d normal = (P[s[1]] - P[s[0]]).cross(P[s[2]] - P[s[0]]).normalized();
     s.push_back(farthest(P, candidates, [&](const Eigen::Vector3d& q) { return std::abs((q - P[s[0]]).dot(normal)); }));
+    // The points the caller needs on the hull come next (up to half the
+    // budget), when they are vertices of the full hull.
+    for (int k : keep) {
+      if (static_cast<int>(s.size()) >= std::max(4, max_vertices / 2)) break;
+      if (std::find(candidates.begin(), candidates.end(), k) != candidates.end() &&
+          std::find(s.begin(), s.end(), k) == s.end())
+        s.push_back(k);
+    }
     detail::QhullHull current;
     for (;;) {
       if (!detail::run_qhull(interleave(P, s), false, current).ok()) break;  // flat start: keep the full hull

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "g2p/mesh.h"
 #include "g2p/status.h"
 
 namespace g2p::detail {
@@ -21,5 +22,12 @@ struct QhullHull {
 // `triangles` (Qhull's Qt), else only `vertices` and `planes` (merged facets).
 // Fails for fewer than 4 points, points on one plane or on a line.
 Status run_qhull(const std::vector<double>& xyz, bool triangulate, QhullHull& out);
+
+// convex_hull() with points that the reduction to `max_vertices` keeps
+// first (indices into `points`; up to half the budget, those that are
+// vertices of the full hull): the corners of a piece's cross-sections, so
+// that two neighbouring hulls meet on their common cut.
+Result<Mesh> convex_hull_keeping(const std::vector<Eigen::Vector3d>& points, int max_vertices,
+                                 const std::vector<int>& keep);
 
 }  // namespace g2p::detail

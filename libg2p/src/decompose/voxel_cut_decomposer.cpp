@@ -182,6 +182,35 @@ void clip(std::vector<Eigen::Vector3d>& poly, int axis, double value, double sig
   poly.swap(out);
 }
 
+// The points of a piece that lie on its cuts (the faces of its region
+// inside the grid), extreme in eight directions within each cut. A hull
+// reduced to a vertex budget keeps them, so that the two hulls on either
+// side of a cut both cover the same octagon of its cross-section and meet
+// there, rather than each retreating from the cut and leaving a crack.
+std::vector<int> cross_section_corners(const std::vector<Eigen::Vector3d>& points, const std::array<double, 6>& limits,
+                                       double cell_m) {
+  std::vector<int> keep;
+  const double tolerance = 1e-6 * cell_m;
+  for (int face = 0; face < 6; ++face) {
+    const double value = limits[static_cast<std::size_t>(face)];
+    if (!std::isfinite(value)) continue;  // the grid's border, not a cut
+    const int axis = face % 3, u = (axis + 1) % 3, v = (axis + 2) % 3;
+    constexpr int kDirections[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
+    for (const auto& d : kDirections) {
+      int best = -1;
+      double best_dot = -HUGE_VAL;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Eigen::Vector3d& q = points[i];
+        if (std::abs(q[axis] - value) > tolerance) continue;
+        const double dot = d[0] * q[u] + d[1] * q[v];
+        if (dot > best_dot) best_dot = dot, best = static_cast<int>(i);
+      }
+      if (best >= 0 && std::find(keep.begin(), keep.end(), best) == keep.end()) keep.push_back(best);
+    }
+  }
+  return keep;
+}
+
 class VoxelCutDecomposer : public Decomposer {
  public:
   Status configure(const BackendSettings& settings) override {
@@ -286,7 +315,8 @@ class VoxelCutDecomposer : public Decomposer {
     for (std::size_t L = 0; L < leaves.size(); ++L) {
       std::vector<Eigen::Vector3d>& p = points[L];
       if (p.empty()) continue;
-      Result<Mesh> hull = convex_hull(p, options.max_vertices_per_hull);
+      Result<Mesh> hull =
+          detail::convex_hull_keeping(p, options.max_vertices_per_hull, cross_section_corners(p, limits[L], g.cell_m));
       if (!hull.ok()) {
         // A sliver on one plane: give it half a cell of thickness each way
         // along the axis it is thinnest in.

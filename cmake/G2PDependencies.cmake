@@ -50,7 +50,7 @@ g2p_require(G2P_TINYXML_LIBRARY libtinyxml-dev)
 if(G2P_WITH_MUJOCO)
   find_package(mujoco 2.2 QUIET)
   if(NOT mujoco_FOUND)
-    message(WARNING "MuJoCo not found: building without the MuJoCo check (install 'libmujoco-dev libqhull-dev "
+    message(WARNING "MuJoCo not found: building without the MuJoCo check (install 'libmujoco-dev "
                     "libgl-dev libopengl-dev' for it, or pass -DG2P_WITH_MUJOCO=OFF to silence this).")
     set(G2P_WITH_MUJOCO OFF CACHE BOOL "Check exported MJCF files in MuJoCo" FORCE)
   endif()

@@ -21,13 +21,13 @@ core=(
   libeigen3-dev libassimp-dev libembree-dev libtbb-dev
   libopencv-dev libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libcurl4-openssl-dev
-  liburdfdom-dev
+  liburdfdom-dev libqhull-dev
 )
 # Tests, validation with real consumers, benchmarks, bindings.
 extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
-  libmujoco-dev libqhull-dev libgl-dev libopengl-dev
+  libmujoco-dev libgl-dev libopengl-dev
   liburdfdom-tools libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-onnx
 )

@@ -37,6 +37,19 @@ find_package(Threads REQUIRED)
 find_package(Qhull QUIET)
 g2p_require(Qhull_FOUND libqhull-dev)
 
+# The optional `hacd` decomposer (docs/decompose.md): Bullet's HACD library,
+# for comparison with `voxel-cut`. Found or not; shared builds only (a static
+# libg2p would have to find it for its consumers too).
+find_path(G2P_HACD_INCLUDE hacdHACD.h PATH_SUFFIXES bullet/HACD)
+find_library(G2P_HACD_LIBRARY NAMES HACD-float64)
+if(G2P_HACD_INCLUDE AND G2P_HACD_LIBRARY AND BUILD_SHARED_LIBS)
+  set(G2P_WITH_HACD ON)
+  message(STATUS "libg2p: the hacd decomposer with ${G2P_HACD_LIBRARY}")
+else()
+  set(G2P_WITH_HACD OFF)
+  message(STATUS "libg2p: no hacd decomposer (libbullet-extras-dev not found, or a static build)")
+endif()
+
 # URDF export goes through urdfdom's model and writer (which print with TinyXML 2.6).
 find_package(urdfdom QUIET)
 g2p_require(urdfdom_FOUND liburdfdom-dev)

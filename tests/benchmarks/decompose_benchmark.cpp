@@ -1,5 +1,5 @@
 // The decompose stage on the closed parts of shared assets: `voxel-cut`
-// (the default) against `hull` (one convex hull per part, what an engine
+// (the default) and `hacd` (when built with it) against `hull` (one convex hull per part, what an engine
 // does with a raw mesh: the reference of the same run). Each asset runs
 // through the pipeline up to the properties stage once (default options:
 // 11 views, pbr, smooth, partition, table); the benchmark then decomposes
@@ -32,6 +32,10 @@ const g2p::PipelineResult& completed(const std::string& name) {
 }
 
 void BM_Decompose(benchmark::State& state, const std::string& name, const std::string& backend) {
+  if (!g2p::decomposer_registry().contains(backend)) {
+    state.SkipWithError(("no backend " + backend + " in this build").c_str());
+    return;
+  }
   const g2p::PipelineResult& r = completed(name);
   std::unique_ptr<g2p::Decomposer> decomposer = std::move(*g2p::make_decomposer(backend));
   std::vector<g2p::ConvexDecomposition> out;
@@ -52,6 +56,9 @@ void BM_Decompose(benchmark::State& state, const std::string& name, const std::s
       ->Unit(benchmark::kMillisecond)                                                               \
       ->UseRealTime();                                                                              \
   BENCHMARK_CAPTURE(BM_Decompose, asset##_voxel_cut, std::string(#asset), std::string("voxel-cut")) \
+      ->Unit(benchmark::kMillisecond)                                                               \
+      ->UseRealTime();                                                                              \
+  BENCHMARK_CAPTURE(BM_Decompose, asset##_hacd, std::string(#asset), std::string("hacd"))           \
       ->Unit(benchmark::kMillisecond)                                                               \
       ->UseRealTime();
 

@@ -146,6 +146,27 @@ TEST(Decompose, BowlKeepsItsHollow) {
   }
 }
 
+TEST(Decompose, HacdWhenBuiltWithIt) {
+  if (!decomposer_registry().contains("hacd")) GTEST_SKIP() << "built without libbullet-extras-dev";
+  const Mesh bowl = test::bowl_mesh(0.1, 0.012);
+  const ConvexDecomposition one = run(bowl, "hull");
+  DecomposeOptions options;
+  options.max_hulls = 12;
+  const ConvexDecomposition d = run(bowl, "hacd", options);
+  EXPECT_FALSE(d.fell_back);
+  EXPECT_GT(d.hulls.size(), 1u);
+  EXPECT_LE(d.hulls.size(), 12u);
+  for (const Mesh& h : d.hulls) expect_convex(h);
+  EXPECT_LT(d.hulls_volume_m3, 0.9 * one.hulls_volume_m3);  // it does carve the hollow
+  EXPECT_LT(d.max_distance_m, 0.5 * one.max_distance_m);
+  // The hulls lie where the bowl is: HACD's normalisation is undone.
+  Eigen::AlignedBox3d box;
+  for (const Mesh& h : d.hulls) box.extend(bounds(h));
+  EXPECT_LT((box.min() - bounds(bowl).min()).norm(), 0.01);
+  EXPECT_LT((box.max() - bounds(bowl).max()).norm(), 0.01);
+  EXPECT_FALSE(make_decomposer("hacd", {{"triangles", "5"}}).ok());
+}
+
 TEST(Decompose, BudgetsAreHonoured) {
   const Mesh bowl = test::bowl_mesh(0.1, 0.012);
   DecomposeOptions options;

@@ -9,5 +9,6 @@ namespace g2p {
 
 std::unique_ptr<Decomposer> make_voxel_cut_decomposer();
 std::unique_ptr<Decomposer> make_hull_decomposer();
+std::unique_ptr<Decomposer> make_hacd_decomposer();  // only with G2P_WITH_HACD
 
 }  // namespace g2p

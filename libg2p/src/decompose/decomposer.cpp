@@ -26,6 +26,9 @@ Registry<Decomposer>& decomposer_registry() {
     auto* r = new Registry<Decomposer>();  // never destroyed: usable during static destruction
     (void)r->add("voxel-cut", &make_voxel_cut_decomposer);
     (void)r->add("hull", &make_hull_decomposer);
+#ifdef G2P_WITH_HACD
+    (void)r->add("hacd", &make_hacd_decomposer);
+#endif
     return r;
   }();
   return *registry;

@@ -144,6 +144,32 @@ TEST(VlmRefiner, AppliesAValidCorrectionAndSendsAWellFormedRequest) {
   EXPECT_EQ(notes(*r).find("sekret"), std::string::npos);
 }
 
+TEST(VlmRefiner, LeavesTheViewsAsTheyWere) {
+  // The refiner encodes each view it sends as PNG; that must not touch the
+  // caller's pixels (it once swapped red and blue in place, so the saved
+  // views turned blue and the next request sent the wrong colours).
+  const Scene s = hammer();
+  std::vector<ImageU8> before;
+  for (const View& v : s.views) before.push_back(v.rgb);
+  std::vector<std::string> first_images;
+  FakeVlmServer server([&](int, const json& request, httplib::Response& res) {
+    for (const json& part : request["messages"].back()["content"])
+      if (part["type"] == "image_url") {
+        first_images.push_back(part["image_url"]["url"].get<std::string>());
+        break;
+      }
+    FakeVlmServer::answer(res, kValid);
+  });
+  for (int round = 0; round < 2; ++round) ASSERT_TRUE(run(s, server.url()).ok());
+  for (std::size_t i = 0; i < s.views.size(); ++i) {
+    ASSERT_EQ(s.views[i].rgb.size(), before[i].size());
+    EXPECT_TRUE(std::equal(before[i].data(), before[i].data() + before[i].size(), s.views[i].rgb.data()))
+        << "view " << i << " changed";
+  }
+  ASSERT_EQ(first_images.size(), 2u);
+  EXPECT_EQ(first_images[0], first_images[1]);  // the same view, the same PNG, each time
+}
+
 TEST(VlmRefiner, RetriesAfter429) {
   const Scene s = hammer();
   FakeVlmServer server([](int attempt, const json&, httplib::Response& res) {

@@ -53,9 +53,14 @@ Result<std::string> encode_png(const ImageU8& image) {
   const int c = image.channels();
   if (image.empty() || (c != 1 && c != 3 && c != 4)) return Status::InvalidArgument("encode_png: bad image");
   try {
+    // A read-only view of the caller's pixels; the colour conversion writes a
+    // new matrix (converting into `src` itself would swap the caller's red
+    // and blue).
     const cv::Mat src(image.height(), image.width(), CV_8UC(c), const_cast<std::uint8_t*>(image.data()));
-    cv::Mat bgr = src;
-    if (c == 3)
+    cv::Mat bgr;
+    if (c == 1)
+      bgr = src;
+    else if (c == 3)
       cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
     else if (c == 4)
       cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGRA);

@@ -27,6 +27,19 @@ if(NOT last_output MATCHES "faces 104" OR NOT last_output MATCHES "steel_head")
   message(FATAL_ERROR "consumer printed unexpected output")
 endif()
 
+# The installed g2p runs from the prefix with no library path set (its run
+# path is relative) and turns the sample model into assets.
+if(EXISTS ${prefix}/bin/g2p)
+  set(ENV{LD_LIBRARY_PATH} "")
+  run(${prefix}/bin/g2p run ${G2P_SAMPLE_MODEL} -o ${G2P_WORK_DIR}/installed-run --overwrite -q --format mjcf)
+  if(NOT last_output MATCHES "2 parts")
+    message(FATAL_ERROR "the installed g2p printed unexpected output:\n${last_output}")
+  endif()
+  if(NOT EXISTS ${G2P_WORK_DIR}/installed-run/hammer.xml)
+    message(FATAL_ERROR "the installed g2p wrote no hammer.xml")
+  endif()
+endif()
+
 # A version the package cannot satisfy must be refused (SameMajorVersion).
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${G2P_CONSUMER_SOURCE} -B ${build}-v9 -DCMAKE_PREFIX_PATH=${prefix}
                         -DCONSUMER_G2P_VERSION=9.0

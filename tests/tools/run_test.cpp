@@ -95,6 +95,20 @@ TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
+TEST(ToolRun, ABadOutputFolderFailsBeforeAnyWork) {
+  const std::string dir = test::scratch_dir("ToolRunBadOutput");
+  test::write_file(dir + "/a_file", "not a folder");
+  const std::string decompose_set = " --decompose-set resolution=16";  // a cheap run if the check were late
+  for (const std::string& out : {dir + "/a_file", dir + "/a_file/sub"}) {
+    test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(out) + decompose_set);
+    EXPECT_EQ(r.exit_code, 2) << out << "\n" << r.err;
+    EXPECT_NE(r.err.find("-o "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("not a folder"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("render"), std::string::npos) << "the pipeline ran first: " << r.err;
+  }
+  EXPECT_EQ(test::read_file(dir + "/a_file"), "not a folder");  // untouched
+}
+
 TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
   const std::string dir = test::scratch_dir("ToolRunVlm");
   const std::string secret = "sk-test-secret-4711";
@@ -122,8 +136,11 @@ TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
 }
 
 // Ctrl-C during a run: exit code 130, nothing written, no temporary folder left.
-TEST(ToolRun, InterruptCancelsAndWritesNothing) {
-  const std::string dir = test::scratch_dir("ToolRunInterrupt");
+class ToolRunSignal : public ::testing::TestWithParam<int> {};
+
+TEST_P(ToolRunSignal, CancelsAndWritesNothing) {
+  const int signal = GetParam();
+  const std::string dir = test::scratch_dir("ToolRunSignal" + std::to_string(signal));
   const std::string out = dir + "/out", err = dir + "/err.txt";
   const std::string model = test::asset_path("SheenChair");  // several seconds: time to interrupt it
   posix_spawn_file_actions_t files;
@@ -142,16 +159,19 @@ TEST(ToolRun, InterruptCancelsAndWritesNothing) {
   while (test::read_file(err).find("render") == std::string::npos &&
          std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  ASSERT_EQ(::kill(pid, signal), 0);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status)) << test::read_file(err);
-  EXPECT_EQ(WEXITSTATUS(status), 130) << test::read_file(err);
-  EXPECT_NE(test::read_file(err).find("cancelled; nothing was written"), std::string::npos) << test::read_file(err);
-  std::vector<std::string> left;
+  EXPECT_EQ(WEXITSTATUS(status), 128 + signal) << test::read_file(err);
+  EXPECT_NE(test::read_file(err).find("nothing was written"), std::string::npos) << test::read_file(err);
+  std::vector<std::string> left;  // no output and no hidden temporary folder
   for (const auto& e : fs::directory_iterator(dir)) left.push_back(e.path().filename().string());
   EXPECT_EQ(left, std::vector<std::string>{"err.txt"});
 }
+
+// Ctrl-C, and TERM as `timeout`, CI runners and containers send it.
+INSTANTIATE_TEST_SUITE_P(IntAndTerm, ToolRunSignal, ::testing::Values(SIGINT, SIGTERM));
 
 TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {
   test::ToolRun r = test::run_tool("run --help");

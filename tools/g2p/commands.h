@@ -10,9 +10,10 @@ namespace g2p::cli {
 // Documented exit codes of every subcommand.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,      // the library reported an error (bad input file, ...)
-  kExitUsage = 2,        // bad command line
-  kExitCancelled = 130,  // interrupted (Ctrl-C); nothing was written
+  kExitFailure = 1,       // the library reported an error (bad input file, ...)
+  kExitUsage = 2,         // bad command line
+  kExitCancelled = 130,   // interrupted (Ctrl-C); nothing was written
+  kExitTerminated = 143,  // terminated (SIGTERM); nothing was written
 };
 
 // Adds a subcommand; the returned function runs it after parsing.

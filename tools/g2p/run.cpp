@@ -36,10 +36,13 @@ struct RunArgs {
   bool fixed = false, anonymize = false, overwrite = false, intermediates = false, json = false, quiet = false;
 };
 
-// The run's context, reachable from the SIGINT handler (cancel() is a
-// lock-free atomic store).
+// The run's context, reachable from the SIGINT and SIGTERM handler (cancel()
+// is a lock-free atomic store). TERM is what `timeout`, CI runners and
+// containers send; both end the run cleanly, with nothing half-written.
 RunContext* g_context = nullptr;
-extern "C" void on_interrupt(int) {
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void on_interrupt(int signal) {
+  g_signal = signal;
   if (g_context != nullptr) g_context->cancel();
 }
 
@@ -80,8 +83,11 @@ int run_pipeline(const RunArgs& args) {
 #if defined(G2P_CLI_WITH_CGAL)
   (void)register_cgal_completers();
 #endif
-  if (fs::exists(args.out) && !args.overwrite)
+  if (fs::exists(args.out) && fs::is_directory(args.out) && !args.overwrite)
     return usage(args.out + " exists; choose another folder or pass --overwrite (replaced only once the run succeeds)");
+  OutputOptions folder;
+  folder.overwrite = args.overwrite;
+  if (Status s = check_output_folder(args.out, folder); !s.ok()) return usage("-o " + s.message());
 
   PipelineOptions o;
   Result<ImportOptions> import = import_options(args.import);
@@ -143,6 +149,7 @@ int run_pipeline(const RunArgs& args) {
   RunContext context([&printer](const Progress& p) { printer(p); });
   g_context = &context;
   auto previous = std::signal(SIGINT, on_interrupt);
+  auto previous_term = std::signal(SIGTERM, on_interrupt);
   Result<PipelineResult> result = pipeline.run_file(args.model, &context);
   Status written = result.ok() ? Status::Ok() : result.status();
   if (result.ok() && !context.cancelled()) {
@@ -152,11 +159,12 @@ int run_pipeline(const RunArgs& args) {
     written = write_pipeline_output(args.out, *result, o, out);
   }
   std::signal(SIGINT, previous);
+  std::signal(SIGTERM, previous_term);
   g_context = nullptr;
   if (context.cancelled() && !(result.ok() && written.ok())) {
     printer.end_line();
-    std::cerr << "g2p run: cancelled; nothing was written\n";
-    return kExitCancelled;
+    std::cerr << "g2p run: cancelled" << (g_signal == SIGTERM ? " (SIGTERM)" : "") << "; nothing was written\n";
+    return g_signal == SIGTERM ? kExitTerminated : kExitCancelled;
   }
   if (context.cancelled())  // the interrupt came while the folder was being written: it is complete
     std::cerr << "g2p run: interrupted after the run; the output is complete\n";
@@ -215,7 +223,7 @@ void add_run_command(CLI::App& app, Command& run) {
   add_decomposer_flags(cmd, args->decomposer);
   cmd->footer(
       "Exit codes: 0 success, 1 the run failed (bad input file, a stage error), 2 bad command line, 130 cancelled "
-      "(Ctrl-C). Nothing is written unless the run succeeds.");
+      "(Ctrl-C), 143 terminated (SIGTERM). Nothing is written unless the run succeeds.");
   cmd->callback([args, &run] { run = [args] { return run_pipeline(*args); }; });
 }
 

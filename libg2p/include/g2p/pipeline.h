@@ -221,6 +221,12 @@ struct OutputOptions {
 G2P_API Status write_pipeline_output(const std::string& dir, const PipelineResult& result,
                                      const PipelineOptions& options = {}, const OutputOptions& output = {});
 
+// Whether write_pipeline_output could write `dir`, checked before a run so
+// that a bad folder fails at once, not after the work: `dir` must not exist
+// (unless output.overwrite, and then it must be a folder), and the nearest
+// existing folder above it must be writable. The message names the folder.
+G2P_API Status check_output_folder(const std::string& dir, const OutputOptions& output = {});
+
 // The machine-readable summary (run.json, `g2p run --json`): stages with
 // time and memory, parts with class, mass and volume, totals, warnings.
 G2P_API std::string pipeline_summary_json(const PipelineResult& result, const PipelineOptions& options = {});

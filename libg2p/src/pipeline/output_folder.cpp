@@ -2,8 +2,10 @@
 // into it, and its machine-readable summary (run.json).
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -133,18 +135,46 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
 
 }  // namespace
 
+namespace {
+
+fs::path final_folder(const std::string& dir) {
+  std::error_code ec;
+  const fs::path target = fs::absolute(fs::path(dir).lexically_normal(), ec);
+  return target.filename().empty() ? target.parent_path() : target;
+}
+
+}  // namespace
+
+Status check_output_folder(const std::string& dir, const OutputOptions& output) {
+  if (dir.empty()) return Status::InvalidArgument("no output folder given");
+  std::error_code ec;
+  const fs::path final_dir = final_folder(dir);
+  if (fs::exists(final_dir, ec) && !fs::is_directory(final_dir, ec))
+    return Status::InvalidArgument(final_dir.string() + ": exists and is not a folder");
+  if (fs::exists(final_dir, ec) && !output.overwrite)
+    return Status::InvalidArgument(final_dir.string() + ": exists; choose another folder or allow overwriting");
+  fs::path above = final_dir.parent_path();
+  while (!above.empty() && !fs::exists(above, ec) && above != above.parent_path()) above = above.parent_path();
+  if (!fs::is_directory(above, ec))
+    return Status::InvalidArgument(above.string() + ": is not a folder, so " + final_dir.string() + " cannot be made");
+  // Permissions alone do not tell (root, read-only mounts, pseudo file
+  // systems): make and remove an empty folder where the output will go.
+  std::string probe = (above / ".g2p-probe-XXXXXX").string();
+  if (::mkdtemp(probe.data()) == nullptr)
+    return Status::IoError(above.string() + ": cannot write here (" + std::strerror(errno) + "), so " +
+                           final_dir.string() + " cannot be made");
+  fs::remove(probe, ec);
+  return Status::Ok();
+}
+
 Status write_pipeline_output(const std::string& dir, const PipelineResult& result, const PipelineOptions& options,
                              const OutputOptions& output) {
   if (dir.empty()) return Status::InvalidArgument("write_pipeline_output: no output folder given");
   if (result.views.empty() || result.asset.parts.empty())
     return Status::InvalidArgument("write_pipeline_output: the result is incomplete (did the run succeed?)");
   std::error_code ec;
-  const fs::path target = fs::absolute(fs::path(dir).lexically_normal(), ec);
-  const fs::path final_dir = target.filename().empty() ? target.parent_path() : target;
-  if (fs::exists(final_dir, ec) && !output.overwrite)
-    return Status::InvalidArgument(final_dir.string() + ": exists; choose another folder or allow overwriting");
-  if (fs::exists(final_dir, ec) && !fs::is_directory(final_dir, ec))
-    return Status::InvalidArgument(final_dir.string() + ": exists and is not a folder");
+  const fs::path final_dir = final_folder(dir);
+  G2P_RETURN_IF_ERROR(check_output_folder(dir, output));
   const fs::path parent = final_dir.parent_path();
   G2P_RETURN_IF_ERROR(detail::ensure_directory(parent.string()));
   const std::string tag = "." + final_dir.filename().string() + ".g2p-" + std::to_string(::getpid());

@@ -274,6 +274,25 @@ TEST(VlmRefiner, UnreachableServerAndBadSettings) {
   EXPECT_NE(unconfigured.status().message().find("model=NAME"), std::string::npos) << unconfigured.status().to_string();
 }
 
+TEST(VlmHelpers, RedactUrl) {
+  EXPECT_EQ(redact_url("http://127.0.0.1:8000/v1"), "http://127.0.0.1:8000/v1");
+  EXPECT_EQ(redact_url("https://user:pass@host/v1"), "https://***@host/v1");
+  EXPECT_EQ(redact_url("https://host/v1?key=abc&api-version=2&flag"), "https://host/v1?key=***&api-version=***&flag");
+  EXPECT_EQ(redact_url("https://u@host:443/p?token=t#frag"), "https://***@host:443/p?token=***#frag");
+  EXPECT_EQ(redact_url("https://host/a@b"), "https://host/a@b");  // an @ in the path is no user
+}
+
+TEST(VlmRefiner, AKeyInTheUrlReachesTheServerAndNoMessage) {
+  const Scene s = hammer();
+  FakeVlmServer server([&](int, const json&, httplib::Response& res) { res.status = 503; });
+  Result<RefineResult> r = run(s, server.url() + "?key=qk-secret-99", {{"retries", "0"}});
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_TRUE(r->fell_back);
+  EXPECT_EQ(server.attempts(), 1);  // the endpoint's path went before the query: the server was reached
+  EXPECT_EQ(notes(*r).find("qk-secret-99"), std::string::npos) << notes(*r);
+  EXPECT_NE(notes(*r).find("chat/completions?key=***"), std::string::npos) << notes(*r);
+}
+
 TEST(VlmHelpers, JsonExtractionAndBase64) {
   EXPECT_EQ(*extract_json_object("reasoning...\n```json\n{\"a\": 1}\n```\n"), "\n{\"a\": 1}\n");
   EXPECT_EQ(*extract_json_object("first {\"x\": {\"y\": 2}} then {\"z\": 3} done"), "{\"z\": 3}");

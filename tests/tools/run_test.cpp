@@ -114,7 +114,8 @@ TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
   const std::string secret = "sk-test-secret-4711";
   ::setenv("G2P_TEST_VLM_KEY", secret.c_str(), 1);
   test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + kQuick +
-                                   " --refiner vlm --vlm-url http://127.0.0.1:9/v1 --vlm-model test"
+                                   " --refiner vlm --vlm-url 'http://me:pw-4711@127.0.0.1:9/v1?key=qk-4711'"
+                                   " --vlm-model test"
                                    " --refine-set retries=0 --refine-set timeout=5"
                                    " --refine-set api_key_env=G2P_TEST_VLM_KEY --estimator vlm"
                                    " --estimate-set retries=0 --estimate-set api_key_env=G2P_TEST_VLM_KEY");
@@ -128,11 +129,15 @@ TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
   EXPECT_EQ(j["parts"].size(), 2u);
   const nlohmann::json refine = nlohmann::json::parse(test::read_file(dir + "/out/refine.json"));
   EXPECT_TRUE(refine.contains("error"));
-  // The key's value never reaches the output or any file.
-  EXPECT_EQ(r.out.find(secret), std::string::npos);
-  EXPECT_EQ(r.err.find(secret), std::string::npos);
-  for (const auto& e : fs::recursive_directory_iterator(dir + "/out"))
-    if (e.is_regular_file()) EXPECT_EQ(test::read_file(e.path().string()).find(secret), std::string::npos) << e.path();
+  // The key's value, and a password or key in the URL, never reach the
+  // output or any file; the URL is shown redacted.
+  EXPECT_NE(r.err.find("http://***@127.0.0.1:9/v1/chat/completions?key=***"), std::string::npos) << r.err;
+  for (const std::string& s : {secret, std::string("pw-4711"), std::string("qk-4711")}) {
+    EXPECT_EQ(r.out.find(s), std::string::npos) << s;
+    EXPECT_EQ(r.err.find(s), std::string::npos) << s;
+    for (const auto& e : fs::recursive_directory_iterator(dir + "/out"))
+      if (e.is_regular_file()) EXPECT_EQ(test::read_file(e.path().string()).find(s), std::string::npos) << e.path();
+  }
 }
 
 // Ctrl-C during a run: exit code 130, nothing written, no temporary folder left.

@@ -57,4 +57,9 @@ G2P_API Result<std::string> extract_json_object(const std::string& answer);
 // Base64 (RFC 4648), for data URLs.
 G2P_API std::string base64_encode(const std::string& bytes);
 
+// A URL as it may be shown or written: user and password (`user:pw@`) and
+// every query value (`?key=...`) replaced by `***`. Messages, run.json,
+// refine.json and summary.html carry only this form.
+G2P_API std::string redact_url(const std::string& url);
+
 }  // namespace g2p

@@ -107,8 +107,14 @@ class OpenAiClient final : public VlmClient {
     messages.push_back({{"role", "user"}, {"content", content}});
     const std::string payload =
         json{{"model", o_.model}, {"temperature", o_.temperature}, {"messages", messages}}.dump();
-    const std::string url =
-        o_.base_url + (o_.base_url.empty() || o_.base_url.back() != '/' ? "/" : "") + "chat/completions";
+    // The endpoint's path goes before any query string (`.../v1?key=K` ->
+    // `.../v1/chat/completions?key=K`); messages show the URL redacted.
+    const std::size_t query = o_.base_url.find_first_of("?#");
+    std::string base = o_.base_url.substr(0, query);
+    const std::string tail = query == std::string::npos ? "" : o_.base_url.substr(query);
+    if (base.empty() || base.back() != '/') base += '/';
+    const std::string url_with_secrets = base + "chat/completions" + tail;
+    const std::string url = redact_url(url_with_secrets);
 
     double wait_s = o_.backoff_s;  // before the next attempt: backoff, 2 backoff, 4 backoff... or Retry-After
     std::string last_error;
@@ -125,7 +131,7 @@ class OpenAiClient final : public VlmClient {
         const std::string auth = std::string("Authorization: Bearer ") + key;
         headers = curl_slist_append(headers, auth.c_str());  // copied by curl; never logged
       }
-      curl_easy_setopt(curl, CURLOPT_URL, url.c_str());
+      curl_easy_setopt(curl, CURLOPT_URL, url_with_secrets.c_str());
       curl_easy_setopt(curl, CURLOPT_HTTPHEADER, headers);
       curl_easy_setopt(curl, CURLOPT_POSTFIELDS, payload.c_str());
       curl_easy_setopt(curl, CURLOPT_POSTFIELDSIZE_LARGE, static_cast<curl_off_t>(payload.size()));
@@ -174,10 +180,37 @@ class OpenAiClient final : public VlmClient {
 
 }  // namespace
 
+std::string redact_url(const std::string& url) {
+  std::string out = url;
+  const std::size_t scheme = out.find("://");
+  const std::size_t host = scheme == std::string::npos ? 0 : scheme + 3;
+  const std::size_t path = out.find_first_of("/?#", host);
+  const std::size_t at = out.rfind('@', path == std::string::npos ? std::string::npos : path);
+  if (at != std::string::npos && at >= host) out.replace(host, at - host, "***");
+  const std::size_t query = out.find('?');
+  if (query == std::string::npos) return out;
+  const std::size_t fragment = out.find('#', query);
+  std::string redacted = out.substr(0, query + 1);
+  const std::string params =
+      out.substr(query + 1, fragment == std::string::npos ? std::string::npos : fragment - query - 1);
+  std::size_t start = 0;
+  while (start <= params.size()) {
+    const std::size_t end = std::min(params.find('&', start), params.size());
+    const std::string param = params.substr(start, end - start);
+    const std::size_t eq = param.find('=');
+    redacted += eq == std::string::npos ? param : param.substr(0, eq + 1) + "***";
+    if (end < params.size()) redacted += '&';
+    start = end + 1;
+  }
+  if (fragment != std::string::npos) redacted += out.substr(fragment);
+  return redacted;
+}
+
 Result<std::unique_ptr<VlmClient>> make_openai_client(const OpenAiClientOptions& options) {
   if (options.model.empty()) return Status::InvalidArgument("vlm: a model name is needed");
   if (options.base_url.rfind("http://", 0) != 0 && options.base_url.rfind("https://", 0) != 0)
-    return Status::InvalidArgument("vlm: base URL must start with http:// or https://, got '" + options.base_url + "'");
+    return Status::InvalidArgument("vlm: base URL must start with http:// or https://, got '" +
+                                   redact_url(options.base_url) + "'");
   if (!(options.timeout_s >= 0.001 && options.timeout_s <= 86400.0) || options.retries < 0 || options.retries > 10 ||
       options.max_response_bytes == 0 || !(options.backoff_s >= 0.0 && options.backoff_s <= 3600.0))
     return Status::InvalidArgument(

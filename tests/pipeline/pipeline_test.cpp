@@ -76,6 +76,34 @@ TEST(Pipeline, TurnsTheHammerIntoAWoodenHandleAndASteelHead) {
     EXPECT_TRUE(std::any_of(seen.begin(), seen.end(), [&](const Progress& p) { return p.stage == s; })) << to_string(s);
 }
 
+TEST(Pipeline, WarnsOfAnImplausibleSizeAndOfPartsLeftOut) {
+  Pipeline pipeline(quick_options());
+  Result<PipelineResult> plain = pipeline.run_file(hammer());
+  ASSERT_TRUE(plain.ok()) << plain.status().to_string();
+  EXPECT_TRUE(plain->warnings.empty());  // a 0.34 m, 1.4 kg hammer is plausible
+
+  // The same hammer read as if its file were in centimetres but taken as metres: 34 m.
+  ImportOptions hundredfold;
+  hundredfold.unit_scale = 100.0;
+  PipelineOptions o = quick_options();
+  o.import = hundredfold;
+  Result<PipelineResult> big = Pipeline(o).run_file(hammer());
+  ASSERT_TRUE(big.ok()) << big.status().to_string();
+  ASSERT_EQ(big->warnings.size(), 1u);
+  EXPECT_NE(big->warnings[0].find("--unit"), std::string::npos) << big->warnings[0];
+  EXPECT_NE(big->warnings[0].find("34 m long"), std::string::npos) << big->warnings[0];
+
+  // Debian's spider (centimetres in an OBJ, so about 190 m): many thin parts
+  // get no closed volume, and the warning names them.
+  Result<PipelineResult> spider = pipeline.run_file(test::assimp_model("OBJ/spider.obj"));
+  ASSERT_TRUE(spider.ok()) << spider.status().to_string();
+  std::string all;
+  for (const std::string& w : spider->warnings) all += w + "\n";
+  EXPECT_NE(all.find("parts are left out of the asset"), std::string::npos) << all;
+  EXPECT_NE(all.find("--unit"), std::string::npos) << all;
+  EXPECT_LT(spider->asset.parts.size(), spider->projection.parts.size());
+}
+
 TEST(Pipeline, IsDeterministic) {
   Pipeline pipeline(quick_options());
   Result<PipelineResult> a = pipeline.run_file(hammer());

@@ -1,5 +1,6 @@
 // Pipeline: the six stages of Gen2Physics (paper, Method) run in order on one
 // model, each through its backend interface.
+#include <cstdio>
 #include <filesystem>
 #include <utility>
 
@@ -45,6 +46,37 @@ Status prepare_slot(Slot<Interface>& slot, const BackendChoice& choice, const ch
   slot.made = std::move(*made);
   slot.made_from = key;
   return Status::Ok();
+}
+
+// Warnings a user should not miss in the finished asset: parts left out of
+// it, and an object far larger or heavier (or smaller) than anything
+// household or industrial, which almost always means a file in other units.
+void plausibility_warnings(PipelineResult& r) {
+  std::vector<bool> exported(r.projection.parts.size(), false);
+  for (const AssetPart& p : r.asset.parts)
+    if (p.part >= 0 && p.part < static_cast<int>(exported.size())) exported[static_cast<std::size_t>(p.part)] = true;
+  std::string missing;
+  int left_out = 0;
+  for (std::size_t i = 0; i < exported.size(); ++i) {
+    if (exported[i]) continue;
+    if (++left_out <= 12) missing += (missing.empty() ? "" : ", ") + std::to_string(i);
+  }
+  if (left_out > 0)
+    r.warnings.push_back("export: " + std::to_string(left_out) + " of " + std::to_string(exported.size()) +
+                         " parts are left out of the asset (no closed volume or no mass): part " + missing +
+                         (left_out > 12 ? ", ..." : "") + "; report.json's notes say why for each");
+  const double longest = bounds(r.model.mesh).sizes().maxCoeff();
+  const double mass = r.asset.total.mass_kg;
+  char what[160];
+  std::snprintf(what, sizeof what, "%.3g kg and %.3g m long", mass, longest);
+  if (longest > 30.0 || mass > 50000.0)
+    r.warnings.push_back(std::string("the object is ") + what +
+                         ", far beyond household and industrial objects: is the file in centimetres or "
+                         "millimetres? Give its unit (g2p run --unit cm or --unit mm; ImportOptions::unit_scale)");
+  else if (longest < 0.005 || mass < 1e-4)
+    r.warnings.push_back(std::string("the object is ") + what +
+                         ", smaller than anything it is likely to be: is the file in another unit? Give its "
+                         "unit (g2p run --unit; ImportOptions::unit_scale)");
 }
 
 }  // namespace
@@ -310,6 +342,7 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     if (!asset.ok()) return asset.status().with_context("export");
     r.asset = std::move(*asset);
     clock.report().notes = r.asset.notes;
+    plausibility_warnings(r);
     G2P_RETURN_IF_ERROR(context.report(Stage::kExport, 1.0, r.asset.name));
     finish(clock);
   }

@@ -62,7 +62,8 @@ void bind_decompose(py::module_& m) {
 
   py::class_<ConvexDecomposition>(m, "ConvexDecomposition", "One part's collision geometry: convex hulls.")
       .def(py::init<>())
-      .def_readwrite("hulls", &ConvexDecomposition::hulls, "list of g2p.Mesh, each closed and convex")
+      .def_readwrite("hulls", &ConvexDecomposition::hulls,
+                     "list of g2p.Mesh, each closed and convex (a copy: assign a new list to change it)")
       .def_readwrite("backend", &ConvexDecomposition::backend)
       .def_readwrite("fell_back", &ConvexDecomposition::fell_back)
       .def_readwrite("part_volume_m3", &ConvexDecomposition::part_volume_m3)

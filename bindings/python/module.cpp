@@ -13,7 +13,7 @@ namespace g2p::python {
 
 namespace {
 
-constexpr int kNumCodes = static_cast<int>(StatusCode::kInternal) + 1;
+constexpr int kNumCodes = static_cast<int>(StatusCode::kOutOfMemory) + 1;
 
 // The exception class of each StatusCode (index = code). Owned by the module
 // object; these handles are borrowed for the interpreter's lifetime.
@@ -52,6 +52,8 @@ void bind_errors(py::module_& m) {
   sub(StatusCode::kUnavailable, "UnavailableError", py::handle(),
       "An optional service (network, model) could not be reached.");
   sub(StatusCode::kInternal, "InternalError", py::handle(), "A bug or an unexpected failure inside libg2p.");
+  sub(StatusCode::kOutOfMemory, "OutOfMemoryError", PyExc_MemoryError,
+      "The work needs more memory than the limit (PipelineOptions.memory_limit_bytes) or the machine has.");
 
   py::register_exception_translator([](std::exception_ptr p) {
     try {
@@ -132,7 +134,8 @@ PYBIND11_MODULE(g2p, m) {
       .value("UNSUPPORTED", g2p::StatusCode::kUnsupported)
       .value("CANCELLED", g2p::StatusCode::kCancelled)
       .value("UNAVAILABLE", g2p::StatusCode::kUnavailable)
-      .value("INTERNAL", g2p::StatusCode::kInternal);
+      .value("INTERNAL", g2p::StatusCode::kInternal)
+      .value("OUT_OF_MEMORY", g2p::StatusCode::kOutOfMemory);
   bind_errors(m);
 
   bind_core(m);

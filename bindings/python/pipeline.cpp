@@ -257,6 +257,8 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("completer", &PipelineOptions::completer)
       .def_readwrite("completion_fallback", &PipelineOptions::completion_fallback, "'' = none")
       .def_readwrite("estimator", &PipelineOptions::estimator)
+      .def_readwrite("memory_limit_bytes", &PipelineOptions::memory_limit_bytes,
+                     "refuse runs needing more; 0 = the machine's memory")
       .def_readwrite("decomposer", &PipelineOptions::decomposer, "decompose backend: voxel-cut (default), hull")
       .def_readwrite("decompose", &PipelineOptions::decompose, "g2p.DecomposeOptions")
       .def_readwrite("name", &PipelineOptions::name, "the asset's name ('' = the file's stem)")

@@ -282,6 +282,14 @@ class ErrorsAndCancellationTest(unittest.TestCase):
         with self.assertRaises(g2p.NotFoundError):
             g2p.make_refiner("no-such-refiner")
 
+    def test_too_little_memory_is_a_memory_error(self):
+        with self.assertRaises(g2p.OutOfMemoryError) as caught:
+            g2p.Pipeline(quick_options(memory_limit_bytes=1000)).run_file(HAMMER)
+        self.assertIsInstance(caught.exception, MemoryError)
+        self.assertIsInstance(caught.exception, g2p.Error)
+        self.assertEqual(caught.exception.code, g2p.StatusCode.OUT_OF_MEMORY)
+        self.assertIn("--resolution", str(caught.exception))
+
     def test_bad_setting_is_a_value_error(self):
         with self.assertRaises(ValueError) as caught:
             g2p.make_refiner("smooth", {"no_such_key": "1"})
@@ -482,6 +490,7 @@ class ModelsAndStagesTest(unittest.TestCase):
         pipeline.options.views.width = 100
         self.assertEqual(pipeline.options.views.width, 100)
         self.assertEqual(pipeline.options.refiner.name, "none")
+
 
 class OneHullPerPart(g2p.Decomposer):
     """A Python decomposer: the convex hull of the part's vertices, as points."""

@@ -109,6 +109,27 @@ TEST(ToolRun, ABadOutputFolderFailsBeforeAnyWork) {
   EXPECT_EQ(test::read_file(dir + "/a_file"), "not a folder");  // untouched
 }
 
+TEST(ToolRun, TooLittleMemoryIsACleanErrorNotACrash) {
+  const std::string dir = test::scratch_dir("ToolRunMemory");
+  // Refused before any work: 11 views of 512 x 512 need about half a GiB.
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + " --memory-limit 0.1");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("out of memory"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--resolution"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("render done"), std::string::npos) << "the run started: " << r.err;
+  // An allocation that fails anyway (a 1.2 GB address space for 2048-pixel
+  // views) ends the run with the same message and exit code, not an abort.
+  const std::string err = dir + "/err.txt";
+  const std::string command = "ulimit -v 1200000; exec " + test::quote(G2P_TEST_TOOL) + " run " + hammer() + " -o " +
+                              test::quote(dir + "/out") + " --resolution 2048 --memory-limit 100 -q 2>" +
+                              test::quote(err);
+  const int status = std::system(("sh -c " + test::quote(command)).c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << test::read_file(err);
+  EXPECT_EQ(WEXITSTATUS(status), 1) << test::read_file(err);
+  EXPECT_NE(test::read_file(err).find("out of memory"), std::string::npos) << test::read_file(err);
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 TEST(ToolRun, AnUnreachableVlmDegradesToTheProjectedLabelsAndTheTable) {
   const std::string dir = test::scratch_dir("ToolRunVlm");
   const std::string secret = "sk-test-secret-4711";

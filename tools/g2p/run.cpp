@@ -34,6 +34,7 @@ struct RunArgs {
   std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
   bool soft = false;  // soft votes in the project stage
   bool fixed = false, anonymize = false, overwrite = false, intermediates = false, json = false, quiet = false;
+  double memory_limit_gib = 0.0;
 };
 
 // The run's context, reachable from the SIGINT and SIGTERM handler (cancel()
@@ -128,6 +129,8 @@ int run_pipeline(const RunArgs& args) {
   }
   o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
   o.decompose = args.decomposer.options;
+  if (!(args.memory_limit_gib >= 0)) return usage("--memory-limit must be 0 (the machine's memory) or more GiB");
+  o.memory_limit_bytes = static_cast<std::size_t>(args.memory_limit_gib * 1024.0 * 1024.0 * 1024.0);
   if (Status valid = validate(o.decompose); !valid.ok()) return usage(valid.message());
   o.formats = args.formats;
   o.name = args.name;
@@ -214,6 +217,8 @@ void add_run_command(CLI::App& app, Command& run) {
                 "Also write every view's buffers, per-view probabilities, per-face votes and part patches");
   cmd->add_flag("--json", args->json, "Print the run's summary (run.json) on stdout instead of text");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+  cmd->add_option("--memory-limit", args->memory_limit_gib,
+                  "Refuse a run whose views and mesh would need more memory, in GiB (default 0: the machine's)");
   add_import_flags(cmd, args->import);
   add_view_flags(cmd, args->views);
   add_segmenter_flags(cmd, args->segmenter);

@@ -124,6 +124,13 @@ struct PipelineOptions {
   // kExport has no asset and cannot be written as an output folder.
   Stage last_stage = Stage::kExport;  // kRender ... kExport
 
+  // The most memory a run may plan to use, in bytes; 0: this machine's
+  // physical memory (or the process's address-space limit, if lower). A run
+  // whose views, label maps and mesh would need more (estimate_run_memory)
+  // is refused before any work with kOutOfMemory, and an allocation that
+  // fails anyway ends the run with kOutOfMemory, never an exception.
+  std::size_t memory_limit_bytes = 0;
+
   // Measure each stage's peak resident memory by resetting the process's
   // high-water mark (Linux /proc/self/clear_refs) before it. Off: the
   // process's peak so far is reported instead.
@@ -165,6 +172,12 @@ struct G2P_API PipelineResult {
   const StageReport* stage(Stage s) const;  // null if it did not run
 };
 
+// What a run of `options` on a mesh of `triangles` will hold at its peak, in
+// bytes, roughly: about 100 bytes per pixel of every view (its buffers and
+// its label map with class probabilities) and 1 KiB per triangle (the mesh,
+// face graph, votes and closed volumes).
+G2P_API std::size_t estimate_run_memory(const PipelineOptions& options, std::size_t triangles);
+
 // ---- The pipeline -------------------------------------------------------------
 
 class G2P_API Pipeline {
@@ -198,6 +211,7 @@ class G2P_API Pipeline {
   Result<PipelineResult> run_file(const std::string& path, RunContext* context = nullptr);
 
  private:
+  Result<PipelineResult> run_unguarded(Model model, RunContext* context);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -22,6 +22,7 @@ enum class StatusCode {
   kCancelled,        // the caller cancelled the operation
   kUnavailable,      // an optional service (network, model) could not be reached
   kInternal,         // a bug or an unexpected failure inside libg2p
+  kOutOfMemory,      // the work needs more memory than the limit or the machine has
 };
 
 // Stable lower-case name of a code, e.g. "parse error".
@@ -41,6 +42,7 @@ class [[nodiscard]] G2P_API Status {
   static Status Cancelled(std::string m) { return {StatusCode::kCancelled, std::move(m)}; }
   static Status Unavailable(std::string m) { return {StatusCode::kUnavailable, std::move(m)}; }
   static Status Internal(std::string m) { return {StatusCode::kInternal, std::move(m)}; }
+  static Status OutOfMemory(std::string m) { return {StatusCode::kOutOfMemory, std::move(m)}; }
 
   bool ok() const { return code_ == StatusCode::kOk; }
   StatusCode code() const { return code_; }

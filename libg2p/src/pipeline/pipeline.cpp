@@ -1,7 +1,12 @@
 // Pipeline: the six stages of Gen2Physics (paper, Method) run in order on one
 // model, each through its backend interface.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 #include <utility>
 
 #include "g2p/pipeline.h"
@@ -349,7 +354,44 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   return Status::Ok();
 }
 
+std::size_t estimate_run_memory(const PipelineOptions& o, std::size_t triangles) {
+  const std::size_t pixels = static_cast<std::size_t>(std::max(0, o.views.num_views)) *
+                             static_cast<std::size_t>(std::max(0, o.views.width)) *
+                             static_cast<std::size_t>(std::max(0, o.views.height));
+  return pixels * 100 + triangles * 1024 + (std::size_t{200} << 20);  // plus the process itself
+}
+
+namespace {
+
+// The memory a run may use: the option, else physical memory or the
+// address-space limit, whichever is lower.
+std::size_t memory_limit(const PipelineOptions& o) {
+  if (o.memory_limit_bytes > 0) return o.memory_limit_bytes;
+  std::size_t limit =
+      static_cast<std::size_t>(::sysconf(_SC_PHYS_PAGES)) * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  rlimit as{};
+  if (::getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY)
+    limit = std::min(limit, static_cast<std::size_t>(as.rlim_cur));
+  return limit;
+}
+
+std::string gib(std::size_t bytes) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f GiB", static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0));
+  return b;
+}
+
+}  // namespace
+
 Result<PipelineResult> Pipeline::run(Model model, RunContext* context) {
+  try {
+    return run_unguarded(std::move(model), context);
+  } catch (const std::bad_alloc&) {
+    return Status::OutOfMemory("the run ran out of memory; lower --resolution or --views, or run with more memory");
+  }
+}
+
+Result<PipelineResult> Pipeline::run_unguarded(Model model, RunContext* context) {
   const auto start = std::chrono::steady_clock::now();
   RunContext local;
   RunContext& ctx = context != nullptr ? *context : local;
@@ -357,6 +399,14 @@ Result<PipelineResult> Pipeline::run(Model model, RunContext* context) {
   if (model.mesh.num_faces() == 0)
     return Status::InvalidArgument(
         "pipeline: " + (model.info.path.empty() ? std::string("the model") : model.info.path) + " has no triangles");
+  const std::size_t need = estimate_run_memory(impl_->options, model.mesh.triangles.size());
+  const std::size_t limit = memory_limit(impl_->options);
+  if (need > limit)
+    return Status::OutOfMemory(
+        "the run would need about " + gib(need) + " (" + std::to_string(impl_->options.views.num_views) + " views of " +
+        std::to_string(impl_->options.views.width) + " x " + std::to_string(impl_->options.views.height) + " pixels, " +
+        std::to_string(model.mesh.num_faces()) + " triangles), more than the " + gib(limit) +
+        " it may use; lower --resolution or --views, or raise --memory-limit");
   G2P_RETURN_IF_ERROR(ctx.report(Stage::kRender, 0.0, "starting"));
   PipelineResult r;
   r.model = std::move(model);
@@ -378,7 +428,12 @@ Result<PipelineResult> Pipeline::run_file(const std::string& path, RunContext* c
   const auto start = std::chrono::steady_clock::now();
   detail::StageClock clock(Stage::kLoad, "assimp", impl_->options.measure_stage_memory);
   G2P_RETURN_IF_ERROR(ctx.report(Stage::kLoad, 0.0, path));
-  Result<Model> model = load_model(path, impl_->options.import);
+  Result<Model> model = Status::Internal("not loaded");
+  try {
+    model = load_model(path, impl_->options.import);
+  } catch (const std::bad_alloc&) {
+    return Status::OutOfMemory(path + ": ran out of memory while loading it");
+  }
   if (!model.ok()) return model.status();
   G2P_RETURN_IF_ERROR(ctx.report(Stage::kLoad, 1.0, std::to_string(model->mesh.num_faces()) + " triangles"));
   const StageReport load = clock.finish();

@@ -14,11 +14,16 @@ using test::quote;
 using test::run_tool;
 using test::ToolRun;
 
+// `g2p export` of the bundled hammer labelled by its materials into DIR/out.
+ToolRun export_hammer(const std::string& dir, const std::string& flags = "") {
+  test::write_file(dir + "/labels.json", R"({"models": {"hammer": {"labels": {"0": "Wood", "1": "Metal"}}}})");
+  return run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
+                  quote(dir + "/labels.json") + flags + " -o " + quote(dir + "/out"));
+}
+
 TEST(ToolExport, WritesAssetsThatValidateInMujoco) {
   const std::string dir = test::scratch_dir("ToolExport");
-  test::write_file(dir + "/labels.json", R"({"models": {"hammer": {"labels": {"0": "Wood", "1": "Metal"}}}})");
-  ToolRun r = run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
-                       quote(dir + "/labels.json") + " -o " + quote(dir + "/out"));
+  ToolRun r = export_hammer(dir);
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   for (const char* f : {"hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb", "report.json",
                         "meshes/part_1_Metal_hull_0.obj", "meshes/part_1_Metal_visual.obj"})
@@ -70,9 +75,7 @@ TEST(ToolExport, BadInputFailsWithAMessage) {
 
 TEST(ToolValidate, ContactCheckDropsBallsAndWritesJson) {
   const std::string dir = test::scratch_dir("ToolValidateContact");
-  test::write_file(dir + "/labels.json", R"({"models": {"hammer": {"labels": {"0": "Wood", "1": "Metal"}}}})");
-  ToolRun r = run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " --truth " +
-                       quote(dir + "/labels.json") + " --format mjcf -o " + quote(dir + "/out"));
+  ToolRun r = export_hammer(dir, " --format mjcf");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 2 --json " + quote(dir + "/contact.json"));
   if (r.err.find("without MuJoCo") != std::string::npos) GTEST_SKIP() << "libg2p built without MuJoCo";

@@ -14,6 +14,8 @@ void add_import_flags(CLI::App* cmd, ImportArgs& args) {
       ->transform(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
   cmd->add_flag("--keep-axes", args.keep_axes, "Keep the file's axes (default: rotate its up axis to +Z)");
   cmd->add_flag("--no-textures", args.no_textures, "Do not decode textures");
+  cmd->add_flag("--lenient", args.lenient,
+                "Import a damaged file anyway: drop its bad triangles with a warning instead of refusing it");
 }
 
 Result<ImportOptions> import_options(const ImportArgs& args) {
@@ -29,6 +31,7 @@ Result<ImportOptions> import_options(const ImportArgs& args) {
   options.up_axis = axis != kAxes.end() ? axis->second : UpAxis::kAuto;
   options.z_up = !args.keep_axes;
   options.load_textures = !args.no_textures;
+  options.strict = !args.lenient;
   return options;
 }
 

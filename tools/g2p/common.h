@@ -20,6 +20,7 @@ struct ImportArgs {
   std::string up = "auto";
   bool keep_axes = false;
   bool no_textures = false;
+  bool lenient = false;  // keep the good triangles of a damaged file (warnings instead of an error)
 };
 
 void add_import_flags(CLI::App* cmd, ImportArgs& args);

@@ -307,18 +307,57 @@ Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bo
     if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
       return Status::Unsupported("the file requires " + ext + ", which this build's assimp cannot decode");
   }
+  // assimp lists a file's primitives in the order its nodes first reference
+  // their meshes, not always in file order (2CylinderEngine), so each of its
+  // meshes is matched to the primitive with the same mesh name and triangle
+  // count (file order first), and only then to one it may have cut short.
+  const std::size_t n = scene.mNumMeshes;
+  std::vector<long long> kept(n, 0);
+  for (unsigned k = 0; k < n; ++k)
+    for (unsigned f = 0; f < scene.mMeshes[k]->mNumFaces; ++f) kept[k] += scene.mMeshes[k]->mFaces[f].mNumIndices == 3;
+  auto same_name = [&](unsigned k, const detail::GltfPrimitive& p) {
+    const std::string name = scene.mMeshes[k]->mName.C_Str();
+    return p.mesh_name.empty() || name.rfind(p.mesh_name, 0) == 0;
+  };
+  std::vector<int> match(n, -1);
+  std::vector<char> used(n, 0);
+  auto assign = [&](auto&& fits) {
+    for (unsigned k = 0; k < n; ++k) {
+      if (match[k] >= 0) continue;
+      if (!used[k] && fits(k, layout->primitives[k])) {  // its own place in file order first
+        match[k] = static_cast<int>(k), used[k] = 1;
+        continue;
+      }
+      for (std::size_t i = 0; i < n && match[k] < 0; ++i)
+        if (!used[i] && fits(k, layout->primitives[i])) match[k] = static_cast<int>(i), used[i] = 1;
+    }
+  };
+  assign([&](unsigned k, const detail::GltfPrimitive& p) { return p.triangles == kept[k] && same_name(k, p); });
+  assign([&](unsigned k, const detail::GltfPrimitive& p) { return p.triangles == kept[k]; });
+  assign([&](unsigned k, const detail::GltfPrimitive& p) { return p.triangles > kept[k] && same_name(k, p); });
+  assign([&](unsigned k, const detail::GltfPrimitive& p) { return p.triangles < 0 || p.triangles > kept[k]; });
+  if (std::find(match.begin(), match.end(), -1) != match.end()) {
+    model.info.warnings.push_back(
+        "could not match assimp's meshes to the glTF primitives (triangle counts differ); material indices are "
+        "assimp's, not the file's");
+    return Status::Ok();
+  }
+  std::vector<detail::GltfPrimitive> ordered(n);
+  for (std::size_t k = 0; k < n; ++k) ordered[k] = layout->primitives[static_cast<std::size_t>(match[k])];
+  layout->primitives = std::move(ordered);
   for (unsigned k = 0; k < scene.mNumMeshes; ++k) {
     const detail::GltfPrimitive& p = layout->primitives[k];
     std::string problem = p.problem;
-    long long kept = 0;
-    for (unsigned f = 0; f < scene.mMeshes[k]->mNumFaces; ++f) kept += scene.mMeshes[k]->mFaces[f].mNumIndices == 3;
-    if (problem.empty() && p.triangles > kept)
-      problem = std::to_string(p.triangles - kept) + " of " + std::to_string(p.triangles) +
+    if (problem.empty() && p.triangles > kept[k])
+      problem = std::to_string(p.triangles - kept[k]) + " of " + std::to_string(p.triangles) +
                 " triangles dropped by the reader (indices out of range or arrays truncated)";
     if (problem.empty()) continue;
     const std::string where = "glTF mesh " + std::to_string(p.mesh) + " '" + p.mesh_name + "' primitive " +
                               std::to_string(p.primitive) + ": " + problem;
-    if (strict) return Status::ParseError(where + " (ImportOptions::strict)");
+    if (strict)
+      return Status::ParseError(where +
+                                " (strict import; g2p's --lenient or ImportOptions::strict = false keeps the "
+                                "good triangles)");
     model.info.warnings.push_back(where + "; the bad triangles were dropped");
   }
   std::vector<SourceMaterial> materials = std::move(layout->materials);

@@ -34,13 +34,32 @@ TEST(ImageIo, ErrorsAndNoHalfWrittenFiles) {
   EXPECT_EQ(read_image(dir + "/bad.png").status().code(), StatusCode::kParseError);
   EXPECT_EQ(write_image(dir + "/x.png", ImageU8()).code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(write_image(dir + "/x.png", ImageU8(2, 2, 2)).code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(write_image(dir + "/x.unknownext", ImageU8(2, 2, 3)).code(), StatusCode::kIoError);
+  const Status unknown = write_image(dir + "/x.unknownext", ImageU8(2, 2, 3));
+  EXPECT_EQ(unknown.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(unknown.message().find("'.unknownext'"), std::string::npos) << unknown.to_string();
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.unknownext"));
   EXPECT_EQ(write_image(dir + "/no/such/dir/x.png", ImageU8(2, 2, 3)).code(), StatusCode::kIoError);
   // Nothing but the input remains in the folder.
   int files = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
   EXPECT_EQ(files, 1);
+}
+
+TEST(ImageIo, AFullDiskIsNamedAsSuch) {
+  // The temporary file a write goes through is made to point at /dev/full,
+  // where every write fails with ENOSPC, as on a full disk.
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const std::string dir = test::scratch_dir("ImageIo.DiskFull");
+  std::filesystem::create_symlink("/dev/full", dir + "/.tmp.view.png");
+  std::filesystem::create_symlink("/dev/full", dir + "/.tmp.run.json");
+  const Status image = write_image(dir + "/view.png", ImageU8(64, 64, 3));
+  EXPECT_EQ(image.code(), StatusCode::kIoError);
+  EXPECT_NE(image.message().find("No space left on device"), std::string::npos) << image.to_string();
+  const Status text = write_text_file(dir + "/run.json", std::string(100000, 'x'));
+  EXPECT_EQ(text.code(), StatusCode::kIoError);
+  EXPECT_NE(text.message().find("No space left on device"), std::string::npos) << text.to_string();
+  EXPECT_FALSE(std::filesystem::exists(dir + "/view.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/run.json"));
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 #include "core/file_util.h"
 #include "g2p/io.h"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -12,14 +15,18 @@ Status write_file_atomically(const std::string& path, const std::string& bytes) 
   const fs::path target(path);
   const fs::path tmp = target.parent_path() / (".tmp." + target.filename().string());
   {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status::IoError(path + ": cannot open for writing");
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out.flush()) {
-      out.close();
+    // C stdio, so that the operating system's reason (errno) reaches the
+    // message: "No space left on device", "Permission denied", ...
+    std::FILE* out = std::fopen(tmp.c_str(), "wb");
+    if (out == nullptr) return Status::IoError(path + ": cannot open for writing: " + std::strerror(errno));
+    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size() && std::fflush(out) == 0;
+    const int error = errno;
+    const bool closed = std::fclose(out) == 0;
+    if (!written || !closed) {
+      const std::string why = std::strerror(written ? errno : error);
       std::error_code ec;
       fs::remove(tmp, ec);
-      return Status::IoError(path + ": write failed (disk full?)");
+      return Status::IoError(path + ": write failed: " + why);
     }
   }
   std::error_code ec;

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/file_util.h"
 #include "g2p/io.h"
 
 namespace g2p {
@@ -102,17 +103,14 @@ Status write_image(const std::string& path, const ImageU8& image) {
       cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGRA);
     else
       bgr = src;
-    // Write beside the target and rename, so a failure never leaves half a file.
-    const std::filesystem::path target(path);
-    const std::filesystem::path tmp = target.parent_path() / (".tmp." + target.filename().string());
-    if (!cv::imwrite(tmp.string(), bgr)) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      return Status::IoError(path + ": cannot write image (unknown extension or unwritable folder)");
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, target, ec);
-    if (ec) return Status::IoError(path + ": " + ec.message());
+    // Encoded in memory, then written beside the target and renamed, so a
+    // failure never leaves half a file and its message is the system's.
+    const std::string extension = std::filesystem::path(path).extension().string();
+    std::vector<std::uint8_t> bytes;
+    if (extension.empty() || !cv::haveImageWriter(path))
+      return Status::InvalidArgument(path + ": unknown image extension '" + extension + "' (png, jpg, bmp, tiff)");
+    if (!cv::imencode(extension, bgr, bytes)) return Status::Internal(path + ": the image encoder failed");
+    return detail::write_file_atomically(path, std::string(bytes.begin(), bytes.end()));
   } catch (const cv::Exception& e) {
     return Status::IoError(path + ": " + e.what());
   }

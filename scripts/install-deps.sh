@@ -28,7 +28,7 @@ extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
   libmujoco-dev libgl-dev libopengl-dev libbullet-extras-dev
-  liburdfdom-tools libcpp-httplib-dev
+  liburdfdom-tools libsdformat-dev libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-onnx
 )
 

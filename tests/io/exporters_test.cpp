@@ -4,6 +4,11 @@
 #include <mujoco/mujoco.h>
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
+#ifdef G2P_TEST_WITH_SDFORMAT
+#include <sdf/Link.hh>
+#include <sdf/Model.hh>
+#include <sdf/Root.hh>
+#endif
 
 #include <cmath>
 #include <cstdlib>
@@ -150,6 +155,29 @@ TEST(Exporters, UrdfdomAndCheckUrdfReadTheUrdf) {
   if (std::filesystem::exists("/usr/bin/check_urdf"))
     EXPECT_EQ(std::system(("/usr/bin/check_urdf " + dir + "/hammer.urdf > /dev/null").c_str()), 0);
 }
+
+#ifdef G2P_TEST_WITH_SDFORMAT
+TEST(Exporters, LibsdformatLoadsTheSdf) {
+  // libsdformat (what Gazebo parses SDF with) reads the written file without
+  // an error, with the same mass, a visual per part and a collision per hull.
+  const SimulationAsset asset = hammer_asset(kMetal);
+  const std::string dir = test::scratch_dir("ExportSdformat");
+  ASSERT_TRUE(write_asset(dir, asset, {"sdf"}).ok());
+  sdf::Root root;
+  const sdf::Errors errors = root.Load(dir + "/hammer.sdf");
+  std::string all;
+  for (const sdf::Error& e : errors) all += e.Message() + "\n";
+  ASSERT_TRUE(errors.empty()) << all;
+  ASSERT_NE(root.Model(), nullptr);
+  const sdf::Link* link = root.Model()->LinkByIndex(0);
+  ASSERT_NE(link, nullptr);
+  expect_relative(link->Inertial().MassMatrix().Mass(), asset.total.mass_kg, 1e-6, "libsdformat mass");
+  std::size_t hulls = 0;
+  for (const AssetPart& p : asset.parts) hulls += p.collision.hulls.size();
+  EXPECT_EQ(link->CollisionCount(), hulls);
+  EXPECT_EQ(link->VisualCount(), asset.parts.size());
+}
+#endif
 
 TEST(Exporters, SdfIsWellFormedWithTheSameInertial) {
   const SimulationAsset asset = hammer_asset(kMetal);

@@ -30,10 +30,27 @@ extra=(
   libmujoco-dev libgl-dev libopengl-dev libbullet-extras-dev
   liburdfdom-tools libsdformat-dev libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-onnx
+  clang libclang-rt-14-dev
 )
 
 pkgs=("${core[@]}")
 [ "$minimal" = 1 ] || pkgs+=("${extra[@]}")
+# Node.js runs the Khronos glTF validator in the tests; a machine that already
+# has node and npm (from any source) keeps them.
+if [ "$minimal" = 0 ] && ! { command -v node && command -v npm; } >/dev/null; then pkgs+=(nodejs npm); fi
+
+# The npm packages the tests use (tests/validators/package-lock.json), from the npm registry.
+install_npm() {
+  [ "$minimal" = 1 ] && return 0
+  local dir
+  dir="$(cd "$(dirname "$0")/.." && pwd)/tests/validators"
+  if [ -d "$dir/node_modules/gltf-validator" ]; then
+    echo "install-deps: npm packages already installed in tests/validators"
+    return 0
+  fi
+  echo "install-deps: npm ci in tests/validators (Khronos gltf-validator)"
+  npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error
+}
 
 # Skip apt entirely when everything is already there (fast re-runs, offline CI).
 missing=()
@@ -42,6 +59,7 @@ for p in "${pkgs[@]}"; do
 done
 if [ "${#missing[@]}" -eq 0 ]; then
   echo "install-deps: all ${#pkgs[@]} packages already installed"
+  install_npm
   exit 0
 fi
 
@@ -54,3 +72,4 @@ echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 run_root apt-get update -q
 run_root apt-get install -y -q --no-install-recommends "${missing[@]}"
+install_npm

@@ -24,6 +24,7 @@
 #include "g2p/segment.h"
 #include "support/gltf_builder.h"
 #include "support/test_data.h"
+#include "support/tool_run.h"
 
 namespace g2p {
 namespace {
@@ -198,12 +199,21 @@ TEST(Exporters, SdfIsWellFormedWithTheSameInertial) {
   EXPECT_EQ(collisions, static_cast<int>(hulls));
 }
 
+// The hammer's GLB in a scratch folder of its own; "" if writing failed.
+std::string hammer_glb(const std::string& scratch, Model& model, std::vector<Part>& parts, SimulationAsset& asset) {
+  asset = hammer_asset(kMetal, &model, &parts);
+  const std::string path = test::scratch_dir(scratch) + "/hammer.glb";
+  const Status s = write_glb(path, model, parts, asset);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return s.ok() ? path : std::string();
+}
+
 TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
   Model model;
   std::vector<Part> parts;
-  const SimulationAsset asset = hammer_asset(kMetal, &model, &parts);
-  const std::string path = test::scratch_dir("ExportGlb") + "/hammer.glb";
-  ASSERT_TRUE(write_glb(path, model, parts, asset).ok());
+  SimulationAsset asset;
+  const std::string path = hammer_glb("ExportGlb", model, parts, asset);
+  ASSERT_FALSE(path.empty());
   // libg2p's own strict glTF import reads it back: the input's faces plus the
   // convex hulls, the input's materials, the same place in space.
   Result<Model> back = load_model(path);
@@ -235,6 +245,18 @@ TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
   }
   EXPECT_EQ(parts_with_density, 2);
   EXPECT_EQ(collision_nodes, hulls);
+}
+
+TEST(Exporters, KhronosValidatorFindsNoErrorInTheGlb) {
+  Model model;
+  std::vector<Part> parts;
+  SimulationAsset asset;
+  const std::string path = hammer_glb("ExportGlbKhronos", model, parts, asset);
+  ASSERT_FALSE(path.empty());
+  const test::ValidatorRun v = test::run_gltf_validator(path);
+  if (!v.available) GTEST_SKIP() << "node or the npm gltf-validator is missing: run scripts/install-deps.sh";
+  EXPECT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
+  EXPECT_NE(v.run.out.find(": 0 errors, 0 warnings"), std::string::npos) << v.run.out;
 }
 
 TEST(Exporters, BadInputIsRefused) {

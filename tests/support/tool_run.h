@@ -13,6 +13,18 @@ struct ToolRun {
 // Runs `g2p ARGS` (ARGS already shell-quoted where needed).
 ToolRun run_tool(const std::string& args);
 
+// Runs a shell command line as given, capturing its output.
+ToolRun run_command(const std::string& command_line);
+
+// The Khronos glTF validator (npm gltf-validator, which scripts/install-deps.sh
+// installs into tests/validators) on one file; exit 0 = no errors. Not
+// `available` when node or the package is missing (the caller skips, saying so).
+struct ValidatorRun {
+  bool available = false;
+  ToolRun run;
+};
+ValidatorRun run_gltf_validator(const std::string& path);
+
 // Single-quotes a string for the shell.
 std::string quote(const std::string& s);
 

@@ -76,6 +76,24 @@ TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   EXPECT_EQ(nlohmann::json::parse(test::read_file(dir + "/soft/project.json"))["vote"], "soft");
 }
 
+TEST(ToolRun, TheGlbOfATexturedAssetPassesTheKhronosValidator) {
+  // A real glTF with base-colour, metallic-roughness and normal textures: the
+  // exported GLB carries its materials and textures, and the hulls.
+  const std::string dir = test::scratch_dir("ToolRunKhronos");
+  test::ToolRun r = test::run_tool("run " + test::quote(test::asset_path("WaterBottle")) + " -o " +
+                                   test::quote(dir + "/out") + kQuick + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  std::string glb;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  for (const auto& f : j["assets"])
+    if (fs::path(f.get<std::string>()).extension() == ".glb") glb = dir + "/out/" + f.get<std::string>();
+  ASSERT_FALSE(glb.empty()) << r.out;
+  const test::ValidatorRun v = test::run_gltf_validator(glb);
+  if (!v.available) GTEST_SKIP() << "node or the npm gltf-validator is missing: run scripts/install-deps.sh";
+  EXPECT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
+  EXPECT_NE(v.run.out.find(": 0 errors"), std::string::npos) << v.run.out;
+}
+
 TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
   const std::string dir = test::scratch_dir("ToolRunBad");
   struct Case {

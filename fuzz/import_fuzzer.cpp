@@ -1,0 +1,36 @@
+// libFuzzer target: load_model_from_memory on arbitrary bytes, read as the
+// format this binary was built for (G2P_FUZZ_FORMAT: glb, gltf, obj, ply, stl).
+// A strict import that is refused is retried leniently (`g2p run --lenient`),
+// so both paths are fuzzed. Whatever loads must satisfy check_model(), and the
+// face graph, the first thing every stage builds, is built from it.
+#include <cstddef>
+#include <cstdint>
+
+#include "g2p/io.h"
+#include "g2p/project.h"
+#include "model_invariants.h"
+
+#ifndef G2P_FUZZ_FORMAT
+#error "G2P_FUZZ_FORMAT must name the format (fuzz/CMakeLists.txt sets it)"
+#endif
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  g2p::ImportOptions options;
+  options.max_faces = 200'000;  // bounds one input's memory (the default guards 50 M)
+  g2p::Result<g2p::Model> model = g2p::load_model_from_memory(data, size, G2P_FUZZ_FORMAT, options);
+  if (!model.ok()) {
+    options.strict = false;
+    model = g2p::load_model_from_memory(data, size, G2P_FUZZ_FORMAT, options);
+  }
+  if (!model.ok()) {
+    if (model.status().message().empty()) g2p::fuzz::violated("a refused import gave no message");
+    return 0;
+  }
+  g2p::fuzz::check_model(*model, options);
+  g2p::Result<g2p::FaceGraph> graph = g2p::build_face_graph(model->mesh);
+  if (!graph.ok()) return 0;
+  if (graph->num_faces() != model->mesh.num_faces()) g2p::fuzz::violated("the face graph has another face count");
+  for (int n : graph->neighbors)
+    if (n < 0 || n >= graph->num_faces()) g2p::fuzz::violated("a face graph neighbour is out of range");
+  return 0;
+}

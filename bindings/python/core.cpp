@@ -194,6 +194,8 @@ void bind_core(py::module_& m) {
       .def_readonly("path", &ImportInfo::path)
       .def_readonly("format", &ImportInfo::format)
       .def_readonly("unit_scale_m", &ImportInfo::unit_scale_m)
+      .def_readonly("scale_source", &ImportInfo::scale_source)
+      .def_readonly("looks_normalised", &ImportInfo::looks_normalised)
       .def_property_readonly("up_axis", [](const ImportInfo& i) { return std::string(1, i.up_axis); })
       .def_readonly("file_to_model", &ImportInfo::file_to_model)
       .def_readonly("num_source_meshes", &ImportInfo::num_source_meshes)
@@ -287,6 +289,9 @@ void bind_core(py::module_& m) {
   py::class_<ImportOptions>(m, "ImportOptions")
       .def(py::init([](const py::kwargs& kw) { return from_kwargs<ImportOptions>(kw); }))
       .def_readwrite("unit_scale", &ImportOptions::unit_scale, "metres per file unit; 0 = from the format")
+      .def_readwrite("height_m", &ImportOptions::height_m, "the object's real height in metres; 0 = the file's")
+      .def_readwrite("longest_side_m", &ImportOptions::longest_side_m,
+                     "the object's real longest side in metres; 0 = the file's")
       .def_readwrite("up_axis", &ImportOptions::up_axis)
       .def_readwrite("z_up", &ImportOptions::z_up)
       .def_readwrite("load_textures", &ImportOptions::load_textures)

@@ -10,6 +10,13 @@ namespace g2p::cli {
 void add_import_flags(CLI::App* cmd, ImportArgs& args) {
   cmd->add_option("--unit", args.unit,
                   "Unit of the file's coordinates: m, cm, mm, km, in, ft (default: from the format)");
+  cmd->add_option("--height", args.height,
+                  "The object's real height in metres: the model is scaled to it (for generated meshes, which come "
+                  "normalised to about a metre)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--longest-side", args.longest_side,
+                  "The object's real longest side in metres: the model is scaled to it")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--up", args.up, "Up axis of the file: auto, x, y, z")
       ->transform(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
   cmd->add_flag("--keep-axes", args.keep_axes, "Keep the file's axes (default: rotate its up axis to +Z)");
@@ -32,6 +39,8 @@ Result<ImportOptions> import_options(const ImportArgs& args) {
   options.z_up = !args.keep_axes;
   options.load_textures = !args.no_textures;
   options.strict = !args.lenient;
+  options.height_m = args.height;
+  options.longest_side_m = args.longest_side;
   return options;
 }
 

@@ -16,7 +16,9 @@ namespace g2p::cli {
 
 // How a model file is read: --unit, --up, --keep-axes, --no-textures.
 struct ImportArgs {
-  std::string unit;  // "" = from the format
+  std::string unit;           // "" = from the format
+  double height = 0.0;        // metres; 0 = the file's size
+  double longest_side = 0.0;  // metres; 0 = the file's size
   std::string up = "auto";
   bool keep_axes = false;
   bool no_textures = false;

@@ -275,7 +275,9 @@ Result<PropertiesReport> run_estimation(const std::string& command, const Estima
   if (!report.ok()) {
     std::cerr << "g2p " << command << ": error: " << report.status().to_string() << "\n";
     exit_code = kExitFailure;
+    return report;
   }
+  report->size = object_size(object.model);
   return report;
 }
 

@@ -16,6 +16,12 @@ struct ImportOptions {
   // Metres per file unit. 0 = from the format: glTF 1 (metres by specification),
   // FBX its UnitScaleFactor, everything else 1 (set it for millimetre STL files).
   double unit_scale = 0.0;
+  // The object's real size, for files whose units cannot be trusted (image-to-3D
+  // generators normalise every object to about a metre). 0 = keep the file's
+  // size. At most one of the two, and not with unit_scale: the model is scaled
+  // uniformly, after the up axis is resolved, so that its bounding box has...
+  double height_m = 0.0;        // ...this extent along the up axis (g2p --height), or
+  double longest_side_m = 0.0;  // ...this longest side (g2p --longest-side).
   // The file's up axis. kAuto: glTF/OBJ/PLY/FBX/DAE +Y (FBX: its UpAxis),
   // STL and 3MF +Z (CAD convention).
   UpAxis up_axis = UpAxis::kAuto;

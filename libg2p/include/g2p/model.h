@@ -64,9 +64,16 @@ struct SourcePrimitive {
 
 // How the file was read.
 struct ImportInfo {
-  std::string path;                                             // as given to load_model
-  std::string format;                                           // e.g. "glb", "obj"
-  double unit_scale_m = 1.0;                                    // metres per file unit that was applied
+  std::string path;           // as given to load_model
+  std::string format;         // e.g. "glb", "obj"
+  double unit_scale_m = 1.0;  // metres per file unit that was applied
+  // Where that scale came from: "file" (the format's unit), "unit" (given),
+  // "height" or "longest-side" (ImportOptions::height_m, longest_side_m).
+  std::string scale_source = "file";
+  // The file's own size looks like an image-to-3D generator's normalisation
+  // (longest side 1 m or 2 m, within 2 %) and no size was given: its masses
+  // are probably not the real object's (a warning says so).
+  bool looks_normalised = false;
   char up_axis = 'Y';                                           // the file's up axis as used: 'X', 'Y' or 'Z'
   Eigen::Matrix4d file_to_model = Eigen::Matrix4d::Identity();  // file coordinates -> Mesh::positions
   int num_source_meshes = 0;
@@ -88,6 +95,16 @@ struct Model {
     return m >= 0 && m < static_cast<int>(materials.size()) ? materials[static_cast<std::size_t>(m)].name : kNone;
   }
 };
+
+// The object's size and where its scale came from (report.json's
+// object.size, summary.html).
+struct ObjectSize {
+  Eigen::Vector3d extent_m = Eigen::Vector3d::Zero();  // bounding-box sides in libg2p's frame (+Z up), metres
+  std::string scale_source;                            // as ImportInfo::scale_source; "" = not known
+  double metres_per_file_unit = 0.0;                   // 0 = not known
+  bool looks_normalised = false;
+};
+G2P_API ObjectSize object_size(const Model& model);
 
 // Replaces every name the model carries (materials, meshes, nodes, external
 // texture file names) by a meaningless one ("material_3", "mesh_1"), as

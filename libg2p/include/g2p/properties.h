@@ -17,6 +17,7 @@
 #include "g2p/export.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
+#include "g2p/model.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
@@ -178,6 +179,9 @@ struct PropertiesReport {
   std::vector<PartReport> parts;
   MassProperties object;  // all parts combined, about the object's centre of mass
   double mass_min_kg = 0.0, mass_max_kg = 0.0;
+  // The object's size: estimate_properties sets the extent from the object's
+  // mesh; callers that loaded a model set the rest (object_size(model)).
+  ObjectSize size;
   std::vector<std::string> notes;
 };
 

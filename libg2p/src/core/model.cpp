@@ -2,6 +2,15 @@
 
 namespace g2p {
 
+ObjectSize object_size(const Model& model) {
+  ObjectSize s;
+  if (!model.mesh.positions.empty()) s.extent_m = bounds(model.mesh).sizes();
+  s.scale_source = model.info.scale_source;
+  s.metres_per_file_unit = model.info.unit_scale_m;
+  s.looks_normalised = model.info.looks_normalised;
+  return s;
+}
+
 void anonymize_names(Model& model) {
   for (std::size_t i = 0; i < model.materials.size(); ++i) {
     SourceMaterial& m = model.materials[i];

@@ -22,6 +22,7 @@
 #include "assimp_convert.h"
 #include "g2p/io.h"
 #include "gltf_layout.h"
+#include "real_size.h"
 #include "triangulate.h"
 
 namespace g2p {
@@ -408,7 +409,7 @@ Status check_options(const ImportOptions& o) {
   if (!(o.min_extent_m >= 0.0 && o.min_extent_m < o.max_extent_m))
     return Status::InvalidArgument("ImportOptions: need 0 <= min_extent_m < max_extent_m");
   if (o.max_faces <= 0) return Status::InvalidArgument("ImportOptions::max_faces must be > 0");
-  return Status::Ok();
+  return detail::check_size_options(o);
 }
 
 // Everything after assimp has parsed the file.
@@ -434,6 +435,7 @@ Result<Model> convert_scene(const aiScene& scene, const std::string& ext, const 
     model.info.warnings.push_back(std::to_string(model.info.num_skipped_primitives) +
                                   " point or line primitives skipped (no area)");
 
+  G2P_RETURN_IF_ERROR(detail::apply_real_size(options, model));
   const Eigen::AlignedBox3d box = bounds(mesh);
   const double extent = box.diagonal().norm();
   if (!(extent >= options.min_extent_m && extent <= options.max_extent_m)) {
@@ -566,3 +568,4 @@ Result<double> parse_unit(const std::string& unit) {
 }
 
 }  // namespace g2p
+

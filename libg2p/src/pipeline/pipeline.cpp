@@ -57,6 +57,8 @@ Status prepare_slot(Slot<Interface>& slot, const BackendChoice& choice, const ch
 // it, and an object far larger or heavier (or smaller) than anything
 // household or industrial, which almost always means a file in other units.
 void plausibility_warnings(PipelineResult& r) {
+  // What the importer recovered from or doubts (a normalised size among them).
+  for (const std::string& w : r.model.info.warnings) r.warnings.push_back("import: " + w);
   std::vector<bool> exported(r.projection.parts.size(), false);
   for (const AssetPart& p : r.asset.parts)
     if (p.part >= 0 && p.part < static_cast<int>(exported.size())) exported[static_cast<std::size_t>(p.part)] = true;
@@ -74,6 +76,7 @@ void plausibility_warnings(PipelineResult& r) {
   const double mass = r.asset.total.mass_kg;
   char what[160];
   std::snprintf(what, sizeof what, "%.3g kg and %.3g m long", mass, longest);
+  if (r.model.info.looks_normalised) return;  // the import warning names the cause and the flags
   if (longest > 30.0 || mass > 50000.0)
     r.warnings.push_back(std::string("the object is ") + what +
                          ", far beyond household and industrial objects: is the file in centimetres or "
@@ -280,6 +283,7 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
         estimate_properties(mesh, r.projection.parts, r.completion, r.table, *estimator.get(), &r.views);
     if (!report.ok()) return report.status().with_context("properties");
     r.properties = std::move(*report);
+    r.properties.size = object_size(r.model);
     clock.report().notes = r.properties.notes;
     // The vlm estimator never fails a part: it falls back to the table, which
     // is a degraded optional stage the caller should hear about.

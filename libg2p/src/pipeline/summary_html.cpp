@@ -36,6 +36,14 @@ void figure(std::ostringstream& h, const std::string& src, const std::string& ca
     << escape(caption) << "</figcaption></figure>\n";
 }
 
+// Where the object's size came from, in the user's terms.
+std::string size_source(const ImportInfo& info) {
+  if (info.scale_source == "height") return "--height";
+  if (info.scale_source == "longest-side") return "--longest-side";
+  if (info.scale_source == "unit") return "--unit";
+  return info.looks_normalised ? "the file, which looks normalised: give --height or --longest-side" : "the file";
+}
+
 }  // namespace
 
 std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
@@ -52,8 +60,10 @@ std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
     << " triangles, " << r.views.size() << " views, " << r.projection.parts.size() << " parts. Total mass <b>"
     << number(m.mass_kg) << " kg</b> (plausible range " << number(r.properties.mass_min_kg) << " to "
     << number(r.properties.mass_max_kg) << " kg), centre of mass (" << number(m.center_of_mass.x()) << ", "
-    << number(m.center_of_mass.y()) << ", " << number(m.center_of_mass.z()) << ") m. Run time "
-    << number(r.seconds, "%.2f") << " s.</p>\n";
+    << number(m.center_of_mass.y()) << ", " << number(m.center_of_mass.z()) << ") m. Size "
+    << number(r.properties.size.extent_m.x()) << " x " << number(r.properties.size.extent_m.y()) << " x "
+    << number(r.properties.size.extent_m.z()) << " m (height last; scale from " << escape(size_source(r.model.info))
+    << "). Run time " << number(r.seconds, "%.2f") << " s.</p>\n";
   if (!r.warnings.empty()) {
     h << "<ul class=\"warn\">\n";
     for (const std::string& w : r.warnings) h << "<li>" << escape(w) << "</li>\n";

@@ -55,6 +55,7 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
   }
   if (masses.empty()) return Status::InvalidArgument("properties: no part has a closed volume");
   report.object = combine(masses);
+  if (!object.positions.empty()) report.size.extent_m = bounds(object).sizes();
   return report;
 }
 
@@ -118,6 +119,14 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
   object["mass_max_kg"] = report.mass_max_kg;
   object["material_volume_m3"] = report.object.volume_m3;
   object["area_m2"] = report.object.area_m2;
+  const ObjectSize& size = report.size;
+  object["size"] = {
+      {"extent_m", vec(size.extent_m)},
+      {"height_m", size.extent_m.z()},
+      {"longest_side_m", size.extent_m.maxCoeff()},
+      {"scale_source", size.scale_source.empty() ? json(nullptr) : json(size.scale_source)},
+      {"metres_per_file_unit", size.metres_per_file_unit > 0 ? json(size.metres_per_file_unit) : json(nullptr)},
+      {"looks_normalised", size.looks_normalised}};
   json doc = {{"format", "g2p.properties"}, {"version", 1},   {"material_table", table.name()},
               {"object", object},           {"parts", parts}, {"notes", report.notes}};
   return doc.dump(2) + "\n";

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 #include "g2p/io.h"
 #include "g2p/materials.h"
 #include "g2p/project.h"

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 #include "g2p/io.h"
 #include "stage_inputs.h"
 

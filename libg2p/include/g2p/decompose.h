@@ -20,7 +20,7 @@
 #include <Eigen/Core>
 
 #include "g2p/complete.h"
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/mesh.h"
 #include "g2p/registry.h"
 #include "g2p/status.h"

@@ -1,15 +1,180 @@
-// The one export macro of libg2p. The library is built with hidden symbols;
-// every public function and class is marked G2P_API.
+// export: the last stage of Gen2Physics, simulation-ready assets. The
+// completed parts with their properties become one rigid body for MuJoCo
+// (MJCF), ROS tools (URDF) and Gazebo (SDF 1.9), with per-part meshes beside
+// them. Output folders are self-contained and relocatable (relative paths
+// only). docs/formats.md shows what each file holds.
 #pragma once
 
-#if defined(G2P_STATIC)
-#define G2P_API
-#elif defined(_WIN32)
-#if defined(G2P_BUILDING)
-#define G2P_API __declspec(dllexport)
-#else
-#define G2P_API __declspec(dllimport)
-#endif
-#else
-#define G2P_API [[gnu::visibility("default")]]
-#endif
+#include <string>
+#include <vector>
+
+#include "g2p/complete.h"
+#include "g2p/decompose.h"
+#include "g2p/visibility.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/model.h"
+#include "g2p/project.h"
+#include "g2p/properties.h"
+#include "g2p/status.h"
+
+namespace g2p {
+
+// One part as the exporters see it.
+struct AssetPart {
+  int part = -1;         // index into the parts given to make_asset
+  std::string name;      // "part_3_Metal", unique, safe in file and XML names
+  std::string material;  // class name
+  std::array<double, 4> rgba{0.5, 0.5, 0.5, 1.0};
+  // Three geometries with distinct roles (docs/formats.md):
+  Mesh closed;                    // the closed volume (complete stage): the mass properties come from it
+  Mesh visual;                    // the part's own surface from the input: what a viewer draws
+  ConvexDecomposition collision;  // convex hulls (decompose stage): what an engine collides
+  PartProperties properties;
+  MassProperties mass;
+};
+
+// A rigid object ready for export.
+struct SimulationAsset {
+  std::string name;  // model, body and link name
+  std::vector<AssetPart> parts;
+  MassProperties total;  // about the centre of mass, in the object's frame (+Z up, metres)
+  std::vector<std::string> notes;
+};
+
+// Gathers the stages' results. Parts without a closed volume are left out
+// (noted); at least one must remain. `collision` holds each part's convex
+// decomposition (same order as `parts`); when it is empty, every part is
+// decomposed here with the default backend (`voxel-cut`, default options).
+// A part whose decomposition failed outright collides as its single convex
+// hull, and one without even that is left out; both are noted.
+G2P_API Result<SimulationAsset> make_asset(const std::string& name, const Mesh& object, const std::vector<Part>& parts,
+                                           const Completion& completion, const PropertiesReport& report,
+                                           const MaterialTable& table,
+                                           const std::vector<ConvexDecomposition>& collision = {});
+
+struct ExportOptions {
+  bool free_joint = true;  // MJCF: the body floats (a free joint); false: fixed to the world
+  // MuJoCo has one friction coefficient per geom (plus torsional and rolling):
+  // the class's dynamic (sliding) coefficient by default, else the static one.
+  bool use_static_friction = false;
+  // Also write each part's closed volume (meshes/NAME_closed.obj). It can be
+  // dense (a grid-based completion of a 12-triangle cube has a million
+  // triangles) and no format references it; for inspection only.
+  bool write_closed_volumes = false;
+};
+
+// The properties report as written beside an asset (report.json): the
+// estimate's notes plus the export's (parts left out, decompositions that
+// fell back).
+G2P_API PropertiesReport with_export_notes(const PropertiesReport& report, const SimulationAsset& asset);
+
+// report.json beside an asset: report_json() with each exported part's three
+// geometries under "geometry" (docs/report-schema.md): the closed volume
+// (triangles, volume), the visual mesh (triangles, file) and the collision
+// hulls (backend, count, vertices, files, volume against the closed volume,
+// mean and largest distance from the part, seconds, fallback and notes).
+G2P_API std::string asset_report_json(const PropertiesReport& report, const SimulationAsset& asset,
+                                      const MaterialTable& table);
+G2P_API Status write_asset_report(const std::string& path, const PropertiesReport& report, const SimulationAsset& asset,
+                                  const MaterialTable& table);
+
+// The texts of the three formats. Each part has one collision shape per
+// convex hull, meshes/NAME_hull_K.obj, and one visual mesh,
+// meshes/NAME_visual.obj, that does not collide (MJCF: contype and
+// conaffinity 0, geom group 2; hulls in group 3).
+G2P_API std::string mjcf_text(const SimulationAsset& asset, const ExportOptions& options = {});
+G2P_API Result<std::string> urdf_text(const SimulationAsset& asset);  // through urdfdom's model and writer
+G2P_API std::string sdf_text(const SimulationAsset& asset);
+
+// Writes DIR/NAME.xml, DIR/NAME.urdf and/or DIR/NAME.sdf (formats "mjcf",
+// "urdf", "sdf") and DIR/meshes/. Every file is written under a temporary
+// name and renamed.
+G2P_API Status write_asset(const std::string& dir, const SimulationAsset& asset,
+                           const std::vector<std::string>& formats, const ExportOptions& options = {});
+
+// A GLB of the object for engines and viewers that read glTF: one node per
+// part with the input's own meshes, UVs and materials (base colour and
+// metallic-roughness factors and textures, alpha mode), the part's physical
+// properties in the node's `extras.g2p`, the object's totals in the root
+// node's, and each part's convex hulls as nodes named NAME_hull_K
+// (extras.g2p: collision = true, part, hull) without a material. The glTF
+// physics extensions are not ratified yet, so none is written. glTF's frame is +Y up:
+// positions, centres of mass and inertia tensors are rotated from libg2p's
+// +Z up (x, y, z) -> (x, z, -y). docs/formats.md lists the fields.
+G2P_API Status write_glb(const std::string& path, const Model& model, const std::vector<Part>& parts,
+                         const SimulationAsset& asset);
+
+// ---- Validation in a real engine ---------------------------------------------
+
+// What MuJoCo makes of an MJCF file: the body's mass properties as the engine
+// compiled them, and a drop onto a plane.
+struct EngineCheck {
+  double mass_kg = 0.0;
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();     // in the body frame
+  Eigen::Vector3d principal_moments = Eigen::Vector3d::Zero();  // ascending, kg m^2
+  // Drop: released from rest with its lowest point `drop_height_m` above a
+  // plane, simulated for `drop_seconds`.
+  bool dropped = false;
+  bool finite = false;            // no NaN or blow-up
+  double lowest_point_m = 0.0;    // min over the run of the lowest collision-mesh vertex's height
+  double resting_lowest_m = 0.0;  // the lowest vertex's height at the end (soft contacts: slightly < 0)
+  double final_speed_m_s = 0.0;   // of the centre of mass at the end
+  double final_height_m = 0.0;    // of the centre of mass at the end
+  std::string engine;             // "MuJoCo 2.2.2"
+};
+
+// Whether libg2p was built with MuJoCo.
+G2P_API bool have_mujoco();
+
+// Loads an MJCF file written by write_asset into MuJoCo and runs the drop.
+// Unavailable when libg2p was built without MuJoCo.
+G2P_API Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_height_m = 0.2,
+                                            double drop_seconds = 2.0);
+
+// ---- Contacts in a real engine ---------------------------------------------
+
+// Probe balls dropped onto the object, fixed in place, to see where an engine
+// lets things rest on it: in a bowl, on a seat, in a channel.
+struct ContactCheckOptions {
+  int grid = 5;  // balls per side of a grid over the object's top view (0: only `points`)
+  // Further start positions (x, y) in the object's frame, metres: a ball
+  // over a bowl's centre, say.
+  std::vector<Eigen::Vector2d> points;
+  double ball_radius_m = 0.0;          // 0: 2 % of the object's longest side, at least 5 mm
+  double ball_density_kg_m3 = 1000.0;  // water
+  double ball_friction = 0.5;          // sliding friction of the balls (MuJoCo combines with the max)
+  double seconds = 3.0;                // simulated time, s
+  double rest_speed_m_s = 0.005;       // a ball slower than this at the end is at rest
+  double drop_height_m = 0.2;          // the free object's drop onto a plane (check_in_mujoco)
+};
+
+// One ball: where it started and where it came to rest.
+struct BallProbe {
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();  // x, y over the object (its frame), m
+  Eigen::Vector3d rest = Eigen::Vector3d::Zero();   // centre at the end, in the object's frame, m
+  double radius_m = 0.0;
+  double height_above_floor_m = 0.0;  // of its lowest point; the floor is at the object's lowest point
+  double final_speed_m_s = 0.0;
+  bool at_rest = false;    // final speed under ContactCheckOptions::rest_speed_m_s
+  bool on_object = false;  // touching one of the object's collision geoms at the end
+  bool on_floor = false;   // touching the floor at the end
+};
+
+struct ContactCheck {
+  std::vector<BallProbe> balls;
+  Eigen::AlignedBox3d object_bounds;  // of the collision geometry, object's frame, m
+  EngineCheck drop;                   // the free object dropped onto a plane (not run when the MJCF is --fixed)
+  bool object_above_plane = false;    // after the drop, nothing of it more than 1 cm below the plane
+  std::string engine;                 // "MuJoCo 2.2.2"
+};
+
+// Loads an MJCF written by write_asset, fixes the body in place over a floor
+// at its lowest point, drops probe balls onto it (they collide with the
+// object's collision geoms and the floor, not with each other) and
+// simulates; then runs check_in_mujoco's drop of the free object. Nothing is
+// written beside the user's files. Unavailable without MuJoCo.
+G2P_API Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path,
+                                                      const ContactCheckOptions& options = {});
+
+}  // namespace g2p

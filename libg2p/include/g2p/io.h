@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <string>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/model.h"
 #include "g2p/status.h"
 

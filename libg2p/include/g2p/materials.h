@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/status.h"
 
 namespace g2p {

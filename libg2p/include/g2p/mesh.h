@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/status.h"
 
 namespace g2p {

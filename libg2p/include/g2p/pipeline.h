@@ -20,8 +20,8 @@
 
 #include "g2p/complete.h"
 #include "g2p/decompose.h"
+#include "g2p/visibility.h"
 #include "g2p/export.h"
-#include "g2p/exporters.h"
 #include "g2p/io.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/render.h"

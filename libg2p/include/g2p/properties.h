@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "g2p/complete.h"
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/model.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/image.h"
 #include "g2p/model.h"
 #include "g2p/registry.h"

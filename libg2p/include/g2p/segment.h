@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/image.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"

@@ -8,7 +8,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "g2p/export.h"
+#include "g2p/visibility.h"
 #include "g2p/status.h"
 
 namespace g2p {

@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "core/file_util.h"
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 #include "g2p/io.h"
-#include "io/asset_names.h"
+#include "export/asset_names.h"
 
 namespace g2p {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 
 namespace g2p::detail {
 

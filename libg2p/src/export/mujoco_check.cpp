@@ -10,9 +10,9 @@
 #include <sstream>
 
 #include "core/file_util.h"
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 #include "g2p/io.h"
-#include "io/mujoco_support.h"
+#include "export/mujoco_support.h"
 
 namespace g2p {
 namespace {

@@ -1,5 +1,5 @@
 // check_in_mujoco and check_contacts_in_mujoco when libg2p is built without MuJoCo (G2P_WITH_MUJOCO=OFF).
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 
 namespace g2p {
 

@@ -10,7 +10,7 @@
 
 #include "decompose/decompose_fixtures.h"
 #include "g2p/decompose.h"
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 #include "g2p/properties.h"
 #include "support/test_data.h"
 

@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "g2p/complete.h"
-#include "g2p/exporters.h"
+#include "g2p/export.h"
 #include "g2p/io.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"

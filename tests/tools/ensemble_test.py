@@ -16,10 +16,11 @@ import torch
 import torch.nn.functional as F
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
+sys.path.insert(0, os.path.join(HERE, "..", ".."))  # the repository root: tools.training is a package
 sys.path.insert(0, HERE)
-import ensemble  # noqa: E402
-import train  # noqa: E402
+from tools.training import ensemble, onnx_weights  # noqa: E402
+from tools.training.model import COMBINES, Ensemble, UNet  # noqa: E402
+from tools.training.runs import build_member, read_runs  # noqa: E402
 from train_test import DatasetCase, seeded, snapshot, write_run  # noqa: E402
 
 ENSEMBLE = os.path.join(HERE, "..", "..", "tools", "training", "ensemble.py")
@@ -28,27 +29,27 @@ CLI, ASSETS = (sys.argv[1:3] + [None, None])[:2]
 
 class EnsembleTest(unittest.TestCase):
     def test_the_output_is_the_mean_of_the_members_log_probabilities(self):
-        a, b = (seeded(train.UNet(inputs=3), s).eval() for s in (1, 2))
+        a, b = (seeded(UNet(inputs=3), s).eval() for s in (1, 2))
         x = torch.randn(2, 3, 32, 32)
         pa, pb = F.softmax(a(x), 1), F.softmax(b(x), 1)
         self.assertFalse(torch.allclose(pa, pb, atol=1e-3))  # the members disagree: the checks below can fail
         geometric = (pa * pb).sqrt()
-        for combine in ensemble.COMBINES:
-            out = ensemble.Ensemble([a, b], combine).eval()(x)
+        for combine in COMBINES:
+            out = Ensemble([a, b], combine).eval()(x)
             torch.testing.assert_close(F.softmax(out, 1), geometric / geometric.sum(1, keepdim=True), rtol=1e-4,
                                        atol=1e-6)
-        torch.testing.assert_close(ensemble.Ensemble([a, b]).eval()(x), (a(x) + b(x)) / 2)  # "logits" by default
+        torch.testing.assert_close(Ensemble([a, b]).eval()(x), (a(x) + b(x)) / 2)  # "logits" by default
         with self.assertRaisesRegex(ValueError, "combine must be one of logits, log_softmax, not 'max'"):
-            ensemble.Ensemble([a, b], "max")
+            Ensemble([a, b], "max")
 
     def test_the_mean_of_logits_exports_without_log_softmax(self):
         import onnx  # python3-onnx
-        members = [seeded(train.UNet(inputs=3), s).eval() for s in (1, 2)]
+        members = [seeded(UNet(inputs=3), s).eval() for s in (1, 2)]
         with tempfile.TemporaryDirectory() as tmp:
             ops = {}
-            for combine in ensemble.COMBINES:
+            for combine in COMBINES:
                 path = os.path.join(tmp, combine + ".onnx")
-                ensemble.export_ensemble(ensemble.Ensemble(members, combine).eval(), 3, 32, path)
+                ensemble.export_ensemble(Ensemble(members, combine).eval(), 3, 32, path)
                 ops[combine] = [n.op_type for n in onnx.load(path).graph.node]
         # OpenCV spends 14 % of a two-member ensemble's time in these (docs/performance.md).
         for op in ("LogSoftmax", "ReduceMean", "Transpose"):
@@ -57,18 +58,18 @@ class EnsembleTest(unittest.TestCase):
         self.assertEqual(ops["logits"].count("Conv"), ops["log_softmax"].count("Conv"))
 
     def test_members_are_rebuilt_as_train_py_exported_them(self):
-        unet = seeded(train.UNet(inputs=6), 3).eval()
+        unet = seeded(UNet(inputs=6), 3).eval()
         prior = torch.tensor([0.5, 0.25, 0.25] + [0.0] * 9)
         record = {"settings": {"normals": True, "out": "run"}, "exported": {"tau": 0.5}}
-        member, inputs = ensemble.build_member(record, unet.state_dict(), "", prior)
+        member, inputs = build_member(record, unet.state_dict(), "", prior)
         self.assertEqual(inputs, 6)
         x = torch.randn(1, 6, 32, 32)
         expected = unet(x)
         adjust = torch.cat([-0.5 * torch.log(prior[:3]), torch.full((9,), -30.0)])
         torch.testing.assert_close(member(x), expected + adjust[None, :, None, None], rtol=1e-4, atol=1e-4)
         with self.assertRaisesRegex(ValueError, "run was trained with a pretrained context encoder: pass --context"):
-            ensemble.build_member({"settings": {"context": "models", "out": "run"}, "exported": {"tau": 0}},
-                                  unet.state_dict(), "", prior)
+            build_member({"settings": {"context": "models", "out": "run"}, "exported": {"tau": 0}},
+                         unet.state_dict(), "", prior)
 
 
 class EnsembleToolTest(DatasetCase):
@@ -76,10 +77,10 @@ class EnsembleToolTest(DatasetCase):
         return subprocess.run([sys.executable, ENSEMBLE, *args], capture_output=True, text=True)
 
     def test_exports_one_model_with_the_members_validation_scores(self):
-        first = seeded(train.UNet(inputs=6), 1).state_dict()
+        first = seeded(UNet(inputs=6), 1).state_dict()
         runs = [os.path.join(self.tmp.name, f"run{i}") for i in range(3)]
         write_run(runs[0], self.dataset, first)
-        write_run(runs[1], self.dataset, seeded(train.UNet(inputs=6), 2).state_dict(), tau=0.25)
+        write_run(runs[1], self.dataset, seeded(UNet(inputs=6), 2).state_dict(), tau=0.25)
         write_run(runs[2], self.dataset, first)  # the same weights twice: the exporter shares them (Identity)
         out = os.path.join(self.tmp.name, "out")
         done = self.run_tool(out, *runs)
@@ -112,7 +113,7 @@ class EnsembleToolTest(DatasetCase):
     def test_a_failed_export_leaves_the_ensemble_it_would_replace(self):
         runs = [os.path.join(self.tmp.name, f"run{i}") for i in range(2)]
         for i, run in enumerate(runs):
-            write_run(run, self.dataset, seeded(train.UNet(inputs=6), i + 1).state_dict())
+            write_run(run, self.dataset, seeded(UNet(inputs=6), i + 1).state_dict())
         out = os.path.join(self.tmp.name, "out")
         done = self.run_tool(out, *runs)
         self.assertEqual(done.returncode, 0, done.stderr)
@@ -134,7 +135,7 @@ class EnsembleToolTest(DatasetCase):
     def test_an_ensemble_stands_for_its_members_and_one_of_them_can_be_continued(self):
         runs = [os.path.join(self.tmp.name, f"run{i}") for i in range(2)]
         for i, run in enumerate(runs):
-            write_run(run, self.dataset, seeded(train.UNet(inputs=6), i + 1).state_dict(), tau=0.25 * i)
+            write_run(run, self.dataset, seeded(UNet(inputs=6), i + 1).state_dict(), tau=0.25 * i)
         out = os.path.join(self.tmp.name, "out")
         self.assertEqual(self.run_tool(out, *runs).returncode, 0)
         for name in ("best.pt", "training.json"):  # the runs are gone: only the ensemble's file is left
@@ -166,22 +167,21 @@ class EnsembleToolTest(DatasetCase):
         continued = os.path.join(self.tmp.name, "continued")
         done = self.run_train(continued, "--epochs", "0", "--init", exported + "#1")
         self.assertEqual(done.returncode, 0, done.stderr)
-        (_, member_record, _), = ensemble.read_runs(out + "#1")
-        member, _ = ensemble.build_member(member_record, None, "", torch.zeros(12))
+        (_, member_record, _), = read_runs(out + "#1")
+        member, _ = build_member(member_record, None, "", torch.zeros(12))
         x = torch.randn(1, 6, 32, 32)
-        started = train.UNet(inputs=6)
-        import onnx_weights
+        started = UNet(inputs=6)
         started.load_state_dict(onnx_weights.recover_state(started, os.path.join(continued, "g2p-materials.onnx"),
                                                            6, 32))
         with torch.no_grad():  # the run starts, and with no epochs ends, as the member (its adjustment included)
             expected = member(x)
             torch.testing.assert_close(started.eval()(x), expected, rtol=0, atol=1e-4 * expected.abs().max().item())
-            other, _ = ensemble.build_member(ensemble.read_runs(out + "#0")[0][1], None, "", torch.zeros(12))
+            other, _ = build_member(read_runs(out + "#0")[0][1], None, "", torch.zeros(12))
             # Member #0 is farther from it than ten times the tolerance: the check above can fail.
             self.assertGreater((other(x) - expected).abs().max().item(), 1e-3 * expected.abs().max().item())
 
     def test_members_validated_on_other_models_are_refused(self):
-        state = seeded(train.UNet(inputs=6), 1).state_dict()
+        state = seeded(UNet(inputs=6), 1).state_dict()
         a, b, c = (os.path.join(self.tmp.name, n) for n in ("a", "b", "c"))
         write_run(a, self.dataset, state)
         write_run(b, self.dataset, state, split_seed=2)

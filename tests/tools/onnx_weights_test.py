@@ -14,11 +14,12 @@ import numpy as np
 import torch
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
+sys.path.insert(0, os.path.join(HERE, "..", ".."))  # the repository root: tools.training is a package
 sys.path.insert(0, HERE)
-import ensemble  # noqa: E402
-import onnx_weights  # noqa: E402
-import train  # noqa: E402
+from tools.training import ensemble, onnx_weights, quantize, train  # noqa: E402
+from tools.training.export import export_onnx, export_shape  # noqa: E402
+from tools.training.model import ContextUNet, Ensemble, UNet  # noqa: E402
+from tools.training.runs import build_member, read_runs  # noqa: E402
 from train_test import DatasetCase, FakeContext, seeded, write_run  # noqa: E402
 
 
@@ -37,11 +38,11 @@ def trained_looking(model, seed):
 
 
 def context_network(seed, inputs=6):
-    return trained_looking(train.ContextUNet(train.UNet(inputs=inputs), FakeContext(), trainable=True), seed)
+    return trained_looking(ContextUNet(UNet(inputs=inputs), FakeContext(), trainable=True), seed)
 
 
 def export(model, path, inputs=6, size=32):
-    train.export_onnx(model, inputs, size, path)
+    export_onnx(model, inputs, size, path)
 
 
 def assert_same_function(got, expected, tolerance=1e-5):
@@ -143,7 +144,7 @@ class RecoverTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "rgb.onnx: not this network's export"):
             onnx_weights.recover_state(context_network(2), other, 6, 32)
         unet = os.path.join(self.tmp.name, "unet.onnx")
-        export(trained_looking(train.UNet(inputs=6), 3), unet)
+        export(trained_looking(UNet(inputs=6), 3), unet)
         with self.assertRaisesRegex(ValueError, "unet.onnx: not this network's export"):
             onnx_weights.recover_state(context_network(2), unet, 6, 32)
         text = os.path.join(self.tmp.name, "text.onnx")
@@ -152,8 +153,8 @@ class RecoverTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "text.onnx: not an ONNX file"):
             onnx_weights.recover_state(context_network(2), text, 6, 32)
         with self.assertRaisesRegex(ValueError, "text.onnx: not an ONNX file"):
-            train.export_shape(text)
-        self.assertEqual(train.export_shape(other), (3, 32))
+            export_shape(text)
+        self.assertEqual(export_shape(other), (3, 32))
 
 
 class EnsembleRecoverTest(unittest.TestCase):
@@ -172,7 +173,7 @@ class EnsembleRecoverTest(unittest.TestCase):
         originals = [context_network(1), context_network(2)]
         with tempfile.TemporaryDirectory() as tmp:
             path, again = os.path.join(tmp, "ensemble.onnx"), os.path.join(tmp, "again.onnx")
-            quantised = ensemble.export_ensemble(ensemble.Ensemble(originals, combine).eval(), 6, 32, path)
+            quantised = ensemble.export_ensemble(Ensemble(originals, combine).eval(), 6, 32, path)
             self.assertEqual(onnx_weights.combine_of(path), combine)
             self.assertGreater(quantised["convolutions"], 30)
             states = onnx_weights.recover_members([context_network(3), context_network(4)], path, 6, 32)
@@ -188,7 +189,7 @@ class EnsembleRecoverTest(unittest.TestCase):
                 alone = os.path.join(tmp, f"alone{k}.onnx")
                 export(original, alone)
                 model = onnx.load(alone)
-                ensemble.quantize.quantize_conv_weights(model)
+                quantize.quantize_conv_weights(model)
                 onnx.save(model, alone)
                 rounded = context_network(6)
                 rounded.load_state_dict(onnx_weights.recover_state(rounded, alone, 6, 32))
@@ -198,7 +199,7 @@ class EnsembleRecoverTest(unittest.TestCase):
                     assert_same_function(got, rounded.eval()(x))
                     self.assertGreater((members[1 - k](x) - got).abs().max().item(), 0.1 * expected.abs().max().item())
             # Exported again as ensemble.py exports, the recovered members give the file they came from.
-            ensemble.export_ensemble(ensemble.Ensemble(members, combine).eval(), 6, 32, again)
+            ensemble.export_ensemble(Ensemble(members, combine).eval(), 6, 32, again)
             first, second = onnx.load(path).graph, onnx.load(again).graph
             with self.assertRaisesRegex(ValueError, "not this network's export .*an ensemble read as one network"):
                 onnx_weights.recover_state(context_network(3), path, 6, 32)
@@ -246,33 +247,33 @@ class ContinueFromExportTest(DatasetCase):
 
 class EnsembleMemberFromExportTest(DatasetCase):
     def test_a_run_without_checkpoints_joins_through_its_export(self):
-        state = trained_looking(train.UNet(inputs=6), 4).state_dict()
+        state = trained_looking(UNet(inputs=6), 4).state_dict()
         run = os.path.join(self.tmp.name, "run")
         write_run(run, self.dataset, state, tau=0.25)
         prior = torch.tensor([0.5, 0.25, 0.25] + [0.0] * 9)
-        record, loaded = ensemble.read_runs(run)[0][1:]
-        reference, _ = ensemble.build_member(record, loaded, "", prior)
+        record, loaded = read_runs(run)[0][1:]
+        reference, _ = build_member(record, loaded, "", prior)
         export(reference, os.path.join(run, "g2p-materials.onnx"))
         os.remove(os.path.join(run, "best.pt"))
-        record, loaded = ensemble.read_runs(run)[0][1:]
+        record, loaded = read_runs(run)[0][1:]
         self.assertIsNone(loaded)
         self.assertEqual(record["weights_from"], os.path.join(os.path.abspath(run), "g2p-materials.onnx"))
-        member, inputs = ensemble.build_member(record, loaded, "", prior)
+        member, inputs = build_member(record, loaded, "", prior)
         self.assertEqual(inputs, 6)
         x = torch.randn(1, 6, 32, 32)
         with torch.no_grad():  # the adjustment (tau 0.25) is in the export once, and not added again
             assert_same_function(member(x), reference(x))
         with self.assertRaisesRegex(ValueError, r"logit adjustment \(tau 0.25\) is folded into the weights"):
-            ensemble.build_member(record, None, "", None)  # a teacher needs the network before it
+            build_member(record, None, "", None)  # a teacher needs the network before it
         os.remove(os.path.join(run, "g2p-materials.onnx"))
         with self.assertRaisesRegex(ValueError, "holds neither best.pt nor g2p-materials.onnx"):
-            ensemble.read_runs(run)
+            read_runs(run)
         with self.assertRaisesRegex(ValueError, r"run#1: .*run is one network, not an ensemble \(drop #1\)"):
-            ensemble.read_runs(run + "#1")
+            read_runs(run + "#1")
         with open(os.path.join(run, "training.json"), "w") as f:
             json.dump({"ensemble": {}, "members": []}, f)
         with self.assertRaisesRegex(ValueError, "an ensemble without members"):
-            ensemble.read_runs(run)
+            read_runs(run)
 
 
 if __name__ == "__main__":

@@ -14,8 +14,8 @@ import torch
 import torch.nn as nn
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
-import quantize  # noqa: E402
+sys.path.insert(0, os.path.join(HERE, "..", ".."))  # the repository root: tools.training is a package
+from tools.training import quantize  # noqa: E402
 
 QUANTIZE = os.path.join(HERE, "..", "..", "tools", "training", "quantize.py")
 

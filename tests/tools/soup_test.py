@@ -13,11 +13,11 @@ import torch
 import torch.nn as nn
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "training"))
+sys.path.insert(0, os.path.join(HERE, "..", ".."))  # the repository root: tools.training is a package
 sys.path.insert(0, HERE)
-import ensemble  # noqa: E402
-import soup  # noqa: E402
-import train  # noqa: E402
+from tools.training import soup  # noqa: E402
+from tools.training.model import UNet  # noqa: E402
+from tools.training.runs import build_member, read_runs  # noqa: E402
 from train_test import DatasetCase, seeded, snapshot, write_run  # noqa: E402
 
 SOUP = os.path.join(HERE, "..", "..", "tools", "training", "soup.py")
@@ -36,7 +36,7 @@ def with_statistics(module, seed):
 
 class AverageTest(unittest.TestCase):
     def test_the_soup_is_the_element_wise_mean(self):
-        a, b = (with_statistics(seeded(train.UNet(inputs=6), s), s).state_dict() for s in (1, 2))
+        a, b = (with_statistics(seeded(UNet(inputs=6), s), s).state_dict() for s in (1, 2))
         mean = soup.average_states([a, b])
         self.assertEqual(list(mean), list(a))
         for key in a:
@@ -50,7 +50,7 @@ class AverageTest(unittest.TestCase):
             self.assertTrue(torch.equal(same[key], a[key]), key)  # one network averaged with itself is itself
 
     def test_other_architectures_are_refused(self):
-        rgb, normals = (seeded(train.UNet(inputs=n), 1).state_dict() for n in (3, 6))
+        rgb, normals = (seeded(UNet(inputs=n), 1).state_dict() for n in (3, 6))
         with self.assertRaisesRegex(ValueError, r"enc.0.0.weight: the members' shapes differ \(\(16, 6, 3, 3\), "
                                                 r"\(16, 3, 3, 3\)\)"):
             soup.average_states([normals, rgb])
@@ -60,7 +60,7 @@ class AverageTest(unittest.TestCase):
             soup.average_states([normals, fewer])
 
     def test_recomputed_statistics_are_those_of_the_inputs_in_training_mode(self):
-        net = with_statistics(seeded(train.UNet(inputs=3), 3), 7)
+        net = with_statistics(seeded(UNet(inputs=3), 3), 7)
         batches = [torch.randn(4, 3, 16, 16) * 2 + 1 for _ in range(3)]
         first_conv, first_bn = net.enc[0][0], net.enc[0][1]
         with torch.no_grad():
@@ -87,7 +87,7 @@ class SoupToolTest(DatasetCase):
         paths = []
         for i in range(count):
             path = os.path.join(self.tmp.name, f"run{i}")
-            state = with_statistics(seeded(train.UNet(inputs=6), i + 1), i + 1).state_dict()
+            state = with_statistics(seeded(UNet(inputs=6), i + 1), i + 1).state_dict()
             write_run(path, self.dataset, state, tau=0.25 * i, **kwargs)
             paths.append(path)
         return paths
@@ -114,10 +114,10 @@ class SoupToolTest(DatasetCase):
         self.assertEqual(record["settings"]["out"], out)
 
         # The folder is a run: ensemble.py rebuilds it with its tau folded in, as train.py would have exported it.
-        (_, member_record, state), = ensemble.read_runs(out)
+        (_, member_record, state), = read_runs(out)
         prior = torch.tensor([0.2, 0.8] + [0.0] * 10)
-        member, _ = ensemble.build_member(member_record, state, "", prior)
-        plain = train.UNet(inputs=6)
+        member, _ = build_member(member_record, state, "", prior)
+        plain = UNet(inputs=6)
         plain.load_state_dict(expected)
         x = torch.randn(1, 6, 32, 32)
         tau = record["exported"]["tau"]
@@ -152,7 +152,7 @@ class SoupToolTest(DatasetCase):
         other_split = os.path.join(self.tmp.name, "other_split")
         write_run(other_split, self.dataset, torch.load(os.path.join(runs[0], "best.pt")), split_seed=2)
         rgb = os.path.join(self.tmp.name, "rgb")
-        write_run(rgb, self.dataset, seeded(train.UNet(inputs=3), 1).state_dict())
+        write_run(rgb, self.dataset, seeded(UNet(inputs=3), 1).state_dict())
         with open(os.path.join(rgb, "training.json")) as f:
             record = json.load(f)
         record["settings"]["normals"] = False

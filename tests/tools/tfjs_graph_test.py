@@ -12,8 +12,8 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "training"))
-from tfjs_graph import GraphModel, read_weights  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))  # the repository root: tools.training is a package
+from tools.training.tfjs_graph import GraphModel, read_weights  # noqa: E402
 
 NHWC, NCHW = [0, 2, 3, 1], [0, 3, 1, 2]
 

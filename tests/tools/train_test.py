@@ -20,8 +20,12 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "training"))
-import train  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))  # the repository root: tools.training is a package
+from tools.training import train  # noqa: E402
+from tools.training.data import (CLASSES, MEAN, STD, UNLABELLED_OBJECT, Dataset, augment, read_manifest,  # noqa: E402
+                                 training_rows, validation_subsample)
+from tools.training.export import RUN_FILES, staged_export  # noqa: E402
+from tools.training.model import ContextUNet, Ensemble, UNet, load_init  # noqa: E402
 
 TRAIN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "training", "train.py")
 
@@ -50,8 +54,8 @@ def seeded(module, seed):
 
 class ContextUNetTest(unittest.TestCase):
     def test_starts_as_its_unet_and_learns_the_injection_only(self):
-        unet = seeded(train.UNet(inputs=6), 1).eval()
-        model = train.ContextUNet(unet, FakeContext()).eval()
+        unet = seeded(UNet(inputs=6), 1).eval()
+        model = ContextUNet(unet, FakeContext()).eval()
         x = torch.randn(2, 6, 64, 64)
         with torch.no_grad():
             self.assertLess(float((model(x) - unet(x)).abs().max()), 1e-6)
@@ -64,44 +68,44 @@ class ContextUNetTest(unittest.TestCase):
         self.assertTrue(all(p.grad is not None and p.grad.abs().sum() > 0 for p in model.inject.parameters()))
 
     def test_feeds_the_encoder_nanodets_normalisation(self):
-        model = train.ContextUNet(train.UNet(inputs=3), FakeContext())
+        model = ContextUNet(UNet(inputs=3), FakeContext())
         rgb = torch.rand(1, 3, 4, 4)
-        ours = (rgb - torch.tensor(train.MEAN)[:, None, None]) / torch.tensor(train.STD)[:, None, None]
+        ours = (rgb - torch.tensor(MEAN)[:, None, None]) / torch.tensor(STD)[:, None, None]
         bgr255 = rgb.flip(1) * 255
         expected = (bgr255 - torch.tensor([103.53, 116.28, 123.675])[:, None, None]) / torch.tensor(
             [57.375, 57.12, 58.395])[:, None, None]
         with torch.no_grad():
             self.assertLess(float((model.to_context(ours) - expected).abs().max()), 1e-4)
         # MobileNetV2 (Keras) takes RGB scaled to -1..1.
-        mobile = train.ContextUNet(train.UNet(inputs=3), FakeContext(), kind="mobilenet_v2")
+        mobile = ContextUNet(UNet(inputs=3), FakeContext(), kind="mobilenet_v2")
         with torch.no_grad():
             self.assertLess(float((mobile.to_context(ours) - (rgb * 2 - 1)).abs().max()), 1e-4)
 
     def test_a_trainable_encoder_gets_gradients(self):
-        model = train.ContextUNet(train.UNet(inputs=3), FakeContext(), trainable=True)
+        model = ContextUNet(UNet(inputs=3), FakeContext(), trainable=True)
         nn.init.normal_(model.inject[0].weight, 0, 0.1)  # so that the encoder's output matters
         model(torch.randn(1, 3, 64, 64)).sum().backward()
         self.assertTrue(model.context.proj.weight.grad.abs().sum() > 0)
 
     def test_an_encoder_with_other_strides_is_refused(self):
         with self.assertRaisesRegex(ValueError, "strides 8, 16, 32"):
-            train.ContextUNet(train.UNet(inputs=3), FakeContext(strides=(4, 8, 16)))
+            ContextUNet(UNet(inputs=3), FakeContext(strides=(4, 8, 16)))
         with self.assertRaisesRegex(ValueError, "strides 8, 16, 32"):
-            train.ContextUNet(train.UNet(inputs=3), FakeContext(), extra=[(FakeContext(strides=(8, 16)), "nanodet")])
+            ContextUNet(UNet(inputs=3), FakeContext(), extra=[(FakeContext(strides=(8, 16)), "nanodet")])
 
     def test_an_extra_encoder_starts_at_zero_and_learns_its_injection(self):
-        first = train.ContextUNet(seeded(train.UNet(inputs=6), 4), FakeContext())
+        first = ContextUNet(seeded(UNet(inputs=6), 4), FakeContext())
         nn.init.normal_(first.inject[0].weight, 0, 0.1)
         extra = FakeContext(channels=32)
-        model = train.ContextUNet(train.UNet(inputs=6), FakeContext(), kind="nanodet",
-                                  extra=[(extra, "mobilenet_v2")])
-        train.load_init(model, first.state_dict())  # a checkpoint without the extra encoder
+        model = ContextUNet(UNet(inputs=6), FakeContext(), kind="nanodet",
+                            extra=[(extra, "mobilenet_v2")])
+        load_init(model, first.state_dict())  # a checkpoint without the extra encoder
         first.eval(), model.eval()
         x = torch.randn(2, 6, 64, 64)
         with torch.no_grad():
             self.assertLess(float((model(x) - first(x)).abs().max()), 1e-6)
         # The extra encoder saw its own normalisation of the RGB channels (-1..1), upsampled as the first.
-        rgb = x[:, :3] * torch.tensor(train.STD)[:, None, None] + torch.tensor(train.MEAN)[:, None, None]
+        rgb = x[:, :3] * torch.tensor(STD)[:, None, None] + torch.tensor(MEAN)[:, None, None]
         seen = F.interpolate(rgb * 2 - 1, scale_factor=2, mode="bilinear", align_corners=False)
         self.assertLess(float((extra.seen - seen).abs().max()), 1e-4)
         self.assertEqual([c.in_channels for c in model.extra[0].inject], [32, 32, 32])
@@ -114,21 +118,21 @@ class ContextUNetTest(unittest.TestCase):
         # Building the extra encoder draws nothing from the generator: a run with it sees the same batches.
         draws = []
         for extra in ([], [(FakeContext(channels=32), "mobilenet_v2")]):
-            unet, context = train.UNet(inputs=6), FakeContext()
+            unet, context = UNet(inputs=6), FakeContext()
             torch.manual_seed(11)
-            train.ContextUNet(unet, context, extra=extra)
+            ContextUNet(unet, context, extra=extra)
             draws.append(torch.rand(3))
         self.assertTrue(torch.equal(draws[0], draws[1]))
         # A checkpoint with the extra encoder does not load into a network without it.
         with self.assertRaisesRegex(ValueError, "ctx.pt does not fit this network.*unexpected.*extra"):
-            train.load_init(train.ContextUNet(train.UNet(inputs=6), FakeContext()), model.state_dict(), "ctx.pt")
+            load_init(ContextUNet(UNet(inputs=6), FakeContext()), model.state_dict(), "ctx.pt")
 
 
 class LoadInitTest(unittest.TestCase):
     def test_an_rgb_unet_starts_the_unet_part_and_grows_normal_inputs(self):
-        rgb_net = seeded(train.UNet(inputs=3), 2).eval()
-        model = train.ContextUNet(train.UNet(inputs=6), FakeContext()).eval()
-        train.load_init(model, rgb_net.state_dict())
+        rgb_net = seeded(UNet(inputs=3), 2).eval()
+        model = ContextUNet(UNet(inputs=6), FakeContext()).eval()
+        load_init(model, rgb_net.state_dict())
         x = torch.randn(1, 6, 64, 64)
         with torch.no_grad():
             # The normals' weights are zero: the network is the RGB one.
@@ -136,19 +140,19 @@ class LoadInitTest(unittest.TestCase):
         self.assertEqual(float(model.unet.enc[0][0].weight[:, 3:].abs().sum()), 0.0)
 
     def test_a_context_checkpoint_restores_the_whole_network(self):
-        source = train.ContextUNet(seeded(train.UNet(inputs=6), 3), FakeContext())
+        source = ContextUNet(seeded(UNet(inputs=6), 3), FakeContext())
         nn.init.normal_(source.inject[1].weight, 0, 0.1)
-        target = train.ContextUNet(train.UNet(inputs=6), FakeContext())
-        train.load_init(target, source.state_dict())
+        target = ContextUNet(UNet(inputs=6), FakeContext())
+        load_init(target, source.state_dict())
         for (k, a), b in zip(source.state_dict().items(), target.state_dict().values()):
             self.assertTrue(torch.equal(a, b), k)
 
     def test_mismatches_say_what_to_do(self):
-        context_state = train.ContextUNet(train.UNet(inputs=3), FakeContext()).state_dict()
+        context_state = ContextUNet(UNet(inputs=3), FakeContext()).state_dict()
         with self.assertRaisesRegex(ValueError, "ctx.pt .*--context"):
-            train.load_init(train.UNet(inputs=3), context_state, "ctx.pt")
+            load_init(UNet(inputs=3), context_state, "ctx.pt")
         with self.assertRaisesRegex(ValueError, "other.pt is not a checkpoint"):
-            train.load_init(train.UNet(inputs=3), {"weight": torch.zeros(1)}, "other.pt")
+            load_init(UNet(inputs=3), {"weight": torch.zeros(1)}, "other.pt")
 
 
 def write_dataset(folder, models, value, split="train", libraries=None):
@@ -159,7 +163,7 @@ def write_dataset(folder, models, value, split="train", libraries=None):
         os.makedirs(os.path.join(folder, sub))
     with open(os.path.join(folder, "manifest.csv"), "w", newline="") as f:
         out = csv.writer(f)
-        out.writerow(["image", "library", "model", "split", "view", "labelled_pixels"] + train.CLASSES)
+        out.writerow(["image", "library", "model", "split", "view", "labelled_pixels"] + CLASSES)
         for i, (model, view) in enumerate((m, v) for m in models for v in range(2)):
             name = f"{i:06d}.png"
             Image.fromarray(np.full((4, 4, 3), value, np.uint8)).save(os.path.join(folder, "images", name))
@@ -175,7 +179,7 @@ def write_run(folder, dataset, state, split_seed=1, tau=0.0, sha=None):
     os.makedirs(folder)
     torch.save(state, os.path.join(folder, "best.pt"))
     if sha is None:
-        _, sha = train.read_manifest(dataset)
+        _, sha = read_manifest(dataset)
     settings = {"dataset": dataset, "out": folder, "seed": split_seed + 10, "split_seed": split_seed,
                 "val_share": 0.2, "val_library": "", "export_size": 32, "size": 16, "balance": 0.5,
                 "normals": True, "context": ""}
@@ -196,7 +200,7 @@ class TrainingRowsTest(unittest.TestCase):
         self.tmp.cleanup()
 
     def test_more_datasets_join_training_and_keep_validation_models_out(self):
-        rows, val_rows, sha, more_sha = train.training_rows(self.first, [self.second], 0.2, 1)
+        rows, val_rows, sha, more_sha = training_rows(self.first, [self.second], 0.2, 1)
         val_models = {r["model"] for r in val_rows}
         self.assertEqual(len(val_models), 2)
         self.assertEqual(len(val_rows), 4)
@@ -207,16 +211,16 @@ class TrainingRowsTest(unittest.TestCase):
         self.assertEqual(len(sha), 64)
         self.assertEqual(len(more_sha), 1)
         # Without --more, the same validation models (the split depends on DATASET and the seed only).
-        alone, alone_val, _, none = train.training_rows(self.first, [], 0.2, 1)
+        alone, alone_val, _, none = training_rows(self.first, [], 0.2, 1)
         self.assertEqual({r["model"] for r in alone_val}, val_models)
         self.assertEqual((len(alone), none), (16, []))
 
     def test_images_are_read_from_their_own_dataset(self):
-        rows, _, _, _ = train.training_rows(self.first, [self.second], 0.2, 1)
-        data = train.Dataset(self.first, rows, 4, False, normals=True)
+        rows, _, _, _ = training_rows(self.first, [self.second], 0.2, 1)
+        data = Dataset(self.first, rows, 4, False, normals=True)
         first = [float(data[i][0][0, 0, 0]) for i, r in enumerate(rows) if "root" not in r]
         second = [float(data[i][0][0, 0, 0]) for i, r in enumerate(rows) if "root" in r]
-        normalised = [(v / 255 - train.MEAN[0]) / train.STD[0] for v in (10, 200)]
+        normalised = [(v / 255 - MEAN[0]) / STD[0] for v in (10, 200)]
         self.assertTrue(all(abs(v - normalised[0]) < 1e-5 for v in first))
         self.assertTrue(all(abs(v - normalised[1]) < 1e-5 for v in second))
         self.assertEqual(tuple(data[0][0].shape), (6, 4, 4))
@@ -226,25 +230,25 @@ class TrainingRowsTest(unittest.TestCase):
         first, second = (os.path.join(self.tmp.name, d) for d in ("lib1", "lib2"))
         write_dataset(first, self.models, 10, libraries=libraries)
         write_dataset(second, self.models, 200, libraries=libraries)
-        rows, val_rows, _, _ = train.training_rows(first, [second], 0.2, 1, "B")
+        rows, val_rows, _, _ = training_rows(first, [second], 0.2, 1, "B")
         self.assertEqual({r["library"] for r in val_rows}, {"B"})
         self.assertEqual(len(val_rows), 8)  # every model of B, DATASET's images only
         self.assertEqual({r["library"] for r in rows}, {"A"})
         self.assertEqual(len(rows), 2 * 12)
         with self.assertRaisesRegex(ValueError, "--val-library C: not a training library of .* \\(it has A, B\\)"):
-            train.training_rows(first, [], 0.2, 1, "C")
+            training_rows(first, [], 0.2, 1, "C")
         single = os.path.join(self.tmp.name, "single")
         write_dataset(single, self.models, 10)
         with self.assertRaisesRegex(ValueError, "no other training library"):
-            train.training_rows(single, [], 0.2, 1, "Lib")
+            training_rows(single, [], 0.2, 1, "Lib")
 
     def test_a_dataset_of_other_models_is_refused(self):
         other = os.path.join(self.tmp.name, "other")
         write_dataset(other, self.models[:5] + ["Lib/stranger.obj"], 10)
         with self.assertRaisesRegex(ValueError, "--more .*other: 1 training models .*Lib/stranger.obj"):
-            train.training_rows(self.first, [other], 0.2, 1)
+            training_rows(self.first, [other], 0.2, 1)
         with self.assertRaisesRegex(ValueError, "missing.manifest.csv: not found"):
-            train.training_rows(self.first, [os.path.join(self.tmp.name, "missing")], 0.2, 1)
+            training_rows(self.first, [os.path.join(self.tmp.name, "missing")], 0.2, 1)
 
 
 class DatasetCase(unittest.TestCase):
@@ -272,7 +276,7 @@ class DistillationTest(DatasetCase):
         # logits must not count.
         student = torch.tensor([[[[0.0, 9.0]], [[0.0, -9.0]]]])
         teacher = torch.tensor([[[[2.0, 0.0]], [[0.0, 0.0]]]])
-        label = torch.tensor([[[train.UNLABELLED_OBJECT, 255]]])
+        label = torch.tensor([[[UNLABELLED_OBJECT, 255]]])
         t = [math.exp(1) / (math.exp(1) + 1), 1 / (math.exp(1) + 1)]  # softmax([2, 0] / T), T = 2
         expected = 4 * sum(p * math.log(p / 0.5) for p in t)  # T^2 KL(t || (0.5, 0.5))
         self.assertAlmostEqual(float(train.distillation_loss(student, teacher, label, 2.0)), expected, places=5)
@@ -291,29 +295,28 @@ class DistillationTest(DatasetCase):
         normals[0, :] = (128, 128, 255)  # row 0 is the object, facing the camera
         Image.fromarray(label).save(os.path.join(self.dataset, "labels", name))
         Image.fromarray(normals).save(os.path.join(self.dataset, "normals", name))
-        rows, _ = train.read_manifest(self.dataset)
-        plain = train.Dataset(self.dataset, rows[:1], 4, False)
-        self.assertEqual(int((plain.label[0] == train.UNLABELLED_OBJECT).sum()), 0)
-        data = train.Dataset(self.dataset, rows[:1], 4, False, objects=True)
-        self.assertEqual(data.label[0, 0].tolist(), [3] + [train.UNLABELLED_OBJECT] * 3)
+        rows, _ = read_manifest(self.dataset)
+        plain = Dataset(self.dataset, rows[:1], 4, False)
+        self.assertEqual(int((plain.label[0] == UNLABELLED_OBJECT).sum()), 0)
+        data = Dataset(self.dataset, rows[:1], 4, False, objects=True)
+        self.assertEqual(data.label[0, 0].tolist(), [3] + [UNLABELLED_OBJECT] * 3)
         self.assertTrue(bool((data.label[0, 1:] == 255).all()))
         self.assertIsNone(data.normal)  # the mask only: the network's inputs stay RGB
         # Crops centre on labelled pixels only: every crop of this image holds the class-3 pixel.
         for _ in range(20):
-            _, crop, _ = train.augment(torch.zeros(3, 4, 4), data.label[0].long(), 4)
+            _, crop, _ = augment(torch.zeros(3, 4, 4), data.label[0].long(), 4)
             self.assertIn(3, crop.tolist()[0] + crop.tolist()[-1])
 
     def test_the_teacher_is_the_runs_ensemble_before_their_logit_adjustment(self):
-        import ensemble
-        a, b = (seeded(train.UNet(inputs=6), s).eval() for s in (1, 2))
+        a, b = (seeded(UNet(inputs=6), s).eval() for s in (1, 2))
         runs = [os.path.join(self.tmp.name, n) for n in ("a", "b")]
         write_run(runs[0], self.dataset, a.state_dict(), tau=0.5)
         write_run(runs[1], self.dataset, b.state_dict())
-        _, sha = train.read_manifest(self.dataset)
+        _, sha = read_manifest(self.dataset)
         settings = {"split_seed": 1, "val_share": 0.2, "val_library": "", "normals": True}
         teacher = train.load_teacher(runs, "", sha, settings)
         x = torch.randn(1, 6, 32, 32)
-        torch.testing.assert_close(teacher(x), ensemble.Ensemble([a, b])(x), rtol=1e-4, atol=1e-5)
+        torch.testing.assert_close(teacher(x), Ensemble([a, b])(x), rtol=1e-4, atol=1e-5)
         self.assertFalse(any(p.requires_grad for p in teacher.parameters()))
         with self.assertRaisesRegex(ValueError, "--teacher .*a: validated on other models .*split_seed differs"):
             train.load_teacher(runs, "", sha, dict(settings, split_seed=2))
@@ -324,10 +327,10 @@ class DistillationTest(DatasetCase):
 
     def test_a_run_with_a_teacher_moves_towards_it(self):
         teacher_run = os.path.join(self.tmp.name, "teacher")
-        teacher = seeded(train.UNet(inputs=6), 5).eval()
+        teacher = seeded(UNet(inputs=6), 5).eval()
         write_run(teacher_run, self.dataset, teacher.state_dict())
         start = os.path.join(self.tmp.name, "start.pt")
-        torch.save(seeded(train.UNet(inputs=6), 6).state_dict(), start)
+        torch.save(seeded(UNet(inputs=6), 6).state_dict(), start)
         out = os.path.join(self.tmp.name, "out")
         done = self.run_train(out, "--teacher", teacher_run, "--distill-weight", "1", "--init", start,
                               "--epochs", "4", "--batch", "2", "--lr", "3e-3", "--seed", "3")
@@ -335,12 +338,12 @@ class DistillationTest(DatasetCase):
         with open(os.path.join(out, "training.json")) as f:
             record = json.load(f)
         self.assertEqual(record["settings"]["teacher"], [teacher_run])
-        x = train.Dataset(self.dataset, train.read_manifest(self.dataset)[0][:4], 16, False, normals=True)
+        x = Dataset(self.dataset, read_manifest(self.dataset)[0][:4], 16, False, normals=True)
         x = F.interpolate(torch.stack([x[i][0] for i in range(4)]), size=(32, 32))
         label = torch.zeros(4, 32, 32, dtype=torch.long)  # every pixel counts
 
         def kl(state_path):
-            student = train.UNet(inputs=6)
+            student = UNet(inputs=6)
             student.load_state_dict(torch.load(state_path))
             with torch.no_grad():
                 return float(train.distillation_loss(student.eval()(x), teacher(x), label, 2.0))
@@ -351,7 +354,7 @@ class DistillationTest(DatasetCase):
     def test_a_teacher_with_no_weight_leaves_the_run_as_it_was(self):
         # The same initial weights, batches and augmentations as without a teacher: runs compare pair-wise.
         teacher_run = os.path.join(self.tmp.name, "teacher")
-        write_run(teacher_run, self.dataset, seeded(train.UNet(inputs=6), 5).state_dict())
+        write_run(teacher_run, self.dataset, seeded(UNet(inputs=6), 5).state_dict())
         outs = [os.path.join(self.tmp.name, n) for n in ("plain", "taught")]
         common = ("--epochs", "2", "--batch", "4", "--seed", "4")
         for out, extra in zip(outs, ([], ["--teacher", teacher_run, "--distill-weight", "0"])):
@@ -363,7 +366,7 @@ class DistillationTest(DatasetCase):
 
     def test_teachers_and_datasets_that_cannot_serve_are_refused(self):
         other = os.path.join(self.tmp.name, "other")
-        write_run(other, self.dataset, seeded(train.UNet(inputs=6), 1).state_dict(), split_seed=2)
+        write_run(other, self.dataset, seeded(UNet(inputs=6), 1).state_dict(), split_seed=2)
         done = self.run_train(os.path.join(self.tmp.name, "out"), "--teacher", other, "--epochs", "1")
         self.assertEqual(done.returncode, 2)
         self.assertRegex(done.stderr, "--teacher .*other: validated on other models than this run "
@@ -414,14 +417,14 @@ class ExportTest(DatasetCase):
             with open(os.path.join(out, name), "w") as f:
                 f.write(text)
         with self.assertRaisesRegex(RuntimeError, "half-way"):
-            with train.staged_export(out) as stage:
+            with staged_export(out) as stage:
                 with open(os.path.join(stage, "a.txt"), "w") as f:
                     f.write("new a")
                 raise RuntimeError("failed half-way")
         digest = {text: hashlib.sha256(text.encode()).hexdigest() for text in ("old a", "old b", "new a")}
         self.assertEqual(snapshot(out), {"a.txt": digest["old a"], "b.txt": digest["old b"]})
         self.assertEqual(sorted(os.listdir(out)), ["a.txt", "b.txt"])  # the scratch folder is gone
-        with train.staged_export(out) as stage:
+        with staged_export(out) as stage:
             with open(os.path.join(stage, "a.txt"), "w") as f:
                 f.write("new a")
         self.assertEqual(snapshot(out), {"a.txt": digest["new a"], "b.txt": digest["old b"]})
@@ -432,7 +435,7 @@ class ExportTest(DatasetCase):
         done = self.run_train(out, "--epochs", "1", "--batch", "8")
         self.assertEqual(done.returncode, 0, done.stderr)
         first = snapshot(out)
-        self.assertEqual(set(first), set(train.RUN_FILES))
+        self.assertEqual(set(first), set(RUN_FILES))
         done = self.run_train(out, "--epochs", "1", "--batch", "8", "--seed", "2")
         self.assertEqual(done.returncode, 2)
         self.assertRegex(done.stderr, r"out: already holds a run \(g2p-materials.onnx, .*best.pt\); .*--overwrite")
@@ -440,7 +443,7 @@ class ExportTest(DatasetCase):
         done = self.run_train(out, "--epochs", "1", "--batch", "8", "--seed", "2", "--overwrite")
         self.assertEqual(done.returncode, 0, done.stderr)
         second = snapshot(out)
-        self.assertEqual(set(second), set(train.RUN_FILES))
+        self.assertEqual(set(second), set(RUN_FILES))
         self.assertNotEqual(second["checkpoint.pt"], first["checkpoint.pt"])
         self.assertNotEqual(second["training.json"], first["training.json"])
 
@@ -462,7 +465,7 @@ class ExportTest(DatasetCase):
         finally:
             sys.argv, train.write_model_card = argv, card
         now = snapshot(out)
-        self.assertEqual(sorted(os.listdir(out)), sorted(train.RUN_FILES))  # no scratch folder left
+        self.assertEqual(sorted(os.listdir(out)), sorted(RUN_FILES))  # no scratch folder left
         for name in ("g2p-materials.onnx", "g2p-materials.json", "training.json"):
             self.assertEqual(now[name], first[name], name)
         self.assertNotEqual(now["checkpoint.pt"], first["checkpoint.pt"])  # --overwrite: checkpoints are replaced
@@ -489,12 +492,12 @@ class ShippedManifestTest(unittest.TestCase):
             with tempfile.TemporaryDirectory() as dataset:
                 with open(os.path.join(dataset, "manifest.csv"), "wb") as f:
                     f.write(manifest)
-                rows, val_rows, sha, _ = train.training_rows(dataset, [], settings["val_share"],
-                                                             settings.get("split_seed", settings["seed"]),
-                                                             settings.get("val_library", ""))
+                rows, val_rows, sha, _ = training_rows(dataset, [], settings["val_share"],
+                                                       settings.get("split_seed", settings["seed"]),
+                                                       settings.get("val_library", ""))
             self.assertEqual(sha, run["manifest_sha256"])
             self.assertEqual(len(rows), run["images"])
-            self.assertEqual(len(train.validation_subsample(val_rows)), run["validation_images"])
+            self.assertEqual(len(validation_subsample(val_rows)), run["validation_images"])
             self.assertFalse({r["model"] for r in rows} & {r["model"] for r in val_rows})
             self.assertEqual({r["split"] for r in rows}, {"train"})
 

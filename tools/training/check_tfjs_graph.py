@@ -19,10 +19,15 @@ import tempfile
 import numpy as np
 import torch
 
+if __name__ == "__main__" and not __package__:  # run as a script: import the package as python3 -m does
+    sys.path[0] = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    __package__ = "tools.training"
+
+from .keras_layers import LayersModel  # noqa: E402
+from .model import CONTEXTS  # noqa: E402
+from .tfjs_graph import GraphModel  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-from keras_layers import LayersModel  # noqa: E402
-from tfjs_graph import GraphModel  # noqa: E402
 
 
 def main():
@@ -39,8 +44,7 @@ def main():
         layers = json.load(f).get("format") == "layers-model"
     nodes = a.nodes
     if not nodes:
-        import train  # noqa: E402 (the same folder)
-        nodes = train.CONTEXTS["mobilenet_v2" if layers else "nanodet"]["outputs"]
+        nodes = CONTEXTS["mobilenet_v2" if layers else "nanodet"]["outputs"]
     torch.manual_seed(0)
     if layers:  # Keras' MobileNetV2 takes -1..1
         x = torch.rand(1, a.channels, a.size, a.size) * 2 - 1

@@ -8,25 +8,31 @@ training image of DATASET (a g2p_make_dataset folder), with train.py's validatio
 logit adjustment. It prints the validation pixel mIoU for each tau and exports itself as 1x1 convolutions
 (OUT/g2p-materials.onnx and its card), so that `g2p eval seg --segmenter onnx --set model_card=...` scores it
 exactly as it scores the network. If the network does not beat this, it has learnt colour and little else
-(docs/training.md, "Colour alone").
+(docs/training-log.md, "Colour alone").
 """
 import argparse
 import json
 import os
 import random
+import sys
 
 import numpy as np
 import torch
 import torch.nn as nn
 
-import train as T
+if __name__ == "__main__" and not __package__:  # run as a script: import the package as python3 -m does
+    sys.path[0] = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    __package__ = "tools.training"
+
+from .data import CLASSES, class_weights, read_png, training_rows  # noqa: E402
+from .metrics import mean_iou  # noqa: E402
 
 
 def pixels(root, rows, per_image):
     xs, ys = [], []
     for r in rows:
-        rgb = T.read_png(os.path.join(root, "images", r["image"])).reshape(-1, 3)
-        label = T.read_png(os.path.join(root, "labels", r["image"])).ravel()
+        rgb = read_png(os.path.join(root, "images", r["image"])).reshape(-1, 3)
+        label = read_png(os.path.join(root, "labels", r["image"])).ravel()
         idx = np.nonzero(label != 255)[0]
         if per_image and len(idx) > per_image:
             idx = np.random.choice(idx, per_image, replace=False)
@@ -47,14 +53,14 @@ def main():
     np.random.seed(a.seed)
     torch.manual_seed(a.seed)
     try:
-        rows, val_rows, _, _ = T.training_rows(a.dataset, [], 0.1, a.seed)  # the validation models train.py uses
+        rows, val_rows, _, _ = training_rows(a.dataset, [], 0.1, a.seed)  # the validation models train.py uses
     except ValueError as e:
         ap.error(str(e))
     val_rows = val_rows[::max(1, len(val_rows) // 256)]
-    weights, counts = T.class_weights(rows, 0.5)
+    weights, counts = class_weights(rows, 0.5)
     x, y = pixels(a.dataset, rows, a.pixels)
     xv, yv = pixels(a.dataset, val_rows, 0)
-    mlp = nn.Sequential(nn.Linear(3, 64), nn.ReLU(), nn.Linear(64, 64), nn.ReLU(), nn.Linear(64, len(T.CLASSES)))
+    mlp = nn.Sequential(nn.Linear(3, 64), nn.ReLU(), nn.Linear(64, 64), nn.ReLU(), nn.Linear(64, len(CLASSES)))
     opt = torch.optim.Adam(mlp.parameters(), 1e-2)
     loss_fn = nn.CrossEntropyLoss(weight=weights)
     for _ in range(6):
@@ -74,8 +80,8 @@ def main():
         logits = mlp(xv)
         for tau in (0.0, 0.25, 0.5, 0.75, 1.0):
             predicted = (logits + adjustment(tau)).argmax(1)
-            matrix = torch.bincount(yv * len(T.CLASSES) + predicted, minlength=len(T.CLASSES) ** 2)
-            print(f"tau {tau}: validation pixel mIoU {T.mean_iou(matrix.view(len(T.CLASSES), -1).double()):.3f}")
+            matrix = torch.bincount(yv * len(CLASSES) + predicted, minlength=len(CLASSES) ** 2)
+            print(f"tau {tau}: validation pixel mIoU {mean_iou(matrix.view(len(CLASSES), -1).double()):.3f}")
     layers = []
     for layer in mlp:
         if isinstance(layer, nn.Linear):
@@ -94,7 +100,7 @@ def main():
     card = {"format": "g2p-onnx-model-card", "version": 1, "model": "g2p-materials.onnx",
             "input": {"width": 128, "height": 128, "channel_order": "RGB", "scale": 1 / 255, "mean": [0, 0, 0],
                       "std": [1, 1, 1], "name": "pixels"},
-            "output": {"kind": "logits", "name": "logits"}, "classes": T.CLASSES,
+            "output": {"kind": "logits", "name": "logits"}, "classes": CLASSES,
             "trained_on": "colour-only baseline (tools/training/colour_baseline.py)"}
     with open(os.path.join(a.out, "g2p-materials.json"), "w") as f:
         json.dump(card, f, indent=2)

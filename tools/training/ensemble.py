@@ -19,7 +19,7 @@ ensemble of four members is about the size of one member in float (18.6 against 
 them in float. OUT receives g2p-materials.onnx, its model card and training.json (the members' own records, and
 the validation mIoU of each member and of the ensemble, in float, on the same images); they replace OUT's only once
 all three are written, so a failed export leaves OUT as it was.
-docs/training.md, "An ensemble of two lineages", gives the measured effect.
+docs/training-log.md, "An ensemble of two lineages", gives the measured effect.
 """
 import argparse
 import json
@@ -27,161 +27,18 @@ import os
 import sys
 
 import torch
-import torch.nn as nn
-import torch.nn.functional as F
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import quantize  # noqa: E402  (tools/training/quantize.py)
-import train  # noqa: E402  (tools/training/train.py)
+if __name__ == "__main__" and not __package__:  # run as a script: import the package as python3 -m does
+    sys.path[0] = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    __package__ = "tools.training"
 
-# The settings that decide which models a run validated on; they must agree across members.
-SPLIT_KEYS = ("split_seed", "val_share", "val_library")
-
-
-# How an Ensemble averages its members, as training.json records it. Both give logits whose softmax is the normalised
-# geometric mean of the members' probabilities: log-softmax only subtracts a constant per pixel, which no softmax sees.
-# "logits" saves OpenCV two ops per member (a log-softmax, which opset 11 exports between two transposes, and a
-# stack averaged along a new axis): 14 % of a two-member ensemble's time per view (docs/performance.md). Ensembles
-# exported before 2026-11-24 (the shipped one until then) average log-softmax; onnx_weights.py reads both.
-COMBINES = {"logits": "mean of logits", "log_softmax": "mean of log-softmax"}
-
-
-class Ensemble(nn.Module):
-    """A logit vector whose softmax is the normalised geometric mean of the members' class probabilities: the mean of
-    their logits, or with combine="log_softmax" (the older exports) of their log-softmax."""
-
-    def __init__(self, members, combine="logits"):
-        super().__init__()
-        if combine not in COMBINES:
-            raise ValueError(f"combine must be one of {', '.join(COMBINES)}, not {combine!r}")
-        self.members = nn.ModuleList(members)
-        self.combine = combine
-
-    def forward(self, x):
-        if self.combine == "log_softmax":
-            return torch.stack([F.log_softmax(m(x), 1) for m in self.members]).mean(0)
-        total = self.members[0](x)
-        for m in self.members[1:]:
-            total = total + m(x)
-        return total * (1.0 / len(self.members))
-
-
-def split_member(spec):
-    """(path, member index or None) of a RUN argument, "FOLDER" or "FOLDER#K" (K from 0)."""
-    path, mark, member = spec.rpartition("#")
-    if mark and member.isdigit():
-        return path, int(member)
-    return spec, None
-
-
-def read_runs(spec):
-    """The members a RUN argument stands for, as (label, training.json record, best.pt's state dict) triples.
-
-    A train.py output folder is one member. A folder whose checkpoints are gone (a run from another machine) serves
-    through its exported g2p-materials.onnx: the state is then None and the record's "weights_from" names the file,
-    whose weights build_member recovers (onnx_weights.py). An ensemble.py output folder (the shipped
-    libg2p/data/models/ is one) stands for all its members, "FOLDER#K" for member K alone (from 0): their records
-    are those the ensemble keeps, with "weights_from" its file and "member" the index. ValueError names what is
-    missing."""
-    folder, only = split_member(spec)
-    paths = {name: os.path.join(folder, name) for name in ("training.json", "best.pt", "g2p-materials.onnx")}
-    if not os.path.isfile(paths["training.json"]):
-        raise ValueError(f"{paths['training.json']}: not found (a member is a train.py or ensemble.py output folder)")
-    with open(paths["training.json"]) as f:
-        record = json.load(f)
-    if "ensemble" in record:
-        members = record.get("members") or []
-        if not members:
-            raise ValueError(f"{paths['training.json']}: an ensemble without members")
-        if only is not None and only >= len(members):
-            raise ValueError(f"{spec}: the ensemble has {len(members)} members (#0 to #{len(members) - 1})")
-        if not os.path.isfile(paths["g2p-materials.onnx"]):
-            raise ValueError(f"{folder}: an ensemble without its g2p-materials.onnx")
-        runs = []
-        for k, member in enumerate(members):
-            if only is not None and k != only:
-                continue
-            member = dict(member, weights_from=os.path.abspath(paths["g2p-materials.onnx"]), member=k)
-            member["ensemble_members"] = [dict(m) for m in members]
-            runs.append((f"{folder}#{k}", member, None))
-        return runs
-    if only is not None:
-        raise ValueError(f"{spec}: {folder} is one network, not an ensemble (drop #{only})")
-    if not record.get("exported"):
-        raise ValueError(f"{paths['training.json']}: no validated epoch was exported (trained without validation)")
-    if os.path.isfile(paths["best.pt"]):
-        return [(spec, record, torch.load(paths["best.pt"], map_location="cpu"))]
-    if not os.path.isfile(paths["g2p-materials.onnx"]):
-        raise ValueError(f"{folder}: holds neither best.pt nor g2p-materials.onnx (the run's weights)")
-    record["weights_from"] = os.path.abspath(paths["g2p-materials.onnx"])
-    return [(spec, record, None)]
-
-
-def network(record, context):
-    """(the untrained network a run's recorded settings describe, its input channels)."""
-    settings = record["settings"]
-    inputs = 6 if settings.get("normals") else 3
-    model = train.UNet(inputs=inputs)
-    if settings.get("context"):
-        if not context:
-            raise ValueError(f"{settings['out']} was trained with a pretrained context encoder: pass --context")
-        model = train.context_unet(model, settings, context)
-    return model, inputs
-
-
-_RECOVERED = {}  # (ensemble file, context) -> its members' state dicts: an ensemble is taken apart once
-
-
-def member_state(record, context):
-    """The weights of ensemble member record["member"] (a record from read_runs), recovered from its ensemble's
-    file together with its fellow members'."""
-    key = (record["weights_from"], context)
-    if key not in _RECOVERED:
-        import onnx_weights  # tools/training/onnx_weights.py
-        built = [network(m, context) for m in record["ensemble_members"]]
-        inputs = {n for _, n in built}
-        if len(inputs) != 1:
-            raise ValueError(f"{record['weights_from']}: its members take different inputs")
-        _RECOVERED[key] = onnx_weights.recover_members([m for m, _ in built], record["weights_from"], inputs.pop(),
-                                                       record["settings"]["export_size"])
-    return _RECOVERED[key][record["member"]]
-
-
-def build_member(record, state, context, prior):
-    """The network a run exported: its architecture from the recorded settings, its best weights and its logit
-    adjustment folded into the classifier's bias, as train.py exports it (with `prior` None, no adjustment). With
-    `state` None the weights are recovered from record["weights_from"], its export (or its ensemble's), which has
-    the adjustment in."""
-    model, inputs = network(record, context)
-    tau = record["exported"]["tau"]
-    if state is None:
-        if prior is None and tau != 0:
-            raise ValueError(f"{record['weights_from']}: its logit adjustment (tau {tau}) is folded into the weights; "
-                             f"without its best.pt the network before the adjustment is not known")
-        if "member" in record:
-            model.load_state_dict(member_state(record, context))
-        else:
-            import onnx_weights  # tools/training/onnx_weights.py
-            model.load_state_dict(onnx_weights.recover_state(model, record["weights_from"], inputs,
-                                                             record["settings"]["export_size"]))
-        return model.eval(), inputs
-    model.load_state_dict(state)
-    if prior is None:  # the network's own probabilities, before the logit adjustment (a teacher's)
-        return model.eval(), inputs
-    with torch.no_grad():
-        model.head.bias += torch.where(prior > 0, -tau * torch.log(prior.clamp(min=1e-12)),
-                                       torch.full_like(prior, -30.0))
-    return model.eval(), inputs
-
-
-def split_mismatch(record, settings, sha):
-    """What makes a run's validation models differ from those of `settings` on the dataset whose manifest has
-    SHA-256 `sha` ("" when they are the same): "manifest" or the differing split settings."""
-    if record["manifest_sha256"] != sha:
-        return "manifest"
-    own = dict(record["settings"])
-    own.setdefault("split_seed", own.get("seed"))  # runs from before --split-seed split with --seed
-    return ", ".join(k for k in SPLIT_KEYS if own.get(k, "") != settings.get(k, ""))
+from . import quantize  # noqa: E402
+from .data import CLASSES, Dataset, class_weights, training_rows, validation_subsample  # noqa: E402
+from .export import export_onnx, staged_export, write_model_card  # noqa: E402
+from .metrics import confusion, mean_iou  # noqa: E402
+from .model import COMBINES, Ensemble, context_kinds  # noqa: E402
+from .onnx_weights import inline_identity_constants  # noqa: E402
+from .runs import build_member, read_runs, split_mismatch  # noqa: E402
 
 
 def export_ensemble(model, inputs, size, onnx_path, int8=True):
@@ -190,10 +47,9 @@ def export_ensemble(model, inputs, size, onnx_path, int8=True):
     replaced by constants, since OpenCV 4.6's importer cannot parse an Identity whose input is a constant, and with
     `int8` the convolution weights in 8 bits (quantize.py). Returns quantize.py's counts (None without `int8`)."""
     import onnx  # python3-onnx
-    import onnx_weights  # tools/training/onnx_weights.py
-    train.export_onnx(model, inputs, size, onnx_path)
+    export_onnx(model, inputs, size, onnx_path)
     exported = onnx.load(onnx_path)
-    onnx_weights.inline_identity_constants(exported)
+    inline_identity_constants(exported)
     quantised = None
     if int8:
         count, before, after = quantize.quantize_conv_weights(exported)
@@ -230,8 +86,8 @@ def main():
     dataset = a.dataset or first["dataset"]
     for record in records:  # runs from before --split-seed split with --seed
         record["settings"].setdefault("split_seed", record["settings"]["seed"])
-    rows, val_rows, sha, _ = train.training_rows(dataset, [], first["val_share"], first["split_seed"],
-                                                 first.get("val_library", ""))
+    rows, val_rows, sha, _ = training_rows(dataset, [], first["val_share"], first["split_seed"],
+                                           first.get("val_library", ""))
     for run, record in zip(labels, records):
         s = record["settings"]
         differs = split_mismatch(record, first, sha)
@@ -240,8 +96,8 @@ def main():
                      f"({differs} differs); its score on these validation images would include its training models")
         if record["settings"].get("export_size") != first.get("export_size"):
             ap.error(f"{run}: export size {s.get('export_size')} differs from {labels[0]}'s")
-    val_rows = train.validation_subsample(val_rows)
-    _, counts = train.class_weights(rows, first["balance"])
+    val_rows = validation_subsample(val_rows)
+    _, counts = class_weights(rows, first["balance"])
     prior = torch.tensor(counts / max(counts.sum(), 1), dtype=torch.float32)
     try:
         built = [build_member(record, state, a.context, prior) for _, record, state in runs]
@@ -255,20 +111,20 @@ def main():
     model = Ensemble(members).eval()
 
     size = first["export_size"]
-    val_data = torch.utils.data.DataLoader(train.Dataset(dataset, val_rows, first["size"], False,
-                                                         normals=inputs == 6), batch_size=32)
-    zero = [torch.zeros(len(train.CLASSES))]
-    scores = {run: train.mean_iou(train.confusion(m, val_data, size, zero, "cpu")[0])
+    val_data = torch.utils.data.DataLoader(Dataset(dataset, val_rows, first["size"], False,
+                                                   normals=inputs == 6), batch_size=32)
+    zero = [torch.zeros(len(CLASSES))]
+    scores = {run: mean_iou(confusion(m, val_data, size, zero, "cpu")[0])
               for run, m in zip(labels, members)}
-    scores["ensemble"] = train.mean_iou(train.confusion(model, val_data, size, zero, "cpu")[0])
+    scores["ensemble"] = mean_iou(confusion(model, val_data, size, zero, "cpu")[0])
     for name, score in scores.items():
         print(f"validation mIoU {100 * score:.1f} %: {name}", flush=True)
 
-    with train.staged_export(a.out) as stage:  # OUT keeps what it held unless the whole export succeeds
+    with staged_export(a.out) as stage:  # OUT keeps what it held unless the whole export succeeds
         onnx_path = os.path.join(stage, "g2p-materials.onnx")
         quantised = export_ensemble(model, inputs, size, onnx_path, int8=not a.float_weights)
-        train.write_model_card(stage, size, inputs == 6,
-                               list(dict.fromkeys(k for r in records for k in train.context_kinds(r["settings"]))))
+        write_model_card(stage, size, inputs == 6,
+                         list(dict.fromkeys(k for r in records for k in context_kinds(r["settings"]))))
         with open(os.path.join(stage, "training.json"), "w") as f:
             json.dump({"ensemble": {"members": labels, "combine": COMBINES[model.combine], "int8_weights": quantised,
                                     "dataset": dataset,

@@ -1,7 +1,7 @@
 """Runs a TensorFlow.js layers model (a Keras topology and its weights manifest) as a torch module.
 
 train.py uses it for an ImageNet encoder from the npm registry: the MobileNetV2 (Sandler et al. 2018) of the
-package nsfwjs, unpacked by unpack_nsfwjs.js (docs/training.md, "An ImageNet encoder"). The interpreter covers
+package nsfwjs, unpacked by unpack_nsfwjs.js (docs/training.md, "Pretrained encoders"). The interpreter covers
 the layers Keras' MobileNetV2 is built from: InputLayer, Conv2D, DepthwiseConv2D, BatchNormalization (inference
 form: moving statistics), ReLU (with max_value), ZeroPadding2D and Add. Only the layers the requested outputs
 depend on are built, so a classifier's head (Dense, pooling) may follow them unread.
@@ -18,7 +18,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from tfjs_graph import read_weights
+from .tfjs_graph import read_weights
 
 _SUPPORTED = {"InputLayer", "Conv2D", "DepthwiseConv2D", "BatchNormalization", "ReLU", "ZeroPadding2D", "Add"}
 

@@ -26,6 +26,10 @@ import numpy as np
 import torch
 import torch.nn as nn
 
+from .export import export_onnx
+from .model import Ensemble
+from .quantize import dequantize_conv_weights
+
 _EXACT = 1 << 24  # float32 holds every integer up to 2^24 exactly
 
 
@@ -45,8 +49,7 @@ def _make_identity(bn):
 
 def _export(model, inputs, size):
     buffer = io.BytesIO()
-    import train  # tools/training/train.py: the probe is exported exactly as the run was
-    train.export_onnx(model, inputs, size, buffer)
+    export_onnx(model, inputs, size, buffer)  # the probe is exported exactly as the run was
     import onnx  # python3-onnx
     return onnx.load_from_string(buffer.getvalue())
 
@@ -79,12 +82,11 @@ def recover_state(model, onnx_path, inputs, size):
     Int8 weights (quantize.py) come back as rounded. ValueError says what does not fit: another architecture, an
     ensemble read as one network or one network as an ensemble."""
     import onnx  # python3-onnx
-    import quantize  # tools/training/quantize.py
     try:
         exported = onnx.load(onnx_path)
     except Exception as e:  # onnx raises its own DecodeError and OSError subclasses
         raise ValueError(f"{onnx_path}: not an ONNX file ({e})") from e
-    quantize.dequantize_conv_weights(exported)
+    dequantize_conv_weights(exported)
     inline_identity_constants(exported)
     template = copy.deepcopy(model).cpu().eval()
     bns = {name for name, m in template.named_modules() if _is_batch_norm(m)}
@@ -146,7 +148,7 @@ def recover_state(model, onnx_path, inputs, size):
 
 
 def combine_of(onnx_path):
-    """How the ensemble.py export `onnx_path` averages its members (an ensemble.COMBINES key): older exports
+    """How the ensemble.py export `onnx_path` averages its members (a model.COMBINES key): older exports
     average log-softmax, which leaves LogSoftmax nodes in the graph. An unreadable file reads as "logits" here;
     recover_state then names what is wrong with it."""
     import onnx  # python3-onnx
@@ -162,8 +164,7 @@ def recover_members(members, onnx_path, inputs, size):
     members' settings in the ensemble's order (their weights do not matter). Each computes, in evaluation mode, what
     it computes inside the file: its logit adjustment folded in, its int8 weights as rounded. Both of ensemble.py's
     combines are read: the probe averages as the file does (log-softmax in exports before 2026-11-24)."""
-    import ensemble  # tools/training/ensemble.py
-    state = recover_state(ensemble.Ensemble(members, combine_of(onnx_path)), onnx_path, inputs, size)
+    state = recover_state(Ensemble(members, combine_of(onnx_path)), onnx_path, inputs, size)
     states = []
     for k in range(len(members)):
         prefix = f"members.{k}."

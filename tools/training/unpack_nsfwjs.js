@@ -2,7 +2,7 @@
 // block_10 were kept frozen while its head was trained on other classes) into a plain TensorFlow.js layers
 // model: OUT/mobilenet_v2.json (Keras topology and weights manifest) and OUT/mobilenet_v2.bin. The package
 // ships both as browserified modules (model.min.js, group1-shard1of1.min.js with the weights in base64);
-// keras_layers.py reads the unpacked files. docs/training.md, "An ImageNet encoder".
+// keras_layers.py reads the unpacked files. docs/training.md, "Pretrained encoders".
 //
 // usage: node unpack_nsfwjs.js PACKAGE_DIR OUT_DIR
 //   (PACKAGE_DIR: the unpacked tarball of `npm pack nsfwjs@4.4.0`, i.e. its package/ folder)

@@ -1,0 +1,40 @@
+"""libg2p's material segmentation network: the recipe that trains it and exports it for the `onnx` backend
+(docs/training.md).
+
+Each step is a module with a main(), run from anywhere as a script or, from the repository root, as a module:
+
+    python3 tools/training/train.py DATASET OUT ...     python3 -m tools.training.train DATASET OUT ...
+
+The steps: attribution (the models a dataset used), train, soup (weights of sibling runs averaged), ensemble (runs
+joined into one ONNX model), quantize (int8 weights), and the checks colour_baseline and check_tfjs_graph. The
+training set itself is rendered by g2p_make_dataset (make_dataset.cpp, built with the C++ tools).
+
+Imports go one way: a module imports only modules listed before it in LAYERS (tests/tools/training_imports_test.py
+checks it), so there is no cycle. Writing an export and reading one back sit below train, since train does both (it
+starts from an export with --init and distils from runs with --teacher); soup and ensemble, which join trained runs
+into the network that ships, sit on top. A new module takes its place in LAYERS.
+"""
+
+LAYERS = (
+    # data: g2p_make_dataset's folders as training and validation rows, images, labels, augmentations
+    "data",
+    "attribution",
+    # model: the networks, and the interpreters of the pretrained encoders from npm
+    "tfjs_graph",
+    "keras_layers",
+    "model",
+    "check_tfjs_graph",
+    # validation scores
+    "metrics",
+    "colour_baseline",
+    # export: what a run writes, int8 weights, weights recovered from an export, run folders read back as networks
+    "export",
+    "quantize",
+    "onnx_weights",
+    "runs",
+    # train
+    "train",
+    # trained runs joined into the network that ships
+    "soup",
+    "ensemble",
+)

@@ -1,0 +1,1 @@
+"""libg2p's tools that are Python: the training recipe (tools/training)."""

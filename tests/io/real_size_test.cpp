@@ -69,7 +69,8 @@ TEST(RealSize, HeightScalesUniformlyAlongTheUpAxis) {
   EXPECT_NEAR(sides.x(), 0.1, 1e-6);   // 0.4 * 0.25
   EXPECT_NEAR(sides.y(), 0.15, 1e-6);  // 0.6 * 0.25
   EXPECT_DOUBLE_EQ(m->info.unit_scale_m, 0.25);
-  EXPECT_NEAR(m->info.file_to_model.block<3, 1>(0, 0).norm(), 0.25, 1e-12);
+  const double column_length = m->info.file_to_model.col(0).head<3>().norm();
+  EXPECT_NEAR(column_length, 0.25, 1e-12);
   EXPECT_EQ(m->info.scale_source, "height");
   EXPECT_FALSE(m->info.looks_normalised);
   EXPECT_EQ(object_size(*m).scale_source, "height");

@@ -1,7 +1,8 @@
 // The object's real size at import (ImportOptions::height_m, longest_side_m).
 // Generated meshes come normalised to a box of about a metre whatever the
 // object is (TRELLIS and Stable Fast 3D to a unit cube, Hunyuan3D to [-1, 1]);
-// masses grow with the cube of the size, so the size is the user's to give.
+// masses grow steeply with size (a solid's with its cube), so the size is the
+// user's to give.
 #include "io/real_size.h"
 
 #include <cmath>
@@ -63,7 +64,7 @@ Status apply_real_size(const ImportOptions& o, Model& model) {
   char text[400];
   std::snprintf(text, sizeof text,
                 "the model looks normalised, as image-to-3D generators write meshes: its longest side is %.3f m "
-                "(%.2f x %.2f x %.2f m assumed, as the file says); every mass grows with the cube of the size. "
+                "(%.2f x %.2f x %.2f m assumed, as the file says); masses grow steeply with size. "
                 "Give the real size with --height or --longest-side (ImportOptions::height_m, longest_side_m)",
                 sides.maxCoeff(), sides.x(), sides.y(), sides.z());
   info.warnings.emplace_back(text);

@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/project.h"
 #include "g2p/registry.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

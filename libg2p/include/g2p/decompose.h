@@ -20,10 +20,10 @@
 #include <Eigen/Core>
 
 #include "g2p/complete.h"
-#include "g2p/visibility.h"
 #include "g2p/mesh.h"
 #include "g2p/registry.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/image.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -10,13 +10,13 @@
 
 #include "g2p/complete.h"
 #include "g2p/decompose.h"
-#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/model.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -4,9 +4,9 @@
 #include <cstddef>
 #include <string>
 
-#include "g2p/visibility.h"
 #include "g2p/model.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

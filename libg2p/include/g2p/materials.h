@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

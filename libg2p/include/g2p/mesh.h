@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

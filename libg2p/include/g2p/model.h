@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/image.h"
 #include "g2p/mesh.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -20,7 +20,6 @@
 
 #include "g2p/complete.h"
 #include "g2p/decompose.h"
-#include "g2p/visibility.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
 #include "g2p/materials.h"
@@ -31,6 +30,7 @@
 #include "g2p/render.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

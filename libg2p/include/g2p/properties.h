@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "g2p/complete.h"
-#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/model.h"
@@ -22,6 +21,7 @@
 #include "g2p/render.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 #include "g2p/vlm.h"
 
 namespace g2p {

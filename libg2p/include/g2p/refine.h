@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/project.h"
@@ -15,6 +14,7 @@
 #include "g2p/render.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 #include "g2p/vlm.h"
 
 namespace g2p {

@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/image.h"
 #include "g2p/model.h"
 #include "g2p/registry.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

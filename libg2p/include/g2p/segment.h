@@ -13,13 +13,13 @@
 #include <string_view>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/image.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

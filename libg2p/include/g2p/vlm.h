@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "g2p/visibility.h"
 #include "g2p/status.h"
+#include "g2p/visibility.h"
 
 namespace g2p {
 

@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "core/file_util.h"
+#include "export/asset_names.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
-#include "export/asset_names.h"
 
 namespace g2p {
 namespace {

@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/file_util.h"
-#include "g2p/export.h"
 #include "export/asset_names.h"
+#include "g2p/export.h"
 #include "io/image_io.h"
 
 namespace g2p {

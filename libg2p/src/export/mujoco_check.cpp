@@ -10,9 +10,9 @@
 #include <sstream>
 
 #include "core/file_util.h"
+#include "export/mujoco_support.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
-#include "export/mujoco_support.h"
 
 namespace g2p {
 namespace {

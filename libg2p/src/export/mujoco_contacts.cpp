@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <limits>
 
-#include "g2p/export.h"
 #include "export/mujoco_support.h"
+#include "g2p/export.h"
 
 namespace g2p {
 namespace {

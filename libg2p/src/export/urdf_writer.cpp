@@ -8,8 +8,8 @@
 
 #include <memory>
 
-#include "g2p/export.h"
 #include "export/asset_names.h"
+#include "g2p/export.h"
 
 namespace g2p {
 

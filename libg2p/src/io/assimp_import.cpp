@@ -568,4 +568,3 @@ Result<double> parse_unit(const std::string& unit) {
 }
 
 }  // namespace g2p
-

@@ -56,16 +56,21 @@ void expect_relative(double got, double want, double tolerance, const char* what
   EXPECT_NEAR(got, want, tolerance * std::abs(want)) << what;
 }
 
+// MuJoCo compiled the asset with libg2p's mass, centre of mass and inertia.
+void expect_mujoco_agrees(const EngineCheck& c, const SimulationAsset& asset) {
+  expect_relative(c.mass_kg, asset.total.mass_kg, 1e-6, "mass");
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(c.center_of_mass[a], asset.total.center_of_mass[a], 1e-6);
+  const Eigen::Vector3d ours = asset.total.principal_moments();
+  for (int a = 0; a < 3; ++a) expect_relative(c.principal_moments[a], ours[a], 1e-6, "principal moment");
+}
+
 TEST(Exporters, MujocoCompilesTheHammerWithLibg2psMassProperties) {
   const SimulationAsset asset = hammer_asset(kMetal);
   const std::string dir = test::scratch_dir("ExportMjcf");
   ASSERT_TRUE(write_asset(dir, asset, {"mjcf", "urdf", "sdf"}).ok());
   Result<EngineCheck> c = check_in_mujoco(dir + "/hammer.xml");
   ASSERT_TRUE(c.ok()) << c.status().to_string();
-  expect_relative(c->mass_kg, asset.total.mass_kg, 1e-6, "mass");
-  for (int a = 0; a < 3; ++a) EXPECT_NEAR(c->center_of_mass[a], asset.total.center_of_mass[a], 1e-6);
-  const Eigen::Vector3d ours = asset.total.principal_moments();
-  for (int a = 0; a < 3; ++a) expect_relative(c->principal_moments[a], ours[a], 1e-6, "principal moment");
+  expect_mujoco_agrees(*c, asset);
   // Dropped on a plane it comes to rest without exploding or sinking through.
   EXPECT_TRUE(c->dropped);
   EXPECT_TRUE(c->finite);
@@ -296,10 +301,7 @@ TEST_P(ExportAssets, MujocoAgreesAndTheDropSettles) {
   ASSERT_TRUE(write_asset(dir, asset, {"mjcf", "urdf", "sdf"}).ok());
   Result<EngineCheck> c = check_in_mujoco(dir + "/" + asset.name + ".xml");
   ASSERT_TRUE(c.ok()) << c.status().to_string();
-  expect_relative(c->mass_kg, asset.total.mass_kg, 1e-6, "mass");
-  for (int a = 0; a < 3; ++a) EXPECT_NEAR(c->center_of_mass[a], asset.total.center_of_mass[a], 1e-6);
-  const Eigen::Vector3d ours = asset.total.principal_moments();
-  for (int a = 0; a < 3; ++a) expect_relative(c->principal_moments[a], ours[a], 1e-6, "principal moment");
+  expect_mujoco_agrees(*c, asset);
   EXPECT_TRUE(c->finite);
   EXPECT_GT(c->resting_lowest_m, -0.01);
   EXPECT_LT(c->final_speed_m_s, 0.1);

@@ -298,7 +298,9 @@ void bind_core(py::module_& m) {
       .def_readwrite("min_extent_m", &ImportOptions::min_extent_m)
       .def_readwrite("max_extent_m", &ImportOptions::max_extent_m)
       .def_readwrite("strict", &ImportOptions::strict)
-      .def_readwrite("max_faces", &ImportOptions::max_faces);
+      .def_readwrite("max_faces", &ImportOptions::max_faces)
+      .def_readwrite("isolate_reader", &ImportOptions::isolate_reader,
+                     "parse in a child process, so a crash inside assimp is an error (default True)");
   m.def(
       "load_model",
       [](const std::string& path, const py::object& options, const py::kwargs& kwargs) {

@@ -32,16 +32,18 @@ void BM_LoadModel(benchmark::State& state) {
   const std::string path = asset(static_cast<int>(state.range(0)));
   g2p::ImportOptions options;
   options.load_textures = state.range(1) != 0;
+  options.isolate_reader = state.range(2) != 0;  // assimp in a child process (the default)
   for (auto _ : state) {
     g2p::Result<g2p::Model> model = g2p::load_model(path, options);
     if (!model.ok()) state.SkipWithError(model.status().message().c_str());
     benchmark::DoNotOptimize(model);
   }
-  state.SetLabel(std::string(kAssets[state.range(0)]) + (options.load_textures ? " +textures" : ""));
+  state.SetLabel(std::string(kAssets[state.range(0)]) + (options.load_textures ? " +textures" : "") +
+                 (options.isolate_reader ? " child" : " in-process"));
 }
 
 BENCHMARK(BM_AssimpReadFile)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_LoadModel)->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LoadModel)->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1}, {1, 0}})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -290,6 +290,16 @@ class ErrorsAndCancellationTest(unittest.TestCase):
         self.assertEqual(caught.exception.code, g2p.StatusCode.OUT_OF_MEMORY)
         self.assertIn("--resolution", str(caught.exception))
 
+    def test_a_file_that_crashes_assimp_is_a_parse_error(self):
+        # Found by fuzzing: Debian's assimp segfaults on it; it is parsed in a
+        # child process, so this interpreter survives and gets the reason.
+        crash = ROOT / "fuzz" / "corpus" / "import_glb" / "assimp-crash-f307c5ba.glb"
+        self.assertTrue(g2p.ImportOptions().isolate_reader)
+        with self.assertRaises(g2p.ParseError) as caught:
+            g2p.load_model(str(crash))
+        self.assertIn("crashed on this file (segmentation fault in libassimp.so", str(caught.exception))
+        self.assertEqual(g2p.load_model(HAMMER, g2p.ImportOptions(isolate_reader=False)).mesh.num_faces, 104)
+
     def test_bad_setting_is_a_value_error(self):
         with self.assertRaises(ValueError) as caught:
             g2p.make_refiner("smooth", {"no_such_key": "1"})

@@ -60,6 +60,23 @@ TEST(ToolInfo, EveryMalformedGltfFailsWithAMessage) {
   EXPECT_EQ(checked, 16);
 }
 
+// Files the fuzzers found that crash Debian's assimp: g2p used to end with a
+// segmentation fault (exit 139) on the GLB and the PLY; assimp now parses in
+// a child process and g2p reports the crash as the file's error.
+TEST(ToolInfo, AFileThatCrashesAssimpIsAnErrorNotACrash) {
+  for (const char* f :
+       {"fuzz/corpus/import_glb/assimp-crash-f307c5ba.glb", "fuzz/corpus/import_obj/assimp-crash-36a93fd0.obj",
+        "fuzz/corpus/import_ply/assimp-crash-743ec6ed.ply"}) {
+    ToolRun r = run_tool("info " + quote(test::source_path(f)));
+    EXPECT_EQ(r.exit_code, 1) << f << ": " << r.err;
+    EXPECT_NE(r.err.find("g2p info: error: parse error: "), std::string::npos) << f << ": " << r.err;
+  }
+  ToolRun glb = run_tool("info " + quote(test::source_path("fuzz/corpus/import_glb/assimp-crash-f307c5ba.glb")));
+  EXPECT_NE(glb.err.find("assimp, the model reader, crashed on this file (segmentation fault in libassimp.so"),
+            std::string::npos)
+      << glb.err;
+}
+
 TEST(ToolInfo, UsageErrorsExitWithTwo) {
   EXPECT_EQ(run_tool("").exit_code, 2);
   EXPECT_EQ(run_tool("info").exit_code, 2);

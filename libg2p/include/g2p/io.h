@@ -39,6 +39,12 @@ struct ImportOptions {
   bool strict = true;
   // Refuse models with more triangles than this (memory guard).
   int max_faces = 50'000'000;
+  // Parse the file in a child process, so that a crash inside assimp (the
+  // parser) becomes a kParseError naming the fault instead of ending the
+  // caller. Costs a fork and a copy of the parsed scene (docs/import.md).
+  // False parses in this process (for debugging assimp, or where fork is
+  // unwelcome).
+  bool isolate_reader = true;
 };
 
 // Reads a model file: glTF/GLB, OBJ(+MTL), PLY, STL, FBX, DAE, 3MF and the

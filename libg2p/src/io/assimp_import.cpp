@@ -23,6 +23,7 @@
 #include "g2p/io.h"
 #include "gltf_layout.h"
 #include "real_size.h"
+#include "scene_reader.h"
 #include "triangulate.h"
 
 namespace g2p {
@@ -491,12 +492,6 @@ Result<Model> guarded(const std::string& where, F&& body) {
   }
 }
 
-std::string assimp_error(const Assimp::Importer& importer) {
-  std::string e = importer.GetErrorString();
-  while (!e.empty() && std::isspace(static_cast<unsigned char>(e.back()))) e.pop_back();
-  return e.empty() ? "the file could not be parsed" : e;
-}
-
 }  // namespace
 
 bool is_supported_extension(const std::string& extension) {
@@ -518,10 +513,13 @@ Result<Model> load_model(const std::string& path, const ImportOptions& options) 
     if (!is_supported_extension(ext))
       return Status::Unsupported("unknown model format '" + (ext.empty() ? std::string("(no extension)") : "." + ext) +
                                  "' (glTF/GLB, OBJ, PLY, STL, FBX, DAE, 3MF and other assimp formats are read)");
-    Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(path, kPostProcess);
-    if (scene == nullptr) return Status::ParseError(assimp_error(importer));
     ImportInfo info;
+    detail::SceneSource source;
+    source.path = path;
+    Result<detail::ParsedScene> parsed =
+        detail::parse_scene(source, kPostProcess, options.isolate_reader, info.warnings);
+    if (!parsed.ok()) return parsed.status();
+    const aiScene* scene = &parsed->scene();
     info.path = path;
     info.format = ext;
     const std::string gltf_bytes = is_gltf(ext) ? read_gltf_json_bytes(path) : std::string();
@@ -538,10 +536,15 @@ Result<Model> load_model_from_memory(const void* data, std::size_t size, const s
     G2P_RETURN_IF_ERROR(check_options(options));
     if (data == nullptr || size == 0) return Status::InvalidArgument("no data");
     if (!is_supported_extension(ext)) return Status::Unsupported("unknown model format '" + ext + "'");
-    Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFileFromMemory(data, size, kPostProcess, ext.c_str());
-    if (scene == nullptr) return Status::ParseError(assimp_error(importer));
     ImportInfo info;
+    detail::SceneSource source;
+    source.data = data;
+    source.size = size;
+    source.hint = ext;
+    Result<detail::ParsedScene> parsed =
+        detail::parse_scene(source, kPostProcess, options.isolate_reader, info.warnings);
+    if (!parsed.ok()) return parsed.status();
+    const aiScene* scene = &parsed->scene();
     info.path = "<memory>";
     info.format = ext;
     const std::string gltf_bytes = is_gltf(ext) ? std::string(static_cast<const char*>(data), size) : std::string();

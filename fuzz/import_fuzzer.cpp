@@ -5,6 +5,7 @@
 // face graph, the first thing every stage builds, is built from it.
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 
 #include "g2p/io.h"
@@ -14,6 +15,11 @@
 #ifndef G2P_FUZZ_FORMAT
 #error "G2P_FUZZ_FORMAT must name the format (fuzz/CMakeLists.txt sets it)"
 #endif
+
+// assimp loops forever on some malformed files (fuzz/corpus/import_ply/
+// assimp-hang-*); the reader stops its child after this long, well inside
+// libFuzzer's -timeout of 30 s.
+const int g_read_timeout = setenv("G2P_READ_TIMEOUT", "5", /*overwrite=*/0);
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   g2p::ImportOptions options;

@@ -7,6 +7,8 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -156,6 +158,24 @@ TEST(AssimpCrash, TheMessageNamesTheCrashAndTheLibrary) {
   const std::string& msg = model.status().message();
   EXPECT_NE(msg.find("assimp, the model reader, crashed on this file (segmentation fault"), std::string::npos) << msg;
   EXPECT_NE(msg.find("in libassimp.so"), std::string::npos) << msg;
+}
+
+// A PLY on which assimp loops forever (found by fuzzing): the child is
+// stopped after the time limit (G2P_READ_TIMEOUT here, else 120 s + 2 s/MB).
+TEST(AssimpHang, TheReaderIsStoppedAfterTheTimeLimitWithAMessageNamingIt) {
+  const std::string path = test::source_path("fuzz/corpus/import_ply/assimp-hang-4ce3b8e2.ply");
+  ASSERT_EQ(setenv("G2P_READ_TIMEOUT", "2", 1), 0);
+  const auto start = std::chrono::steady_clock::now();
+  Result<Model> model = load_model(path);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  unsetenv("G2P_READ_TIMEOUT");
+  ASSERT_FALSE(model.ok());
+  const std::string& msg = model.status().message();
+  EXPECT_EQ(model.status().code(), StatusCode::kParseError) << msg;
+  EXPECT_NE(msg.find("was still parsing this file after 2 s and was stopped"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("G2P_READ_TIMEOUT"), std::string::npos) << msg;
+  EXPECT_GE(seconds, 2.0);
+  EXPECT_LT(seconds, 60.0);  // stopped, not left to run
 }
 
 // The bytes between the child and the caller: a truncated or corrupted

@@ -11,6 +11,7 @@
 #include <dlfcn.h>
 #include <execinfo.h>
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
@@ -20,10 +21,15 @@
 
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <new>
 
 namespace g2p::detail {
@@ -182,6 +188,20 @@ Status child_failure(int wait_status, const CrashNote& note) {
   return Status::Internal("the model reader ended without a result (exit status " + std::to_string(code) + ")");
 }
 
+// How long the child may parse: G2P_READ_TIMEOUT (seconds) if set, else 120 s
+// plus 2 s per MB of input (assimp reads tens of MB a second; a loop on a
+// malformed file would otherwise hang the caller).
+double read_time_limit_s(const SceneSource& source) {
+  if (const char* env = std::getenv("G2P_READ_TIMEOUT")) {
+    char* end = nullptr;
+    const double v = std::strtod(env, &end);
+    if (end != env && *end == '\0' && v > 0.0 && v < 1e7) return v;
+  }
+  std::error_code ec;
+  const std::uintmax_t bytes = source.data != nullptr ? source.size : std::filesystem::file_size(source.path, ec);
+  return 120.0 + 2.0 * static_cast<double>(ec ? 0 : bytes) / 1e6;
+}
+
 }  // namespace
 
 Result<ParsedScene> parse_scene(const SceneSource& source, unsigned post_process, bool isolate,
@@ -224,9 +244,24 @@ Result<ParsedScene> parse_scene(const SceneSource& source, unsigned post_process
   // straight into a buffer of that size), else a message to the end.
   std::string message;
   bool out_of_memory = false;
+  const double limit_s = read_time_limit_s(source);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+  bool timed_out = false;
   auto read_some = [&](char* p, std::size_t n) -> std::size_t {
     std::size_t got = 0;
-    while (got < n) {
+    while (got < n && !timed_out) {
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      pollfd pfd{fds[0], POLLIN, 0};
+      const int ready =
+          left.count() > 0 ? poll(&pfd, 1, static_cast<int>(std::min<long long>(left.count(), 60'000))) : 0;
+      if (ready < 0 && errno == EINTR) continue;
+      if (ready == 0) {
+        if (std::chrono::steady_clock::now() < deadline) continue;
+        timed_out = true;
+        kill(pid, SIGKILL);
+        break;
+      }
       const ssize_t r = read(fds[0], p + got, n - got);
       if (r < 0 && errno == EINTR) continue;
       if (r <= 0) break;
@@ -261,6 +296,13 @@ Result<ParsedScene> parse_scene(const SceneSource& source, unsigned post_process
   munmap(shared, sizeof(CrashNote));
 
   if (out_of_memory) return Status::OutOfMemory("out of memory receiving the parsed scene");
+  if (timed_out) {
+    char secs[32];
+    std::snprintf(secs, sizeof secs, "%.0f", limit_s);
+    return Status::ParseError(std::string("assimp, the model reader, was still parsing this file after ") + secs +
+                              " s and was stopped: the file is probably malformed (a loop in the parser). For a "
+                              "large file that needs longer, set G2P_READ_TIMEOUT=SECONDS");
+  }
   const bool clean_exit = WIFEXITED(wait_status) && WEXITSTATUS(wait_status) == 0;
   if (!clean_exit || message.empty()) return child_failure(wait_status, note);
   switch (message[0]) {

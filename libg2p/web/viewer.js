@@ -269,7 +269,8 @@ function start(section, model) {
   show(-1);
   resize();
   section.dataset.state = 'ready';
-  window.g2pViewer = { parts: parts.length, render };
+  // For scripts and tests: redraw now, the WebGL context.
+  window.g2pViewer = { parts: parts.length, render, gl: () => renderer.getContext() };
 }
 
 function main() {

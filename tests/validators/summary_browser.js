@@ -5,8 +5,10 @@
 // each changes the picture; hovering over the object shows the part's
 // details. Pixels come from screenshots of the page, not from the page's own code.
 //
-//   node summary_browser.js PAGE.html [--screenshot OUT.png] [--no-webgl]
+//   node summary_browser.js PAGE.html [--screenshot OUT.png] [--no-webgl | --draw-only]
 //
+// --draw-only checks only that the view draws, and times it: the seconds from
+// opening the page to a ready view (ready_s) and one frame (frame_ms).
 // --no-webgl starts Chromium without WebGL and checks that the page says so
 // and keeps its static content. Prints one JSON line; exits 1 with the reason
 // on stderr when a check fails, 2 when the browser cannot be started.
@@ -18,8 +20,9 @@ const args = process.argv.slice(2);
 const page_path = args.find((a) => !a.startsWith('--') && args[args.indexOf(a) - 1] !== '--screenshot');
 const shot = args.includes('--screenshot') ? args[args.indexOf('--screenshot') + 1] : null;
 const no_webgl = args.includes('--no-webgl');
+const draw_only = args.includes('--draw-only');
 if (!page_path) {
-  console.error('usage: node summary_browser.js PAGE.html [--screenshot OUT.png] [--no-webgl]');
+  console.error('usage: node summary_browser.js PAGE.html [--screenshot OUT.png] [--no-webgl | --draw-only]');
   process.exit(2);
 }
 
@@ -101,12 +104,14 @@ async function main() {
       }
       return route.continue();
     });
+    const opened = Date.now();
     await page.goto('file://' + path.resolve(page_path));
     const section = page.locator('#g2p-3d');
     check(await section.count() === 1, 'the page has no 3D view section (#g2p-3d)');
     await page.waitForFunction(() => document.getElementById('g2p-3d').dataset.state, null, { timeout: 20000 })
       .catch(() => { throw new CheckFailed('the 3D view never started (no data-state after 20 s)'); });
     const state = await section.getAttribute('data-state');
+    result.ready_s = (Date.now() - opened) / 1000;
     check(outside.length === 0, `the page asked the network for ${outside.join(', ')}`);
     check(await page.locator('h2', { hasText: 'Parts' }).count() === 1, 'the static parts table is missing');
     if (no_webgl) {
@@ -126,6 +131,21 @@ async function main() {
       check(first.object > 0.01, `the 3D view is blank: ${(100 * first.object).toFixed(2)} % of the canvas differs ` +
         'from its background');
       result.checks.push('the 3D view draws the object');
+      result.frame_ms = await page.evaluate(() => {
+        const t = performance.now();
+        const gl = window.g2pViewer.gl();
+        const pixel = new Uint8Array(4);
+        for (let i = 0; i < 5; ++i) {
+          window.g2pViewer.render();
+          gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);  // waits for the frame
+        }
+        return (performance.now() - t) / 5;
+      });
+      if (draw_only) {
+        result.seconds = (Date.now() - start) / 1000;
+        console.log(JSON.stringify(result));
+        return;
+      }
 
       // Hover over the object: the part's details appear.
       const box = await canvas.boundingBox();

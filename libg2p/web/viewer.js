@@ -155,7 +155,7 @@ function start(section, model) {
 
   camera.near = radius / 100;
   camera.far = radius * 100;
-  camera.position.copy(centre).add(new Vector3(1.6, -2.2, 1.2).normalize().multiplyScalar(radius * 4));
+  camera.position.copy(centre).add(new Vector3(1.6, -2.2, 1.2).normalize().multiplyScalar(radius * 3.5));
   controls.target.copy(centre);
   controls.update();
 
@@ -216,8 +216,8 @@ function start(section, model) {
   function show(i) {
     info.replaceChildren(i >= 0 ? partDetails(parts[i].data) : text('span', 'Hover over or click a part for its details.'));
     parts.forEach((p, k) => {
-      p.classMaterial.emissive.setHex(k === i ? 0x303030 : 0);
-      if (p.lookMaterial) p.lookMaterial.emissive.setHex(k === i ? 0x303030 : 0);
+      p.classMaterial.emissive.setHex(k === i ? 0x404040 : 0);
+      if (p.lookMaterial) p.lookMaterial.emissive.setHex(k === i ? 0x404040 : 0);
       list.children[k].classList.toggle('sel', k === i);
     });
     requestRender();

@@ -76,8 +76,8 @@ TEST(SummaryBrowser, WithoutWebGLThePageSaysSoAndKeepsItsTables) {
   ASSERT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
 }
 
-// 1.2M triangles: the page draws a simplified surface and stays quick.
-TEST(SummaryBrowser, AMillionTriangleModelOpensQuickly) {
+// 1.2M triangles: the page opens and draws its simplified surface.
+TEST(SummaryBrowser, AMillionTriangleModelOpensAndDraws) {
   const std::string html = summary_html(test::large_grid_result());
   if (html.find("id=\"g2p-model\"") == std::string::npos)
     GTEST_SKIP() << "libg2p was built without the 3D view (three.js missing: scripts/install-deps.sh)";
@@ -87,11 +87,8 @@ TEST(SummaryBrowser, AMillionTriangleModelOpensQuickly) {
   SKIP_WITHOUT_BROWSER(v);
   ASSERT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
   const nlohmann::json j = nlohmann::json::parse(v.run.out);
-  // Software WebGL (SwiftShader, about 0.3 s a frame for the simplified
-  // surface on two shared cores; a GPU takes milliseconds): generous bounds
-  // that a page drawing all 1.2M triangles (six times the work) would miss.
-  EXPECT_LT(j["ready_s"].get<double>(), 15.0) << j.dump();
-  EXPECT_LT(j["frame_ms"].get<double>(), 1500.0) << j.dump();
+  // How quick it is goes to the log, not into a bound (docs/testing.md: no
+  // timed tests); the simplification itself is SummaryHtml.SimplifiesWhatItDrawsOfAMillionTriangleModel.
   std::printf("1.2M-triangle page: ready in %.2f s, %.0f ms a frame\n", j["ready_s"].get<double>(),
               j["frame_ms"].get<double>());
 }

@@ -5,7 +5,10 @@
 // each changes the picture; hovering over the object shows the part's
 // details. Pixels come from screenshots of the page, not from the page's own code.
 //
-//   node summary_browser.js PAGE.html [--screenshot OUT.png] [--no-webgl | --draw-only]
+//   node summary_browser.js PAGE.html [--screenshot OUT.png] [--screenshot-top OUT.png] [--no-webgl | --draw-only]
+//
+// --screenshot saves the whole page at the end; --screenshot-top the first
+// 1280 x 900 pixels while the mouse rests on a part (the picture in README.md).
 //
 // --draw-only checks only that the view draws, and times it: the seconds from
 // opening the page to a ready view (ready_s) and one frame (frame_ms).
@@ -17,12 +20,14 @@ const path = require('path');
 const { chromium } = require('playwright-core');
 
 const args = process.argv.slice(2);
-const page_path = args.find((a) => !a.startsWith('--') && args[args.indexOf(a) - 1] !== '--screenshot');
-const shot = args.includes('--screenshot') ? args[args.indexOf('--screenshot') + 1] : null;
+const page_path = args.find((a, i) => !a.startsWith('--') && !/^--screenshot/.test(args[i - 1] || ''));
+const option = (name) => (args.includes(name) ? args[args.indexOf(name) + 1] : null);
+const shot = option('--screenshot');
+const top_shot = option('--screenshot-top');
 const no_webgl = args.includes('--no-webgl');
 const draw_only = args.includes('--draw-only');
 if (!page_path) {
-  console.error('usage: node summary_browser.js PAGE.html [--screenshot OUT.png] [--no-webgl | --draw-only]');
+  console.error('usage: node summary_browser.js PAGE.html [--screenshot OUT.png] [--screenshot-top OUT.png] [--no-webgl | --draw-only]');
   process.exit(2);
 }
 
@@ -155,6 +160,7 @@ async function main() {
       const info = await section.locator('.g2p-info').innerText();
       check(/density/.test(info) && /mass/.test(info), `hovering over the object shows no part details: "${info}"`);
       result.hover = info.split('\n')[0];
+      if (top_shot) await page.screenshot({ path: top_shot });  // the view with a part's details, for the docs
       result.checks.push('hovering shows a part\'s details');
       await page.mouse.move(box.x + 2, box.y + 2);  // away, so the highlight goes
       await frames(page);

@@ -13,7 +13,7 @@
 namespace g2p::detail {
 
 // Most triangles the view draws for the object's surface; larger inputs are
-// simplified (view_mesh) and the page says so. About 25 bytes per triangle in the page.
+// simplified (view_mesh) and the page says so. 30 to 40 bytes a drawn triangle in the page.
 constexpr std::size_t kViewerTriangleBudget = 200000;
 
 // Whether this libg2p was built with the viewer script (three.js and esbuild

@@ -80,8 +80,9 @@ function webglAvailable() {
 function partDetails(p) {
   const rows = [
     ['class', p.material],
-    ['structure', p.structure ? (p.structure === 'hollow' && p.wall_thickness_m > 0
-      ? `hollow, ${fmt(p.wall_thickness_m * 1e3, 3)} mm walls` : p.structure) : '-'],
+    ['structure', p.structure || '-'],
+    ['wall thickness', p.structure === 'hollow' && p.wall_thickness_m > 0 ? `${fmt(p.wall_thickness_m * 1e3, 3)} mm`
+      : p.structure === 'solid' ? '- (solid)' : '-'],
     ['density', p.density_kg_m3 ? `${fmt(p.density_kg_m3)} kg/m\u00b3` : '-'],
     ['mass', p.mass_kg !== undefined ? `${fmt(p.mass_kg)} kg` : '-'],
     ['volume', p.volume_m3 ? `${fmt(p.volume_m3 * 1e6)} cm\u00b3` : '-'],

@@ -158,7 +158,7 @@ async function main() {
         box.y + first.centroid[1] * box.height / first.height);
       await frames(page);
       const info = await section.locator('.g2p-info').innerText();
-      check(/density/.test(info) && /mass/.test(info), `hovering over the object shows no part details: "${info}"`);
+      check(/density/.test(info) && /mass/.test(info) && /wall thickness/.test(info), `hovering over the object shows no part details (class, structure, wall thickness, density, mass): "${info}"`);
       result.hover = info.split('\n')[0];
       if (top_shot) await page.screenshot({ path: top_shot });  // the view with a part's details, for the docs
       result.checks.push('hovering shows a part\'s details');

@@ -23,7 +23,8 @@ core=(
   nlohmann-json3-dev libcli11-dev libcurl4-openssl-dev
   liburdfdom-dev libqhull-dev
 )
-# Tests, validation with real consumers, benchmarks, bindings.
+# Tests, validation with real consumers, benchmarks, bindings; Chromium for
+# the summary.html browser tests (headless).
 extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
@@ -31,6 +32,7 @@ extra=(
   liburdfdom-tools libsdformat-dev libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-onnx
   clang libclang-rt-14-dev
+  chromium
 )
 
 pkgs=("${core[@]}")
@@ -39,17 +41,25 @@ pkgs=("${core[@]}")
 # has node and npm (from any source) keeps them.
 if [ "$minimal" = 0 ] && ! { command -v node && command -v npm; } >/dev/null; then pkgs+=(nodejs npm); fi
 
-# The npm packages the tests use (tests/validators/package-lock.json), from the npm registry.
+# The npm packages, from the npm registry, each folder pinned by its package-lock.json:
+# libg2p/web (three.js and esbuild: summary.html's 3D view, bundled into libg2p
+# at build time; without them the page has no 3D view) and tests/validators
+# (the Khronos glTF validator; playwright-core, which drives Chromium in the
+# summary.html browser tests).
 install_npm() {
   [ "$minimal" = 1 ] && return 0
-  local dir
-  dir="$(cd "$(dirname "$0")/.." && pwd)/tests/validators"
-  if [ -d "$dir/node_modules/gltf-validator" ]; then
-    echo "install-deps: npm packages already installed in tests/validators"
-    return 0
-  fi
-  echo "install-deps: npm ci in tests/validators (Khronos gltf-validator)"
-  npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error
+  local root dir
+  root="$(cd "$(dirname "$0")/.." && pwd)"
+  for dir in "$root/libg2p/web" "$root/tests/validators"; do
+    if node -e 'const d = process.argv[1], fs = require("fs");
+                process.exit(Object.keys(require(d + "/package.json").dependencies)
+                  .every((p) => fs.existsSync(d + "/node_modules/" + p + "/package.json")) ? 0 : 1)' "$dir"; then
+      echo "install-deps: npm packages already installed in ${dir#"$root"/}"
+      continue
+    fi
+    echo "install-deps: npm ci in ${dir#"$root"/}"
+    npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error
+  done
 }
 
 # Skip apt entirely when everything is already there (fast re-runs, offline CI).

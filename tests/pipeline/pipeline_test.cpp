@@ -302,7 +302,7 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
   const std::string html = test::read_file(dir + "/summary.html");
   EXPECT_NE(html.find("Metal"), std::string::npos);
   EXPECT_NE(html.find("Wood"), std::string::npos);
-  EXPECT_NE(html.find("projected/contact_sheet.png"), std::string::npos);
+  EXPECT_NE(html.find("projected/view_05_labels.png"), std::string::npos);
 
   // An existing folder is kept unless overwriting is asked for; then it is replaced whole.
   test::write_file(dir + "/mine.txt", "the user's file");

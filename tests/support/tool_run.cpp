@@ -33,6 +33,23 @@ ValidatorRun run_gltf_validator(const std::string& path) {
   return v;
 }
 
+ValidatorRun run_summary_browser(const std::string& page, const std::string& args) {
+  ValidatorRun v;
+  const char* chromium = std::getenv("G2P_CHROMIUM");
+  const std::string browser = chromium != nullptr && *chromium != '\0' ? chromium : "/usr/bin/chromium";
+  if (std::system("command -v node >/dev/null 2>&1") != 0)
+    v.missing = "node";
+  else if (!std::filesystem::exists(source_path("tests/validators/node_modules/playwright-core/package.json")))
+    v.missing = "the npm playwright-core in tests/validators";
+  else if (!std::filesystem::exists(browser))
+    v.missing = "Chromium (" + browser + "; set G2P_CHROMIUM to another)";
+  v.available = v.missing.empty();
+  if (v.available)
+    v.run = run_command("node " + quote(source_path("tests/validators/summary_browser.js")) + " " + quote(page) +
+                        (args.empty() ? "" : " " + args));
+  return v;
+}
+
 std::string quote(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);

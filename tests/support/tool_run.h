@@ -21,9 +21,15 @@ ToolRun run_command(const std::string& command_line);
 // `available` when node or the package is missing (the caller skips, saying so).
 struct ValidatorRun {
   bool available = false;
+  std::string missing;  // what is not installed, when not available
   ToolRun run;
 };
 ValidatorRun run_gltf_validator(const std::string& path);
+
+// tests/validators/summary_browser.js: a summary.html in headless Chromium
+// (playwright-core from tests/validators, the browser at $G2P_CHROMIUM or
+// /usr/bin/chromium). `args` go after the page, already shell-quoted.
+ValidatorRun run_summary_browser(const std::string& page, const std::string& args = "");
 
 // Single-quotes a string for the shell.
 std::string quote(const std::string& s);

@@ -13,6 +13,7 @@
 #include "core/file_util.h"
 #include "g2p/io.h"
 #include "g2p/pipeline.h"
+#include "pipeline/run_summary.h"
 
 namespace g2p {
 namespace {
@@ -203,6 +204,28 @@ Status write_pipeline_output(const std::string& dir, const PipelineResult& resul
   return Status::Ok();
 }
 
+namespace detail {
+
+nlohmann::json part_summary_json(const PipelineResult& r, std::size_t i) {
+  const Part& p = r.projection.parts[i];
+  nlohmann::json j = {
+      {"part", i}, {"material", class_name(r.table, p.label)}, {"faces", p.faces.size()}, {"area_m2", p.area_m2}};
+  if (i < r.completion.parts.size()) {
+    j["closed"] = r.completion.parts[i].ok;
+    j["volume_m3"] = r.completion.parts[i].checks.volume_m3;
+  }
+  if (i < r.properties.parts.size()) {
+    const PartReport& pr = r.properties.parts[i];
+    j["density_kg_m3"] = pr.properties.density_kg_m3;
+    j["structure"] = to_string(pr.properties.structure);
+    j["wall_thickness_m"] = pr.properties.wall_thickness_m;
+    j["mass_kg"] = pr.mass.mass_kg;
+  }
+  return j;
+}
+
+}  // namespace detail
+
 std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions& o) {
   nlohmann::json stages = nlohmann::json::array();
   nlohmann::json backends = nlohmann::json::object();
@@ -218,22 +241,7 @@ std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions
     stages.push_back(std::move(j));
   }
   nlohmann::json parts = nlohmann::json::array();
-  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) {
-    const Part& p = r.projection.parts[i];
-    nlohmann::json j = {
-        {"part", i}, {"material", class_name(r.table, p.label)}, {"faces", p.faces.size()}, {"area_m2", p.area_m2}};
-    if (i < r.completion.parts.size()) {
-      j["closed"] = r.completion.parts[i].ok;
-      j["volume_m3"] = r.completion.parts[i].checks.volume_m3;
-    }
-    if (i < r.properties.parts.size()) {
-      const PartReport& pr = r.properties.parts[i];
-      j["density_kg_m3"] = pr.properties.density_kg_m3;
-      j["structure"] = to_string(pr.properties.structure);
-      j["mass_kg"] = pr.mass.mass_kg;
-    }
-    parts.push_back(std::move(j));
-  }
+  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) parts.push_back(detail::part_summary_json(r, i));
   const MassProperties& m = r.properties.object;
   std::vector<std::string> files;
   for (const std::string& f : o.formats) {

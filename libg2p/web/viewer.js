@@ -1,0 +1,298 @@
+// The 3D view of summary.html. libg2p writes the object's geometry into the
+// page as JSON (<script type="application/json" id="g2p-model">, written by
+// libg2p/src/pipeline/summary_viewer.cpp) and inlines this file, bundled with
+// three.js by esbuild at build time, so the page works from file:// offline.
+// Without WebGL the section says so and the rest of the page is unchanged.
+import {
+  AmbientLight,
+  Box3,
+  BufferAttribute,
+  BufferGeometry,
+  Color,
+  DirectionalLight,
+  EdgesGeometry,
+  Group,
+  LineBasicMaterial,
+  LineSegments,
+  Mesh,
+  MeshBasicMaterial,
+  MeshLambertMaterial,
+  PerspectiveCamera,
+  Raycaster,
+  Scene,
+  SphereGeometry,
+  Vector2,
+  Vector3,
+  WebGLRenderer,
+} from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const BACKGROUND = 0xf4f4f4;
+
+function decode(base64, Type) {
+  const bytes = Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
+  return new Type(bytes.buffer, 0, bytes.byteLength / Type.BYTES_PER_ELEMENT);
+}
+
+function geometryOf(mesh) {
+  const g = new BufferGeometry();
+  g.setAttribute('position', new BufferAttribute(decode(mesh.positions, Float32Array), 3));
+  g.setIndex(new BufferAttribute(decode(mesh.indices, Uint32Array), 1));
+  g.computeVertexNormals();
+  return g;
+}
+
+// Per-face colours need a vertex per corner: made on first use only.
+function lookGeometry(indexed, faceColorsBase64) {
+  const g = indexed.toNonIndexed();
+  const face = decode(faceColorsBase64, Uint8Array);
+  const colors = new Float32Array(g.attributes.position.count * 3);
+  const c = new Color();
+  for (let f = 0; f < face.length / 3; ++f) {
+    c.setRGB(face[3 * f] / 255, face[3 * f + 1] / 255, face[3 * f + 2] / 255, 'srgb');
+    for (let k = 0; k < 3; ++k) colors.set([c.r, c.g, c.b], 9 * f + 3 * k);
+  }
+  g.setAttribute('color', new BufferAttribute(colors, 3));
+  g.computeVertexNormals();
+  return g;
+}
+
+function text(tag, content, className) {
+  const e = document.createElement(tag);
+  if (content !== undefined) e.textContent = content;
+  if (className) e.className = className;
+  return e;
+}
+
+function fmt(v, digits = 4) {
+  return Number(v).toPrecision(digits).replace(/\.?0+(e|$)/, '$1');
+}
+
+function webglAvailable() {
+  try {
+    const c = document.createElement('canvas');
+    return !!(c.getContext('webgl2') || c.getContext('webgl'));
+  } catch (e) {
+    return false;
+  }
+}
+
+function partDetails(p) {
+  const rows = [
+    ['class', p.material],
+    ['structure', p.structure || '-'],
+    ['wall thickness', p.structure === 'hollow' && p.wall_thickness_m > 0 ? `${fmt(p.wall_thickness_m * 1e3, 3)} mm`
+      : p.structure === 'solid' ? '- (solid)' : '-'],
+    ['density', p.density_kg_m3 ? `${fmt(p.density_kg_m3)} kg/m\u00b3` : '-'],
+    ['mass', p.mass_kg !== undefined ? `${fmt(p.mass_kg)} kg` : '-'],
+    ['volume', p.volume_m3 ? `${fmt(p.volume_m3 * 1e6)} cm\u00b3` : '-'],
+  ];
+  const box = document.createDocumentFragment();
+  box.append(text('b', p.name));
+  if (p.left_out) box.append(text('div', 'left out of the asset: ' + p.left_out, 'warn'));
+  const table = document.createElement('table');
+  for (const [k, v] of rows) {
+    const tr = document.createElement('tr');
+    tr.append(text('th', k), text('td', v));
+    table.append(tr);
+  }
+  box.append(table);
+  return box;
+}
+
+function start(section, model) {
+  const box = section.querySelector('.g2p-canvas');
+  const side = section.querySelector('.g2p-side');
+  const renderer = new WebGLRenderer({ antialias: true });
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+  renderer.setClearColor(BACKGROUND);
+  box.append(renderer.domElement);
+
+  const scene = new Scene();
+  scene.add(new AmbientLight(0xffffff, 1.2));
+  const sun = new DirectionalLight(0xffffff, 2.0);
+  scene.add(sun);
+
+  // libg2p's frame is +Z up.
+  const camera = new PerspectiveCamera(35, 1, 1e-3, 1e3);
+  camera.up.set(0, 0, 1);
+  const controls = new OrbitControls(camera, renderer.domElement);
+
+  const parts = model.parts.map((p, i) => {
+    const group = new Group();
+    const geometry = geometryOf(p.visual);
+    const classMaterial = new MeshLambertMaterial({ color: new Color(p.color), flatShading: true, side: 2 });
+    const mesh = new Mesh(geometry, classMaterial);
+    mesh.userData.part = i;
+    group.add(mesh);
+    const hulls = new Group();
+    for (const h of p.hulls) {
+      const hg = geometryOf(h);
+      hulls.add(new Mesh(hg, new MeshBasicMaterial({ color: 0x1f5fbf, transparent: true, opacity: 0.15, depthWrite: false })));
+      hulls.add(new LineSegments(new EdgesGeometry(hg, 20), new LineBasicMaterial({ color: 0x1f3f8f })));
+    }
+    hulls.visible = false;
+    group.add(hulls);
+    scene.add(group);
+    return { data: p, group, mesh, hulls, classMaterial, lookMaterial: null, lookGeometry: null };
+  });
+
+  const bounds = new Box3();
+  for (const p of parts) bounds.expandByObject(p.mesh);
+  const centre = bounds.getCenter(new Vector3());
+  const radius = Math.max(bounds.getSize(new Vector3()).length() / 2, 1e-6);
+
+  // The centre of mass: a ball and three axes through it, drawn over the object.
+  const com = new Group();
+  const ball = new Mesh(new SphereGeometry(radius * 0.04, 24, 12), new MeshBasicMaterial({ color: 0xd01010, depthTest: false }));
+  const axes = new BufferGeometry();
+  const a = radius * 0.3;
+  axes.setAttribute('position', new BufferAttribute(new Float32Array([-a, 0, 0, a, 0, 0, 0, -a, 0, 0, a, 0, 0, 0, -a, 0, 0, a]), 3));
+  com.add(ball, new LineSegments(axes, new LineBasicMaterial({ color: 0xd01010, depthTest: false })));
+  for (const o of com.children) o.renderOrder = 10;
+  com.position.fromArray(model.center_of_mass_m);
+  com.visible = false;
+  scene.add(com);
+
+  camera.near = radius / 100;
+  camera.far = radius * 100;
+  camera.position.copy(centre).add(new Vector3(1.6, -2.2, 1.2).normalize().multiplyScalar(radius * 3.5));
+  controls.target.copy(centre);
+  controls.update();
+
+  let pending = false;
+  function render() {
+    pending = false;
+    sun.position.copy(camera.position).sub(controls.target).add(new Vector3(0, 0, radius));
+    renderer.render(scene, camera);
+  }
+  function requestRender() {
+    if (!pending) {
+      pending = true;
+      requestAnimationFrame(render);
+    }
+  }
+  function resize() {
+    const w = box.clientWidth;
+    const h = box.clientHeight;
+    renderer.setSize(w, h, true);
+    camera.aspect = w / Math.max(h, 1);
+    camera.updateProjectionMatrix();
+    render();
+  }
+  controls.addEventListener('change', requestRender);
+  new ResizeObserver(resize).observe(box);
+
+  // Controls: colour mode, hulls, centre of mass, one checkbox per part.
+  const controlsBox = side.querySelector('.g2p-toggles');
+  function toggle(label, checked, onChange, name) {
+    const l = document.createElement('label');
+    const input = document.createElement('input');
+    input.type = 'checkbox';
+    input.checked = checked;
+    if (name) input.name = name;
+    input.addEventListener('change', () => { onChange(input.checked); requestRender(); });
+    l.append(input, ' ' + label);
+    controlsBox.append(l);
+    return input;
+  }
+  toggle("input's own look", false, (on) => {
+    for (const p of parts) {
+      if (on && !p.lookGeometry) {
+        p.lookGeometry = lookGeometry(p.mesh.geometry, p.data.visual.look);
+        p.lookMaterial = new MeshLambertMaterial({ vertexColors: true, side: 2 });
+        p.classGeometry = p.mesh.geometry;
+      }
+      p.mesh.geometry = on ? p.lookGeometry : p.classGeometry || p.mesh.geometry;
+      p.mesh.material = on ? p.lookMaterial : p.classMaterial;
+    }
+  }, 'look');
+  toggle('collision hulls', false, (on) => { for (const p of parts) p.hulls.visible = on; }, 'hulls');
+  toggle('centre of mass', false, (on) => { com.visible = on; }, 'com');
+
+  const info = side.querySelector('.g2p-info');
+  const list = side.querySelector('.g2p-parts');
+  let pinned = -1;
+  let hovered = -1;
+  function show(i) {
+    info.replaceChildren(i >= 0 ? partDetails(parts[i].data) : text('span', 'Hover over or click a part for its details.'));
+    parts.forEach((p, k) => {
+      p.classMaterial.emissive.setHex(k === i ? 0x404040 : 0);
+      if (p.lookMaterial) p.lookMaterial.emissive.setHex(k === i ? 0x404040 : 0);
+      list.children[k].classList.toggle('sel', k === i);
+    });
+    requestRender();
+  }
+  parts.forEach((p, i) => {
+    const li = document.createElement('li');
+    const input = document.createElement('input');
+    input.type = 'checkbox';
+    input.checked = true;
+    input.name = 'part' + i;
+    input.addEventListener('change', () => { p.group.visible = input.checked; requestRender(); });
+    const sw = text('span', '', 'sw');
+    sw.style.background = p.data.color;
+    const name = text('span', `${p.data.name}${p.data.left_out ? ' (left out)' : ''}`);
+    name.addEventListener('click', () => { pinned = pinned === i ? -1 : i; show(pinned); });
+    const l = document.createElement('label');
+    l.append(input, sw);
+    li.append(l, name);
+    list.append(li);
+  });
+
+  const raycaster = new Raycaster();
+  const pointer = new Vector2();
+  function pick(event) {
+    const r = renderer.domElement.getBoundingClientRect();
+    pointer.set(((event.clientX - r.left) / r.width) * 2 - 1, -((event.clientY - r.top) / r.height) * 2 + 1);
+    raycaster.setFromCamera(pointer, camera);
+    const visible = parts.filter((p) => p.group.visible).map((p) => p.mesh);
+    const hit = raycaster.intersectObjects(visible, false)[0];
+    return hit ? hit.object.userData.part : -1;
+  }
+  let moveQueued = null;
+  renderer.domElement.addEventListener('pointermove', (event) => {
+    if (moveQueued) { moveQueued = event; return; }
+    moveQueued = event;
+    requestAnimationFrame(() => {
+      const i = pick(moveQueued);
+      moveQueued = null;
+      if (pinned < 0 && i !== hovered) { hovered = i; show(i); }
+    });
+  });
+  let down = null;
+  renderer.domElement.addEventListener('pointerdown', (e) => { down = [e.clientX, e.clientY]; });
+  renderer.domElement.addEventListener('pointerup', (e) => {
+    if (!down || Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;  // a drag, not a click
+    pinned = pick(e);
+    show(pinned);
+  });
+  show(-1);
+  resize();
+  section.dataset.state = 'ready';
+  // For scripts and tests: redraw now, the WebGL context.
+  window.g2pViewer = { parts: parts.length, render, gl: () => renderer.getContext() };
+}
+
+function main() {
+  const section = document.getElementById('g2p-3d');
+  const data = document.getElementById('g2p-model');
+  if (!section || !data) return;
+  const status = section.querySelector('.g2p-status');
+  if (!webglAvailable()) {
+    section.dataset.state = 'no-webgl';
+    status.textContent = 'This browser has no WebGL, so the 3D view is off; the rest of the page is complete.';
+    return;
+  }
+  try {
+    section.querySelector('.g2p-viewer').hidden = false;
+    start(section, JSON.parse(data.textContent));
+    status.remove();
+  } catch (e) {
+    section.dataset.state = 'error';
+    status.textContent = `The 3D view failed (${e.message}); the rest of the page is complete.`;
+    throw e;
+  }
+}
+
+main();

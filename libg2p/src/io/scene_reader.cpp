@@ -124,8 +124,6 @@ std::string assimp_error(const Assimp::Importer& importer) {
 
 [[noreturn]] void child_main(int fd, const SceneSource& source, unsigned post_process) {
   prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the caller
-  void* warm[1];
-  backtrace(warm, 1);  // loads the unwinder now, not inside the handler
   struct sigaction sa {};
   sa.sa_sigaction = on_fatal_signal;
   sa.sa_flags = SA_SIGINFO | SA_RESETHAND;
@@ -217,6 +215,13 @@ Result<ParsedScene> parse_scene(const SceneSource& source, unsigned post_process
       fallback = std::strerror(errno);
     } else {
       std::memset(shared, 0, sizeof(CrashNote));
+      // The crash handler's backtrace() loads the unwinder on first use: load
+      // it here, once, so no child pays for it (or does it inside a handler).
+      static const int unwinder_loaded = [] {
+        void* frame[1];
+        return backtrace(frame, 1);
+      }();
+      (void)unwinder_loaded;
       fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);  // fewer switches for large scenes; best effort
       pid = fork();
       if (pid < 0) fallback = std::strerror(errno);

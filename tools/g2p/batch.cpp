@@ -3,8 +3,11 @@
 #include <limits.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <iostream>
 #include <memory>
 
@@ -46,7 +49,7 @@ const PassThrough kPassThrough[] = {
 
 struct BatchArgs {
   std::vector<std::string> inputs;
-  std::string manifest, out;
+  std::string manifest, out, scheduler;
   int jobs = 1;
   double timeout_s = 0.0, memory_limit_gib = 0.0;
   bool retry_failed = false, fail_on_error = false, quiet = false;
@@ -113,6 +116,113 @@ int usage(const std::string& message) {
   return kExitUsage;
 }
 
+// `g2p batch --scheduler ADDRESS`: the same batch through the Python module's
+// Dask executor (g2p.batch(..., client=Client(ADDRESS))); this process
+// becomes that Python program. The summary and the exit codes are the same.
+const char* const kDaskDriver = R"PY(
+import json, signal, sys
+a = json.loads(sys.argv[1])
+try:
+    import g2p
+    from distributed import Client
+except ImportError as e:
+    sys.stderr.write("g2p batch: --scheduler needs the g2p Python module (PYTHONPATH) and python3-distributed: %s\n" % e)
+    sys.exit(2)
+def on_term(signum, frame):
+    raise SystemExit(143)
+signal.signal(signal.SIGTERM, on_term)
+try:
+    client = Client(a["scheduler"], timeout=a["connect_timeout"])
+except Exception as e:
+    sys.stderr.write("g2p batch: error: cannot reach the Dask scheduler at %s (%s)\n" % (a["shown"], type(e).__name__))
+    sys.exit(1)
+def progress(p):
+    if p["last"] and not a["quiet"]:
+        eta = "-" if p["eta_s"] < 0 else "%.0fs" % p["eta_s"]
+        sys.stderr.write("g2p batch: [%d/%d, %d failed, ETA %s] %s\n" % (p["done"], p["total"], p["failed"], eta, p["last"]))
+try:
+    rows = g2p.batch(a["inputs"] or None, a["output"], manifest=a["manifest"] or None, timeout=a["timeout"],
+                     memory_limit=a["memory_limit"], run_args=a["run_args"], retry_failed=a["retry_failed"],
+                     progress=progress, client=client)
+except KeyboardInterrupt:
+    sys.stderr.write("g2p batch: stopped (SIGINT); finished assets and the index are kept, a rerun goes on from here\n")
+    sys.exit(130)
+except SystemExit as e:
+    if e.code == 143:
+        sys.stderr.write("g2p batch: stopped (SIGTERM); finished assets and the index are kept, a rerun goes on from here\n")
+    raise
+except g2p.Error as e:
+    sys.stderr.write("g2p batch: error: %s\n" % e)
+    sys.exit(2 if isinstance(e, g2p.InvalidArgumentError) else 1)
+finally:
+    client.close()
+ok = sum(r["status"] == "ok" for r in rows)
+failed = [r for r in rows if r["status"] == "failed"]
+for r in failed:
+    origin = "" if r["origin"] == r["input"] else " (%s)" % r["origin"]
+    sys.stderr.write("g2p batch: failed: %s%s: %s\n" % (r["name"], origin, r["error"]))
+print("%d assets: %d ok, %d failed on the Dask cluster -> %s/index.csv" % (len(rows), ok, len(failed), a["output"]))
+sys.exit(1 if ok == 0 or (a["fail_on_error"] and failed) else 0)
+)PY";
+
+// A scheduler address as it may be shown: any user:password@ part hidden.
+std::string shown_address(const std::string& address) {
+  const std::size_t scheme = address.find("://");
+  const std::size_t start = scheme == std::string::npos ? 0 : scheme + 3;
+  const std::size_t at = address.find('@', start);
+  if (at == std::string::npos || address.find('/', start) < at) return address;
+  return address.substr(0, start) + "***@" + address.substr(at + 1);
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_list(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (const std::string& i : items) out += (out.size() > 1 ? "," : "") + json_string(i);
+  return out + "]";
+}
+
+int run_on_dask(const BatchArgs& args, const std::vector<std::string>& run_args) {
+  char number[64];
+  std::string j = "{\"scheduler\":" + json_string(args.scheduler) +
+                  ",\"shown\":" + json_string(shown_address(args.scheduler)) + ",\"inputs\":" + json_list(args.inputs) +
+                  ",\"manifest\":" + json_string(args.manifest) + ",\"output\":" + json_string(args.out) +
+                  ",\"run_args\":" + json_list(run_args);
+  std::snprintf(number, sizeof number, ",\"timeout\":%.17g,\"memory_limit\":%.17g,\"connect_timeout\":%d",
+                args.timeout_s, args.memory_limit_gib, 30);
+  j += number;
+  j += std::string(",\"retry_failed\":") + (args.retry_failed ? "true" : "false") +
+       ",\"fail_on_error\":" + (args.fail_on_error ? "true" : "false") +
+       ",\"quiet\":" + (args.quiet ? "true" : "false") + "}";
+  // The module of this build first (the installed one, or PYTHONPATH's, otherwise).
+  std::string path = G2P_CLI_PYTHON_DIR;
+  if (const char* old = std::getenv("PYTHONPATH"); old != nullptr && *old != '\0') path += std::string(":") + old;
+  ::setenv("PYTHONPATH", path.c_str(), 1);
+  const char* python = std::getenv("G2P_PYTHON");
+  if (python == nullptr || *python == '\0')
+    python = ::access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+  std::vector<const char*> argv{python, "-c", kDaskDriver, j.c_str(), nullptr};
+  std::fflush(nullptr);
+  ::execvp(python, const_cast<char* const*>(argv.data()));
+  std::cerr << "g2p batch: --scheduler needs Python 3 (" << python << ": " << std::strerror(errno) << ")\n";
+  return kExitUsage;
+}
+
 int run_batch_command(const BatchArgs& args) {
   if (args.inputs.empty() && args.manifest.empty()) return usage("give model files, folders, patterns or --manifest");
   std::vector<BatchAsset> assets;
@@ -133,6 +243,8 @@ int run_batch_command(const BatchArgs& args) {
     std::cerr << "g2p batch: error: no model files found in the inputs\n";
     return kExitFailure;
   }
+  if (args.jobs != 1 && !args.scheduler.empty())
+    return usage("--jobs and --scheduler exclude each other (the cluster's workers set how many run at a time)");
   if (Status s = name_batch_assets(assets); !s.ok()) {
     std::cerr << "g2p batch: error: " << s.message() << "\n";
     return kExitFailure;
@@ -152,6 +264,7 @@ int run_batch_command(const BatchArgs& args) {
       o.run_args.emplace_back(kPassThrough[i].flag);
     }
   }
+  if (!args.scheduler.empty()) return run_on_dask(args, o.run_args);
   BatchProgressPrinter printer(args.quiet);
   o.on_progress = [&printer](const BatchProgress& p) { printer(p); };
   o.stop_requested = [] { return static_cast<int>(g_stop); };
@@ -206,6 +319,9 @@ void add_batch_command(CLI::App& app, Command& run) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--memory-limit", args->memory_limit_gib, "Memory limit per asset, GiB (default 0: none)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--scheduler", args->scheduler,
+                  "Run on a Dask cluster (tcp://HOST:8786) instead of local workers; needs python3-distributed and "
+                  "the g2p Python module, and the same paths on every machine");
   cmd->add_flag("--retry-failed", args->retry_failed, "Also rerun the assets the index records as failed");
   cmd->add_flag("--fail-on-error", args->fail_on_error, "Exit 1 when any asset failed");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");

@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "g2p/status.h"
@@ -67,6 +68,8 @@ struct BatchProgress {
   std::string last;         // "NAME: ok" or "NAME: failed: MESSAGE" of the asset that just finished
 };
 
+class BatchExecutor;
+
 struct BatchOptions {
   std::string tool;                   // the g2p executable; each asset runs `TOOL run MODEL -o OUT/NAME ...` (required)
   std::string output_dir;             // OUT: a subfolder per asset, index.json, index.csv (made if missing)
@@ -81,6 +84,10 @@ struct BatchOptions {
   // SIGTERM (their output is not written) and the index is written.
   std::function<int()> stop_requested;
   std::function<void(const BatchProgress&)> on_progress;
+  // Where the assets run; null = local worker processes, `jobs` at a time.
+  // A cluster's executor (the Python module's Dask one) runs each asset as
+  // run_batch_asset on a machine that sees the same paths.
+  BatchExecutor* executor = nullptr;
 };
 
 // One row of the index: one asset's latest outcome.
@@ -109,6 +116,28 @@ struct BatchResult {
   std::size_t skipped = 0;     // unchanged, not run
   std::size_t cancelled = 0;   // stopped by a signal, or never started because of one
   int stop_signal = 0;         // the signal that stopped the batch, 0 if none
+};
+
+// Runs one asset where a batch would: `TOOL run MODEL -o OUT/NAME --overwrite -q FLAGS`
+// as a child process in its own process group, under options.timeout_s and
+// options.memory_limit_gib, stopped (SIGTERM, then SIGKILL) when
+// options.stop_requested says so. Blocks until it ends; the row says how
+// (key left empty). No lock, no index: run_batch's part, or a cluster
+// worker's. Fails only when no process can start.
+G2P_API Result<BatchRow> run_batch_asset(const BatchAsset& asset, const BatchOptions& options);
+
+// Where run_batch runs the assets it decided to run. run_batch calls it from
+// one thread: submit() while fewer than capacity() are in flight, finished()
+// about every 20 ms, stop() once when the batch is stopped (then finished()
+// until every submitted asset is back, as "cancelled" or whatever it came to).
+class G2P_API BatchExecutor {
+ public:
+  virtual ~BatchExecutor() = default;
+  virtual std::size_t capacity() const = 0;
+  // Starts asset `ticket` (its row comes back from finished() with the same ticket).
+  virtual Status submit(std::size_t ticket, const BatchAsset& asset) = 0;
+  virtual std::vector<std::pair<std::size_t, BatchRow>> finished() = 0;
+  virtual void stop(int signal) = 0;
 };
 
 // The content hash that decides whether an asset runs again: the model file's

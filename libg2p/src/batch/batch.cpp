@@ -1,8 +1,7 @@
-// run_batch: the pool of worker processes over the asset list. One thread
-// polls the workers (wait4 with WNOHANG), enforces the time limit (SIGTERM,
-// then SIGKILL after a grace period), stops on request, reads each finished
-// asset's run.json and rewrites the index after every asset. An flock on
-// OUT/.g2p-batch.lock keeps a second batch off the same output.
+// run_batch: decides which assets run (resume), hands them to an executor
+// (local worker processes by default, asset_run.cpp), stops on request, and
+// rewrites the index after every asset. An flock on OUT/.g2p-batch.lock keeps
+// a second batch off the same output.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -12,15 +11,12 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <ctime>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
-#include <sstream>
 #include <thread>
 
+#include "batch/asset_run.h"
 #include "batch/worker.h"
 #include "core/file_util.h"
 #include "g2p/batch.h"
@@ -31,88 +27,12 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kLockFile = ".g2p-batch.lock";
-constexpr const char* kWorkDir = ".g2p-batch.tmp";  // the workers' stderr while they run
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  ::gmtime_r(&t, &tm);
-  char buffer[32];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buffer;
-}
-
-std::string seconds_text(double s) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%g", s);
-  return buffer;
-}
-
-// The flags an asset's own flag replaces (CLI11 refuses a flag given twice;
-// --height and --longest-side exclude each other).
-std::vector<std::string> replaced_by(const std::string& flag) {
-  if (flag == "--height" || flag == "--longest-side") return {"--height", "--longest-side"};
-  return {flag};
-}
-
-// The batch's flags, less those the asset gives itself, then the asset's.
-std::vector<std::string> merged_run_args(const std::vector<std::string>& batch, const std::vector<std::string>& own) {
-  std::vector<std::string> dropped;
-  for (const std::string& a : own)
-    if (a.rfind("--", 0) == 0)
-      for (const std::string& f : replaced_by(a.substr(0, a.find('=')))) dropped.push_back(f);
-  std::vector<std::string> out;
-  for (std::size_t i = 0; i < batch.size(); ++i) {
-    const std::string flag = batch[i].substr(0, batch[i].find('='));
-    if (std::find(dropped.begin(), dropped.end(), flag) == dropped.end()) {
-      out.push_back(batch[i]);
-      continue;
-    }
-    // Skip the flag and its value (a following word that is not a flag).
-    if (batch[i].find('=') == std::string::npos && i + 1 < batch.size() && batch[i + 1].rfind("--", 0) != 0) ++i;
-  }
-  out.insert(out.end(), own.begin(), own.end());
-  return out;
-}
-
-// Fills the row's results from the asset's run.json; false if it is missing or malformed.
-bool read_run_json(const fs::path& folder, BatchRow& row) {
-  std::ifstream in(folder / "run.json");
-  if (!in) return false;
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || j.value("format", "") != "g2p-run") return false;
-  row.parts = j.contains("parts") && j["parts"].is_array() ? j["parts"].size() : 0;
-  row.materials.clear();
-  if (j.contains("parts") && j["parts"].is_array())
-    for (const nlohmann::json& p : j["parts"]) {
-      const std::string m = p.is_object() ? p.value("material", "") : "";
-      if (!m.empty() && std::find(row.materials.begin(), row.materials.end(), m) == row.materials.end())
-        row.materials.push_back(m);
-    }
-  if (j.contains("object") && j["object"].is_object()) {
-    row.mass_kg = j["object"].value("mass_kg", 0.0);
-    row.mass_min_kg = j["object"].value("mass_min_kg", 0.0);
-    row.mass_max_kg = j["object"].value("mass_max_kg", 0.0);
-  }
-  row.stage_seconds.clear();
-  if (j.contains("stages") && j["stages"].is_array())
-    for (const nlohmann::json& s : j["stages"])
-      if (s.is_object() && s.contains("stage")) row.stage_seconds[s.value("stage", "")] = s.value("seconds", 0.0);
-  return true;
-}
 
 // Removes what killed runs leave in OUT: `g2p run`'s hidden .NAME.g2p-PID.tmp
 // (and .old) folders, and the batch's work folder. Only under the lock.
 void remove_leftovers(const fs::path& out) {
   std::error_code ec;
-  fs::remove_all(out / kWorkDir, ec);
+  fs::remove_all(out / detail::kBatchWorkDir, ec);
   std::vector<fs::path> stale;
   for (auto it = fs::directory_iterator(out, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
     const std::string name = it->path().filename().string();
@@ -134,7 +54,7 @@ class OutputLock {
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd_ < 0) return Status::IoError(path.string() + ": cannot open: " + std::strerror(errno));
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      const std::string holder = read_text(path);
+      const std::string holder = detail::read_text(path);
       return Status::Unavailable(out.string() + ": another g2p batch" +
                                  (holder.empty() ? std::string() : " (pid " + holder + ")") +
                                  " is writing to this folder; wait for it to finish or choose another output");
@@ -148,14 +68,37 @@ class OutputLock {
   int fd_ = -1;
 };
 
-// One running asset.
-struct Running {
-  std::size_t index = 0;  // into the asset list
-  detail::WorkerProcess process;
-  fs::path stderr_path;
-  double term_sent_s = -1.0;  // elapsed time of the SIGTERM sent, -1 = none
-  bool timed_out = false;
-  int stopped_by = 0;  // the batch's stop signal, when it stopped this one
+// The default executor: `jobs` local worker processes.
+class LocalExecutor : public BatchExecutor {
+ public:
+  explicit LocalExecutor(const BatchOptions& options) : options_(options) {}
+  std::size_t capacity() const override { return static_cast<std::size_t>(options_.jobs); }
+  Status submit(std::size_t ticket, const BatchAsset& asset) override {
+    Result<detail::AssetRun> run = detail::AssetRun::start(asset, options_);
+    if (!run.ok()) return run.status();
+    running_.emplace_back(ticket, std::move(*run));
+    return Status::Ok();
+  }
+  std::vector<std::pair<std::size_t, BatchRow>> finished() override {
+    std::vector<std::pair<std::size_t, BatchRow>> done;
+    for (auto it = running_.begin(); it != running_.end();) {
+      BatchRow row;
+      if (it->second.poll(row)) {
+        done.emplace_back(it->first, std::move(row));
+        it = running_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    return done;
+  }
+  void stop(int signal) override {
+    for (auto& [ticket, run] : running_) run.stop(signal);
+  }
+
+ private:
+  const BatchOptions& options_;
+  std::vector<std::pair<std::size_t, detail::AssetRun>> running_;
 };
 
 class BatchRunner {
@@ -173,8 +116,8 @@ class BatchRunner {
     if (!index.ok()) return index.status();
     index_ = std::move(*index);
     std::error_code ec;
-    fs::create_directories(out_ / kWorkDir, ec);
-    if (ec) return Status::IoError((out_ / kWorkDir).string() + ": cannot create: " + ec.message());
+    fs::create_directories(out_ / detail::kBatchWorkDir, ec);
+    if (ec) return Status::IoError((out_ / detail::kBatchWorkDir).string() + ": cannot create: " + ec.message());
     plan();
     report(nullptr);
     Status s = loop();
@@ -241,7 +184,7 @@ class BatchRunner {
       if (!key.ok()) {  // unreadable: a failure of its own, like any other
         row.status = "failed";
         row.error = key.status().message();
-        row.finished_at = utc_now();
+        row.finished_at = detail::utc_now();
         upsert(row);
         ++result_.failed;
         continue;
@@ -249,7 +192,8 @@ class BatchRunner {
       row.key = *key;
       const BatchRow* before = previous(a.name);
       const bool same = before != nullptr && before->key == row.key && before->input == a.path;
-      const bool complete = same && before->status == "ok" && read_run_json(out_ / a.name, row);
+      const bool complete =
+          same && before->status == "ok" && detail::asset_output_complete((out_ / a.name).string(), row);
       const bool kept_failure = same && before->status == "failed" && !options_.retry_failed;
       if (complete || kept_failure) {
         row = *before;
@@ -263,43 +207,30 @@ class BatchRunner {
   }
 
   Status loop() {
-    std::vector<Running> running;
+    LocalExecutor local(options_);
+    BatchExecutor& executor = options_.executor != nullptr ? *options_.executor : local;
+    const std::size_t capacity = std::max<std::size_t>(1, executor.capacity());
     while (true) {
       const int stop = options_.stop_requested ? options_.stop_requested() : 0;
       if (stop != 0 && stop_signal_ == 0) {
         stop_signal_ = stop;
-        for (Running& r : running) {
-          r.stopped_by = stop;
-          r.process.signal_group(SIGTERM);
-          r.term_sent_s = r.process.elapsed_s();
-        }
+        executor.stop(stop);
       }
-      while (stop_signal_ == 0 && !queue_.empty() && static_cast<int>(running.size()) < options_.jobs) {
+      while (stop_signal_ == 0 && !queue_.empty() && in_flight_ < capacity) {
         const std::size_t i = queue_.front();
         queue_.pop_front();
-        Result<Running> started = start(i);
-        if (!started.ok()) return started.status();  // fork failed: nothing more can start
-        running.push_back(std::move(*started));
+        if (Status s = executor.submit(i, assets_[i]); !s.ok()) {
+          executor.stop(SIGTERM);  // nothing more can start: end what runs, keep the index
+          stop_signal_ = SIGTERM;
+          queue_.push_front(i);
+          error_ = s;
+          break;
+        }
+        ++in_flight_;
         report(nullptr);
       }
-      for (auto it = running.begin(); it != running.end();) {
-        detail::WorkerExit exit;
-        if (it->process.poll(exit)) {
-          G2P_RETURN_IF_ERROR(finish(*it, exit));
-          it = running.erase(it);
-          continue;
-        }
-        const double elapsed = it->process.elapsed_s();
-        if (options_.timeout_s > 0 && elapsed > options_.timeout_s && it->term_sent_s < 0) {
-          it->timed_out = true;
-          it->process.signal_group(SIGTERM);
-          it->term_sent_s = elapsed;
-        } else if (it->term_sent_s >= 0 && elapsed - it->term_sent_s > options_.kill_grace_s) {
-          it->process.signal_group(SIGKILL);
-        }
-        ++it;
-      }
-      if (running.empty() && (queue_.empty() || stop_signal_ != 0)) break;
+      for (auto& [ticket, row] : executor.finished()) G2P_RETURN_IF_ERROR(finish(ticket, std::move(row)));
+      if (in_flight_ == 0 && (queue_.empty() || stop_signal_ != 0)) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     for (std::size_t i : queue_) {  // never started: the batch was stopped
@@ -308,74 +239,32 @@ class BatchRunner {
       row.error = "not started: the batch was stopped (" + detail::signal_name(stop_signal_) + ")";
       ++result_.cancelled;
     }
-    result_.stop_signal = stop_signal_;
-    return write_index();
+    result_.stop_signal = error_.ok() ? stop_signal_ : 0;
+    G2P_RETURN_IF_ERROR(write_index());
+    return error_;
   }
 
-  Result<Running> start(std::size_t i) {
-    const BatchAsset& a = assets_[i];
-    std::vector<std::string> argv{options_.tool, "run", a.path, "-o", (out_ / a.name).string(), "--overwrite", "-q"};
-    std::vector<std::string> flags = merged_run_args(options_.run_args, a.run_args);
-    if (options_.memory_limit_gib > 0)
-      flags = merged_run_args(flags, {"--memory-limit", seconds_text(options_.memory_limit_gib)});
-    argv.insert(argv.end(), flags.begin(), flags.end());
-    Running r;
-    r.index = i;
-    r.stderr_path = out_ / kWorkDir / (a.name + ".stderr");
-    Result<detail::WorkerProcess> p =
-        detail::WorkerProcess::start(argv, r.stderr_path.string(), options_.memory_limit_gib);
-    if (!p.ok()) return p.status();
-    r.process = *p;
-    return r;
-  }
-
-  Status finish(const Running& r, const detail::WorkerExit& exit) {
-    const BatchAsset& a = assets_[r.index];
-    BatchRow& row = result_.rows[r.index];
-    const fs::path folder = out_ / a.name;
-    const std::string err = read_text(r.stderr_path);
-    std::error_code ec;
-    fs::remove(r.stderr_path, ec);
-    row.exit_code = exit.exited ? exit.code : 128 + exit.code;
-    row.seconds = exit.seconds;
-    row.peak_rss_bytes = exit.peak_rss_bytes;
-    row.finished_at = utc_now();
-    row.error.clear();
-    const bool ran_ok = exit.exited && exit.code == 0;
-    if (ran_ok && read_run_json(folder, row)) {  // done before a stop or a timeout took effect: it stands
-      row.status = "ok";
-      row.output = folder.string();
+  Status finish(std::size_t i, BatchRow row) {
+    if (i >= assets_.size() || in_flight_ == 0) return Status::Internal("batch executor returned an unknown asset");
+    --in_flight_;
+    ++finished_;
+    BatchRow& kept = result_.rows[i];
+    row.name = kept.name;  // as planned, whatever the executor says
+    row.input = kept.input;
+    row.origin = kept.origin;
+    row.key = kept.key;
+    if (row.status == "ok") {
       ++result_.succeeded;
-    } else if (r.stopped_by != 0 && !r.timed_out) {
-      row.status = "cancelled";
-      row.error = "cancelled (" + detail::signal_name(r.stopped_by) + ")";
+    } else if (row.status == "cancelled") {
       ++result_.cancelled;
     } else {
       row.status = "failed";
-      row.output.clear();
-      row.parts = 0;
-      row.materials.clear();
-      row.mass_kg = row.mass_min_kg = row.mass_max_kg = 0.0;
-      row.stage_seconds.clear();
-      if (r.timed_out) {
-        row.error = "timed out after " + seconds_text(options_.timeout_s) + " s";
-      } else if (ran_ok) {
-        row.error = "g2p run succeeded but wrote no readable run.json in " + folder.string();
-      } else {
-        row.error = detail::describe_failure(exit, err, options_.memory_limit_gib);
-      }
-      // An earlier output of this name belongs to other content or options.
-      fs::remove_all(folder, ec);
       ++result_.failed;
     }
-    // A killed run leaves its hidden .NAME.g2p-PID.tmp folder behind.
-    const std::string tag = "." + a.name + ".g2p-" + std::to_string(r.process.pid());
-    fs::remove_all(out_ / (tag + ".tmp"), ec);
-    fs::remove_all(out_ / (tag + ".old"), ec);
-    ++finished_;
+    kept = row;
     upsert(row);
     G2P_RETURN_IF_ERROR(write_index());
-    report(&row);
+    report(&kept);
     return Status::Ok();
   }
 
@@ -386,7 +275,7 @@ class BatchRunner {
     p.skipped = result_.skipped;
     p.failed = result_.failed;
     p.done = result_.succeeded + result_.failed + result_.skipped + result_.cancelled;
-    p.running = to_run_ - finished_ - queue_.size();
+    p.running = in_flight_;
     p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
     if (finished_ > 0)
       p.eta_s = p.elapsed_s / static_cast<double>(finished_) * static_cast<double>(to_run_ - finished_);
@@ -402,8 +291,9 @@ class BatchRunner {
   std::vector<BatchRow> index_;  // the whole index: this batch's rows and earlier ones
   BatchResult result_;
   std::deque<std::size_t> queue_;
-  std::size_t to_run_ = 0, finished_ = 0;
+  std::size_t to_run_ = 0, finished_ = 0, in_flight_ = 0;
   int stop_signal_ = 0;
+  Status error_;  // an executor that could not start an asset
 };
 
 }  // namespace

@@ -17,9 +17,9 @@ import unittest
 import g2p
 
 try:
-    from distributed import Client, LocalCluster
+    from distributed import Client, LocalCluster, get_task_stream
 except ImportError:
-    Client = LocalCluster = None
+    Client = LocalCluster = get_task_stream = None
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HAMMER = pathlib.Path(os.environ.get("G2P_HAMMER_OBJ", str(ROOT / "examples" / "data" / "hammer.obj")))
@@ -72,7 +72,13 @@ class DaskBatchTest(unittest.TestCase):
         empty.write_bytes(b"")
         models.append(empty)
         out = self.dir / "out"
-        rows = g2p.batch(models, out, run_args=QUICK, timeout=15, tool=misbehaving_tool(self.dir), client=self.client)
+        with get_task_stream(self.client) as tasks:
+            rows = g2p.batch(models, out, run_args=QUICK, timeout=15, tool=misbehaving_tool(self.dir),
+                             client=self.client)
+        # Every model was a task of the cluster, on both of its workers.
+        ran = [t for t in tasks.data if t["key"].startswith("g2p-")]
+        self.assertEqual(len(ran), 5, tasks.data)
+        self.assertEqual(len({t["worker"] for t in ran}), 2, ran)
         by_name = {r["name"]: r for r in rows}
         self.assertEqual([r["name"] for r in rows], ["good1", "crash", "hang", "good2", "empty"])
         for good in ("good1", "good2"):

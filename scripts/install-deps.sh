@@ -31,6 +31,7 @@ extra=(
   libmujoco-dev libgl-dev libopengl-dev libbullet-extras-dev
   liburdfdom-tools libsdformat-dev libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-onnx
+  python3-pandas python3-dask python3-distributed
   clang libclang-rt-14-dev
   chromium
 )

@@ -195,5 +195,6 @@ void bind_stage_types(py::module_& m);  // stage_types.cpp: cameras, views, labe
 void bind_stages(py::module_& m);       // stages.cpp: the stage interfaces, registries, stage functions
 void bind_decompose(py::module_& m);    // decompose.cpp: options, results, Decomposer, convex_hull
 void bind_pipeline(py::module_& m);     // pipeline.cpp: options, RunContext, Pipeline, PipelineResult
+void bind_batch(py::module_& m);        // batch.cpp: g2p.batch, its rows and DataFrame
 
 }  // namespace g2p::python

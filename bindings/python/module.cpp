@@ -143,6 +143,7 @@ PYBIND11_MODULE(g2p, m) {
   bind_stages(m);
   bind_decompose(m);
   bind_pipeline(m);
+  bind_batch(m);
 
 #if defined(G2P_PYTHON_WITH_CGAL)
   // The GPL component is linked into this module: its completers ("alpha-wrap",

@@ -1,5 +1,7 @@
 #include "support/tool_run.h"
 
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +13,22 @@
 namespace g2p::test {
 
 ToolRun run_tool(const std::string& args) { return run_command(quote(G2P_TEST_TOOL) + " " + args); }
+
+int spawn_tool(const std::vector<std::string>& args, const std::string& stderr_path) {
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  std::vector<std::string> words{G2P_TEST_TOOL};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, G2P_TEST_TOOL, &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  return rc == 0 ? pid : -1;
+}
 
 ToolRun run_command(const std::string& command_line) {
   static int counter = 0;  // ctest runs tests in parallel processes: one folder per run

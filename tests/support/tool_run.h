@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace g2p::test {
 
@@ -12,6 +13,10 @@ struct ToolRun {
 
 // Runs `g2p ARGS` (ARGS already shell-quoted where needed).
 ToolRun run_tool(const std::string& args);
+
+// Starts `g2p ARGS` in the background (argv words, no shell), stdout on
+// /dev/null and stderr into `stderr_path`; returns its pid (-1 on failure).
+int spawn_tool(const std::vector<std::string>& args, const std::string& stderr_path);
 
 // Runs a shell command line as given, capturing its output.
 ToolRun run_command(const std::string& command_line);

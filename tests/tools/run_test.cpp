@@ -2,9 +2,7 @@
 // summary, degraded optional stages, and a folder the other commands accept.
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -263,17 +261,8 @@ TEST_P(ToolRunSignal, CancelsAndWritesNothing) {
   const std::string dir = test::scratch_dir("ToolRunSignal" + std::to_string(signal));
   const std::string out = dir + "/out", err = dir + "/err.txt";
   const std::string model = test::asset_path("SheenChair");  // several seconds: time to interrupt it
-  posix_spawn_file_actions_t files;
-  posix_spawn_file_actions_init(&files);
-  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  std::vector<std::string> args{G2P_TEST_TOOL, "run", model, "-o", out};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, G2P_TEST_TOOL, &files, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&files);
+  const pid_t pid = test::spawn_tool({"run", model, "-o", out}, err);
+  ASSERT_GT(pid, 0);
   // Interrupt once rendering has begun (progress lines on stderr).
   const auto start = std::chrono::steady_clock::now();
   while (test::read_file(err).find("render") == std::string::npos &&

@@ -1,6 +1,7 @@
 // Umbrella header: the whole public API of libg2p.
 #pragma once
 
+#include "g2p/batch.h"
 #include "g2p/complete.h"
 #include "g2p/decompose.h"
 #include "g2p/eval.h"

@@ -6,48 +6,15 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
+#include "core/csv.h"
 #include "core/file_util.h"
 #include "g2p/project.h"
 #include "g2p/segment.h"
 
 namespace g2p {
-namespace {
 
-// RFC 4180: quote fields holding a comma, a quote or a line break.
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-// Splits one CSV record (RFC 4180 quoting, no line breaks inside fields).
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        out.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else if (c != '\r') {
-      out.back() += c;
-    }
-  }
-  return out;
-}
-
-}  // namespace
+using detail::csv_field;
+using detail::csv_fields;
 
 Result<FacesFile> read_faces_csv(const std::string& path, const Mesh& mesh, const MaterialTable& table) {
   std::ifstream in(path, std::ios::binary);

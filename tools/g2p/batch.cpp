@@ -1,0 +1,349 @@
+// g2p batch INPUTS... -o OUT: many models, each through `g2p run` in its own
+// worker process (g2p::run_batch), one subfolder per asset and an index.
+#include <limits.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <memory>
+
+#include "commands.h"
+#include "g2p/batch.h"
+
+namespace g2p::cli {
+namespace {
+
+// `g2p run` flags that `g2p batch` passes on to every asset, as given.
+struct PassThrough {
+  const char* flag;
+  const char* help;
+  bool takes_value;
+  bool repeatable;
+};
+const PassThrough kPassThrough[] = {
+    {"--unit", "Length unit of the files (m, cm, mm, in, ft)", true, false},
+    {"--up", "Up axis of the files (auto, y, z, ...)", true, false},
+    {"--height", "Real height of every object, metres", true, false},
+    {"--longest-side", "Real longest side of every object, metres", true, false},
+    {"--views", "Number of views (default 11)", true, false},
+    {"--resolution", "View resolution in pixels (default 512)", true, false},
+    {"--segmenter", "Segmenter backend (default pbr)", true, false},
+    {"--set", "Segmenter setting KEY=VALUE (repeatable)", true, true},
+    {"--refiner", "Refiner backend (default smooth)", true, false},
+    {"--completer", "Completer backend (default partition)", true, false},
+    {"--estimator", "Property estimator backend (default table)", true, false},
+    {"--decomposer", "Decomposer backend (default voxel-cut)", true, false},
+    {"--decompose-set", "Decomposer setting KEY=VALUE (repeatable)", true, true},
+    {"--materials", "Material table JSON", true, false},
+    {"--format", "Formats: mjcf, urdf, sdf, glb (comma-separated)", true, false},
+    {"--soft", "Soft votes in the project stage", false, false},
+    {"--fixed", "MJCF: fix the body to the world", false, false},
+    {"--keep-axes", "Keep the file's axes", false, false},
+    {"--no-textures", "Ignore textures", false, false},
+    {"--lenient", "Keep the good triangles of a damaged file", false, false},
+};
+
+struct BatchArgs {
+  std::vector<std::string> inputs;
+  std::string manifest, out, scheduler;
+  int jobs = 1;
+  double timeout_s = 0.0, memory_limit_gib = 0.0;
+  bool retry_failed = false, fail_on_error = false, quiet = false;
+  std::vector<std::vector<std::string>> pass_values = std::vector<std::vector<std::string>>(std::size(kPassThrough));
+  std::vector<bool> pass_flags = std::vector<bool>(std::size(kPassThrough), false);
+};
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop(int signal) { g_stop = signal; }
+
+// The running g2p executable, which every asset's worker runs.
+std::string own_executable() {
+  char path[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return "";
+  path[n] = '\0';
+  return path;
+}
+
+std::string duration(double s) {
+  char buffer[32];
+  if (s < 60)
+    std::snprintf(buffer, sizeof buffer, "%.0fs", s);
+  else if (s < 3600)
+    std::snprintf(buffer, sizeof buffer, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  else
+    std::snprintf(buffer, sizeof buffer, "%dh%02dm", static_cast<int>(s) / 3600, static_cast<int>(s) / 60 % 60);
+  return buffer;
+}
+
+// A redrawn bar on a terminal; one line per finished asset otherwise.
+class BatchProgressPrinter {
+ public:
+  explicit BatchProgressPrinter(bool quiet) : quiet_(quiet), tty_(::isatty(STDERR_FILENO) == 1) {}
+  void operator()(const BatchProgress& p) {
+    if (quiet_) return;
+    const std::string eta = p.eta_s < 0 ? std::string("-") : duration(p.eta_s);
+    if (tty_) {
+      const int width = 24;
+      const int filled = p.total == 0 ? width : static_cast<int>(width * p.done / p.total);
+      if (!p.last.empty() && p.last.find(": ok") == std::string::npos) {  // a failure stays on screen
+        std::fprintf(stderr, "\r\033[K%s\n", p.last.c_str());
+      }
+      std::fprintf(stderr, "\r\033[K[%-*s] %zu/%zu done, %zu failed, %zu skipped, %zu running, ETA %s", width,
+                   std::string(filled, '#').c_str(), p.done, p.total, p.failed, p.skipped, p.running, eta.c_str());
+      std::fflush(stderr);
+      drawn_ = true;
+    } else if (!p.last.empty()) {
+      std::fprintf(stderr, "g2p batch: [%zu/%zu, %zu failed, ETA %s] %s\n", p.done, p.total, p.failed, eta.c_str(),
+                   p.last.c_str());
+    }
+  }
+  void end_line() {
+    if (drawn_) std::fputc('\n', stderr);
+    drawn_ = false;
+  }
+
+ private:
+  bool quiet_, tty_, drawn_ = false;
+};
+
+int usage(const std::string& message) {
+  std::cerr << "g2p batch: " << message << "\n";
+  return kExitUsage;
+}
+
+// `g2p batch --scheduler ADDRESS`: the same batch through the Python module's
+// Dask executor (g2p.batch(..., client=Client(ADDRESS))); this process
+// becomes that Python program. The summary and the exit codes are the same.
+const char* const kDaskDriver = R"PY(
+import json, signal, sys
+a = json.loads(sys.argv[1])
+try:
+    import g2p
+    from distributed import Client
+except ImportError as e:
+    sys.stderr.write("g2p batch: --scheduler needs the g2p Python module (PYTHONPATH) and python3-distributed: %s\n" % e)
+    sys.exit(2)
+def on_term(signum, frame):
+    raise SystemExit(143)
+signal.signal(signal.SIGTERM, on_term)
+try:
+    client = Client(a["scheduler"], timeout=a["connect_timeout"])
+except Exception as e:
+    sys.stderr.write("g2p batch: error: cannot reach the Dask scheduler at %s (%s)\n" % (a["shown"], type(e).__name__))
+    sys.exit(1)
+def progress(p):
+    if p["last"] and not a["quiet"]:
+        eta = "-" if p["eta_s"] < 0 else "%.0fs" % p["eta_s"]
+        sys.stderr.write("g2p batch: [%d/%d, %d failed, ETA %s] %s\n" % (p["done"], p["total"], p["failed"], eta, p["last"]))
+try:
+    rows = g2p.batch(a["inputs"] or None, a["output"], manifest=a["manifest"] or None, timeout=a["timeout"],
+                     memory_limit=a["memory_limit"], run_args=a["run_args"], retry_failed=a["retry_failed"],
+                     progress=progress, client=client)
+except KeyboardInterrupt:
+    sys.stderr.write("g2p batch: stopped (SIGINT); finished assets and the index are kept, a rerun goes on from here\n")
+    sys.exit(130)
+except SystemExit as e:
+    if e.code == 143:
+        sys.stderr.write("g2p batch: stopped (SIGTERM); finished assets and the index are kept, a rerun goes on from here\n")
+    raise
+except g2p.Error as e:
+    sys.stderr.write("g2p batch: error: %s\n" % e)
+    sys.exit(2 if isinstance(e, g2p.InvalidArgumentError) else 1)
+finally:
+    client.close()
+ok = sum(r["status"] == "ok" for r in rows)
+failed = [r for r in rows if r["status"] == "failed"]
+for r in failed:
+    origin = "" if r["origin"] == r["input"] else " (%s)" % r["origin"]
+    sys.stderr.write("g2p batch: failed: %s%s: %s\n" % (r["name"], origin, r["error"]))
+print("%d assets: %d ok, %d failed on the Dask cluster -> %s/index.csv" % (len(rows), ok, len(failed), a["output"]))
+sys.exit(1 if ok == 0 or (a["fail_on_error"] and failed) else 0)
+)PY";
+
+// A scheduler address as it may be shown: any user:password@ part hidden.
+std::string shown_address(const std::string& address) {
+  const std::size_t scheme = address.find("://");
+  const std::size_t start = scheme == std::string::npos ? 0 : scheme + 3;
+  const std::size_t at = address.find('@', start);
+  if (at == std::string::npos || address.find('/', start) < at) return address;
+  return address.substr(0, start) + "***@" + address.substr(at + 1);
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_list(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (const std::string& i : items) out += (out.size() > 1 ? "," : "") + json_string(i);
+  return out + "]";
+}
+
+int run_on_dask(const BatchArgs& args, const std::vector<std::string>& run_args) {
+  char number[64];
+  std::string j = "{\"scheduler\":" + json_string(args.scheduler) +
+                  ",\"shown\":" + json_string(shown_address(args.scheduler)) + ",\"inputs\":" + json_list(args.inputs) +
+                  ",\"manifest\":" + json_string(args.manifest) + ",\"output\":" + json_string(args.out) +
+                  ",\"run_args\":" + json_list(run_args);
+  std::snprintf(number, sizeof number, ",\"timeout\":%.17g,\"memory_limit\":%.17g,\"connect_timeout\":%d",
+                args.timeout_s, args.memory_limit_gib, 30);
+  j += number;
+  j += std::string(",\"retry_failed\":") + (args.retry_failed ? "true" : "false") +
+       ",\"fail_on_error\":" + (args.fail_on_error ? "true" : "false") +
+       ",\"quiet\":" + (args.quiet ? "true" : "false") + "}";
+  // The module of this build first (the installed one, or PYTHONPATH's, otherwise).
+  std::string path = G2P_CLI_PYTHON_DIR;
+  if (const char* old = std::getenv("PYTHONPATH"); old != nullptr && *old != '\0') path += std::string(":") + old;
+  ::setenv("PYTHONPATH", path.c_str(), 1);
+  const char* python = std::getenv("G2P_PYTHON");
+  if (python == nullptr || *python == '\0')
+    python = ::access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+  std::vector<const char*> argv{python, "-c", kDaskDriver, j.c_str(), nullptr};
+  std::fflush(nullptr);
+  ::execvp(python, const_cast<char* const*>(argv.data()));
+  std::cerr << "g2p batch: --scheduler needs Python 3 (" << python << ": " << std::strerror(errno) << ")\n";
+  return kExitUsage;
+}
+
+int run_batch_command(const BatchArgs& args) {
+  if (args.inputs.empty() && args.manifest.empty()) return usage("give model files, folders, patterns or --manifest");
+  std::vector<BatchAsset> assets;
+  if (!args.manifest.empty()) {
+    Result<std::vector<BatchAsset>> listed = read_batch_manifest(args.manifest);
+    if (!listed.ok()) {
+      std::cerr << "g2p batch: error: " << listed.status().message() << "\n";
+      return listed.status().code() == StatusCode::kNotFound ? kExitUsage : kExitFailure;
+    }
+    assets = std::move(*listed);
+  }
+  if (!args.inputs.empty()) {
+    Result<std::vector<BatchAsset>> listed = list_batch_inputs(args.inputs);
+    if (!listed.ok()) return usage(listed.status().message());
+    assets.insert(assets.end(), listed->begin(), listed->end());
+  }
+  if (assets.empty()) {
+    std::cerr << "g2p batch: error: no model files found in the inputs\n";
+    return kExitFailure;
+  }
+  if (args.jobs != 1 && !args.scheduler.empty())
+    return usage("--jobs and --scheduler exclude each other (the cluster's workers set how many run at a time)");
+  if (Status s = name_batch_assets(assets); !s.ok()) {
+    std::cerr << "g2p batch: error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+
+  BatchOptions o;
+  o.tool = own_executable();
+  o.output_dir = args.out;
+  o.jobs = args.jobs;
+  o.timeout_s = args.timeout_s;
+  o.memory_limit_gib = args.memory_limit_gib;
+  o.retry_failed = args.retry_failed;
+  for (std::size_t i = 0; i < std::size(kPassThrough); ++i) {
+    if (kPassThrough[i].takes_value) {
+      for (const std::string& v : args.pass_values[i]) o.run_args.insert(o.run_args.end(), {kPassThrough[i].flag, v});
+    } else if (args.pass_flags[i]) {
+      o.run_args.emplace_back(kPassThrough[i].flag);
+    }
+  }
+  if (!args.scheduler.empty()) return run_on_dask(args, o.run_args);
+  BatchProgressPrinter printer(args.quiet);
+  o.on_progress = [&printer](const BatchProgress& p) { printer(p); };
+  o.stop_requested = [] { return static_cast<int>(g_stop); };
+
+  auto previous_int = std::signal(SIGINT, on_stop);
+  auto previous_term = std::signal(SIGTERM, on_stop);
+  Result<BatchResult> result = run_batch(assets, o);
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+  printer.end_line();
+  if (!result.ok()) {
+    const Status& s = result.status();
+    if (s.code() == StatusCode::kInvalidArgument) return usage(s.message());
+    std::cerr << "g2p batch: error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  const BatchResult& r = *result;
+  std::size_t ok = 0, failed = 0;  // this run's and the unchanged ones the index keeps
+  for (const BatchRow& row : r.rows) {
+    if (row.status == "ok") ++ok;
+    if (row.status != "failed") continue;
+    ++failed;
+    const bool listed_by_path = row.origin == row.input;
+    std::cerr << "g2p batch: failed: " << row.name << (listed_by_path ? "" : " (" + row.origin + ")") << ": "
+              << row.error << "\n";
+  }
+  std::printf("%zu assets: %zu ok, %zu failed, %zu skipped (unchanged)%s -> %s/index.csv\n", r.rows.size(), r.succeeded,
+              r.failed, r.skipped, r.cancelled > 0 ? (", " + std::to_string(r.cancelled) + " cancelled").c_str() : "",
+              args.out.c_str());
+  if (r.stop_signal != 0) {
+    std::cerr << "g2p batch: stopped (" << (r.stop_signal == SIGTERM ? "SIGTERM" : "SIGINT")
+              << "); finished assets and the index are kept, a rerun goes on from here\n";
+    return r.stop_signal == SIGTERM ? kExitTerminated : kExitCancelled;
+  }
+  if (ok == 0) return kExitFailure;
+  if (args.fail_on_error && failed > 0) return kExitFailure;
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_batch_command(CLI::App& app, Command& run) {
+  auto args = std::make_shared<BatchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "batch", "Many models through `g2p run`, each in its own process: a subfolder per asset and an index, resumable");
+  cmd->add_option("inputs", args->inputs, "Model files, folders (every model file below) or quoted patterns ('*.glb')");
+  cmd->add_option("--manifest", args->manifest,
+                  "CSV (header: path,name,unit,up,segmenter,height,longest_side) or JSON Lines, one model a row");
+  cmd->add_option("-o,--output", args->out, "Output folder: a subfolder per asset, index.json, index.csv")->required();
+  cmd->add_option("-j,--jobs", args->jobs, "Worker processes at a time (default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--timeout", args->timeout_s, "Wall-clock limit per asset, seconds (default 0: none)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--memory-limit", args->memory_limit_gib, "Memory limit per asset, GiB (default 0: none)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--scheduler", args->scheduler,
+                  "Run on a Dask cluster (tcp://HOST:8786) instead of local workers; needs python3-distributed and "
+                  "the g2p Python module, and the same paths on every machine");
+  cmd->add_flag("--retry-failed", args->retry_failed, "Also rerun the assets the index records as failed");
+  cmd->add_flag("--fail-on-error", args->fail_on_error, "Exit 1 when any asset failed");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+  for (std::size_t i = 0; i < std::size(kPassThrough); ++i) {
+    const PassThrough& p = kPassThrough[i];
+    const std::string help = std::string(p.help) + " (passed to g2p run)";
+    if (!p.takes_value) {
+      cmd->add_flag_function(
+          p.flag, [args, i](std::int64_t) { args->pass_flags[i] = true; }, help);
+    } else if (p.repeatable) {
+      cmd->add_option(p.flag, args->pass_values[i], help)->allow_extra_args(false);
+    } else {
+      cmd->add_option_function<std::string>(
+          p.flag, [args, i](const std::string& v) { args->pass_values[i] = {v}; }, help);
+    }
+  }
+  cmd->footer(
+      "Each asset runs as `g2p run MODEL -o OUT/NAME` in its own process; a crash, timeout or out-of-memory is "
+      "recorded in OUT/index.csv and the batch goes on. A rerun skips unchanged assets. Exit codes: 0 done (some "
+      "assets may have failed: see the index), 1 nothing succeeded or --fail-on-error with a failure, 2 bad command "
+      "line, 130 stopped (Ctrl-C), 143 stopped (SIGTERM); finished assets and the index stay.");
+  cmd->callback([args, &run] { run = [args] { return run_batch_command(*args); }; });
+}
+
+}  // namespace g2p::cli

@@ -241,6 +241,32 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("free_joint", &ExportOptions::free_joint)
       .def_readwrite("use_static_friction", &ExportOptions::use_static_friction);
 
+  py::class_<Overrides>(m, "Overrides",
+                        "A person's corrections (summary.html's 3D view, docs/pipeline.md#overrides): classes, "
+                        "solid/hollow, wall thickness and density per part or face. Read them with "
+                        "g2p.read_overrides(path) or g2p.parse_overrides(text); give them to "
+                        "PipelineOptions(overrides=...).")
+      .def(py::init<>())
+      .def("__len__", [](const Overrides& o) { return o.entries.size(); })
+      .def_property_readonly("changes_classes", &Overrides::changes_labels)
+      .def_property_readonly("changes_properties", &Overrides::changes_properties)
+      .def_readwrite("model", &Overrides::model)
+      .def_readwrite("faces_total", &Overrides::faces_total, "the input's face count, checked when >= 0")
+      .def(
+          "to_json", [](const Overrides& o, const MaterialTable& table) { return overrides_json(o, table); },
+          py::arg("table") = MaterialTable::paper_default(), "The file's JSON text.");
+  m.def(
+      "read_overrides",
+      [](const std::string& path, const MaterialTable& table) { return unwrap(read_overrides(path, table)); },
+      py::arg("path"), py::arg("table") = MaterialTable::paper_default(),
+      "Reads an overrides file; a bad entry raises g2p.InvalidArgumentError naming it.");
+  m.def(
+      "parse_overrides",
+      [](const std::string& text, const MaterialTable& table, const std::string& origin) {
+        return unwrap(parse_overrides(text, table, origin));
+      },
+      py::arg("text"), py::arg("table") = MaterialTable::paper_default(), py::arg("origin") = "overrides");
+
   py::class_<PipelineOptions>(
       m, "PipelineOptions",
       "Everything a run needs; nested structs are edited in place (options.views.num_views = 6). Keyword "
@@ -265,6 +291,7 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("export_options", &PipelineOptions::export_options)
       .def_readwrite("formats", &PipelineOptions::formats,
                      "a list copy: assign a new list (options.formats = ['mjcf']) to change it")
+      .def_readwrite("overrides", &PipelineOptions::overrides, "g2p.Overrides: corrections to apply")
       .def_readwrite("last_stage", &PipelineOptions::last_stage)
       .def_readwrite("measure_stage_memory", &PipelineOptions::measure_stage_memory);
 
@@ -325,6 +352,8 @@ void bind_pipeline(py::module_& m) {
           },
           "The stage's report as a dict, or None if it did not run.")
       .def_readonly("warnings", &PipelineResult::warnings)
+      .def_readonly("overrides_applied", &PipelineResult::overrides_applied,
+                    "what PipelineOptions.overrides changed, one line per entry")
       .def_readonly("seconds", &PipelineResult::seconds)
       .def_readonly("peak_rss_bytes", &PipelineResult::peak_rss_bytes)
       .def(

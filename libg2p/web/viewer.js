@@ -100,6 +100,57 @@ function partDetails(p) {
   return box;
 }
 
+// Corrections (docs/pipeline.md#overrides): a form for the pinned part, the
+// list of corrections so far, and a button that downloads them as the
+// overrides file `g2p run/refine/properties/export --overrides` apply.
+function correctionForm(p, index, classes, onAdd) {
+  const form = text('div', undefined, 'g2p-fix');
+  form.append(text('b', 'Correct this part'));
+  const field = (label, input) => {
+    const l = document.createElement('label');
+    l.append(label + ' ', input);
+    form.append(l);
+    return input;
+  };
+  const cls = document.createElement('select');
+  cls.name = 'g2p-fix-class';
+  for (const c of classes) {
+    const o = new Option(c.name, c.name, false, c.name === p.material);
+    cls.append(o);
+  }
+  field('class', cls);
+  const structure = document.createElement('select');
+  structure.name = 'g2p-fix-structure';
+  for (const [v, t] of [['', 'as estimated'], ['solid', 'solid'], ['hollow', 'hollow']]) structure.append(new Option(t, v));
+  field('structure', structure);
+  const wall = document.createElement('input');
+  Object.assign(wall, { type: 'number', name: 'g2p-fix-wall-mm', min: '0', step: 'any', placeholder: 'as estimated' });
+  field('wall (mm)', wall);
+  const density = document.createElement('input');
+  Object.assign(density, { type: 'number', name: 'g2p-fix-density', min: '0', step: 'any', placeholder: 'as estimated' });
+  field('density (kg/m\u00b3)', density);
+  const error = text('div', '', 'warn');
+  const add = text('button', 'Add correction', 'g2p-fix-add');
+  add.type = 'button';
+  add.addEventListener('click', () => {
+    const entry = { part: p.part, was: { class: p.material, faces: p.faces } };
+    if (cls.value !== p.material) entry.class = cls.value;
+    if (structure.value) entry.structure = structure.value;
+    const mm = wall.value === '' ? null : Number(wall.value);
+    const rho = density.value === '' ? null : Number(density.value);
+    if (mm !== null && !(mm > 0 && mm <= 10000)) { error.textContent = 'the wall must be more than 0 mm'; return; }
+    if (mm !== null && structure.value === 'solid') { error.textContent = 'a solid part has no wall'; return; }
+    if (rho !== null && !(rho > 0 && rho <= 30000)) { error.textContent = 'the density must be between 0 and 30000 kg/m\u00b3'; return; }
+    if (mm !== null) entry.wall_thickness_m = mm / 1000;
+    if (rho !== null) entry.density_kg_m3 = rho;
+    if (Object.keys(entry).length === 2) { error.textContent = 'nothing changed'; return; }
+    error.textContent = '';
+    onAdd(index, entry);
+  });
+  form.append(add, error);
+  return form;
+}
+
 function start(section, model) {
   const box = section.querySelector('.g2p-canvas');
   const side = section.querySelector('.g2p-side');
@@ -212,10 +263,66 @@ function start(section, model) {
 
   const info = side.querySelector('.g2p-info');
   const list = side.querySelector('.g2p-parts');
+  const fixesBox = side.querySelector('.g2p-fixes');
+  const fixes = [];  // overrides entries, in the order they were made
   let pinned = -1;
   let hovered = -1;
+  function overridesFile() {
+    return {
+      format: 'g2p-overrides', version: 1, model: model.model || undefined, faces_total: model.triangles,
+      overrides: fixes,
+    };
+  }
+  function showFixes() {
+    fixesBox.replaceChildren();
+    if (!fixes.length) return;
+    fixesBox.append(text('b', `Corrections (${fixes.length})`));
+    const ol = document.createElement('ol');
+    for (const f of fixes) {
+      const what = ['class', 'structure', 'wall_thickness_m', 'density_kg_m3'].filter((k) => k in f)
+        .map((k) => (k === 'wall_thickness_m' ? `wall ${fmt(f[k] * 1e3, 3)} mm` : k === 'density_kg_m3'
+          ? `${fmt(f[k])} kg/m\u00b3` : f[k]));
+      ol.append(text('li', `${parts[f.part].data.name} (${f.was.class}): ${what.join(', ')}`));
+    }
+    const download = text('button', 'Download overrides.json', 'g2p-fix-download');
+    download.type = 'button';
+    download.addEventListener('click', () => {
+      const blob = new Blob([JSON.stringify(overridesFile(), null, 1) + '\n'], { type: 'application/json' });
+      const a = document.createElement('a');
+      a.href = URL.createObjectURL(blob);
+      a.download = 'overrides.json';
+      document.body.append(a);
+      a.click();
+      a.remove();
+      setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+    });
+    const clear = text('button', 'Clear', 'g2p-fix-clear');
+    clear.type = 'button';
+    clear.addEventListener('click', () => {
+      fixes.length = 0;
+      parts.forEach((p, k) => {
+        p.classMaterial.color.set(p.data.color);
+        list.children[k].querySelector('.sw').style.background = p.data.color;
+      });
+      showFixes();
+      requestRender();
+    });
+    fixesBox.append(ol, download, ' ', clear,
+      text('p', 'Apply them with g2p export THIS_FOLDER --overrides overrides.json -o NEW_FOLDER (or g2p run ' +
+        'MODEL --overrides overrides.json -o NEW_FOLDER); the stages after the change run again.', 'note'));
+  }
+  function addFix(i, entry) {
+    for (let k = fixes.length - 1; k >= 0; --k) if (fixes[k].part === entry.part) fixes.splice(k, 1);  // the latest stands
+    fixes.push(entry);
+    const c = entry.class && model.classes.find((x) => x.name === entry.class);
+    parts[i].classMaterial.color.set(c ? c.color : parts[i].data.color);
+    list.children[i].querySelector('.sw').style.background = c ? c.color : parts[i].data.color;
+    showFixes();
+    requestRender();
+  }
   function show(i) {
     info.replaceChildren(i >= 0 ? partDetails(parts[i].data) : text('span', 'Hover over or click a part for its details.'));
+    if (i >= 0 && i === pinned && model.classes) info.append(correctionForm(parts[i].data, i, model.classes, addFix));
     parts.forEach((p, k) => {
       p.classMaterial.emissive.setHex(k === i ? 0x404040 : 0);
       if (p.lookMaterial) p.lookMaterial.emissive.setHex(k === i ? 0x404040 : 0);
@@ -271,7 +378,7 @@ function start(section, model) {
   resize();
   section.dataset.state = 'ready';
   // For scripts and tests: redraw now, the WebGL context.
-  window.g2pViewer = { parts: parts.length, render, gl: () => renderer.getContext() };
+  window.g2pViewer = { parts: parts.length, render, gl: () => renderer.getContext(), overrides: overridesFile };
 }
 
 function main() {

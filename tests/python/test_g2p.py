@@ -575,5 +575,49 @@ class DecomposeTest(unittest.TestCase):
             g2p.Pipeline(quick_options(decomposer=g2p.BackendChoice("no-such-decomposer"))).run_file(HAMMER)
 
 
+class OverridesTest(unittest.TestCase):
+    """Corrections from a file (docs/pipeline.md#overrides) on a run."""
+
+    FIX = {
+        "format": "g2p-overrides",
+        "version": 1,
+        "overrides": [
+            {"part": 0, "was": {"class": "Wood"}, "class": "Plastic"},
+            {"part": 1, "structure": "hollow", "wall_thickness_m": 0.004, "density_kg_m3": 7000},
+        ],
+    }
+
+    def test_a_run_applies_them(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "fix.json")
+            with open(path, "w") as f:
+                json.dump(self.FIX, f)
+            overrides = g2p.read_overrides(path)
+        self.assertEqual(len(overrides), 2)
+        self.assertTrue(overrides.changes_classes and overrides.changes_properties)
+        plain = g2p.Pipeline(quick_options()).run_file(HAMMER)
+        fixed = g2p.Pipeline(quick_options(overrides=overrides)).run_file(HAMMER)
+        self.assertEqual([p["class"] for p in fixed.parts], ["Plastic", "Metal"])
+        head = fixed.properties[1]
+        self.assertEqual(head["structure"], "hollow")
+        self.assertAlmostEqual(head["wall_thickness_m"], 0.004)
+        self.assertAlmostEqual(head["density_kg_m3"], 7000.0)
+        self.assertEqual(len(fixed.overrides_applied), 2)
+        self.assertLess(fixed.mass_kg, 0.8 * plain.mass_kg)
+        # The text round-trips.
+        again = g2p.parse_overrides(overrides.to_json())
+        self.assertEqual(again.to_json(), overrides.to_json())
+
+    def test_a_bad_entry_is_named(self):
+        bad = dict(self.FIX, overrides=[{"part": 0, "density_kg_m3": -1}])
+        with self.assertRaises(g2p.InvalidArgumentError) as caught:
+            g2p.parse_overrides(json.dumps(bad), origin="fix.json")
+        self.assertIn("fix.json: overrides entry 1: 'density_kg_m3'", str(caught.exception))
+        wrong_run = dict(self.FIX, overrides=[{"part": 0, "was": {"class": "Glass"}, "class": "Metal"}])
+        with self.assertRaises(g2p.InvalidArgumentError) as caught:
+            g2p.Pipeline(quick_options(overrides=g2p.parse_overrides(json.dumps(wrong_run)))).run_file(HAMMER)
+        self.assertIn("another model or run", str(caught.exception))
+
+
 if __name__ == "__main__":
     unittest.main()

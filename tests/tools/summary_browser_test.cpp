@@ -52,6 +52,39 @@ TEST(SummaryBrowser, The3DViewDrawsTheHammerAndEveryControlChangesThePicture) {
   EXPECT_TRUE(fs::exists(shot));
 }
 
+// The correction round trip: a person picks the hammer's handle in the page,
+// makes it plastic of 1100 kg/m^3 and downloads the overrides; `g2p export`
+// applies them to the run's folder, and report.json says so.
+TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
+  const std::string& page = hammer_page();
+  if (!has_viewer(page))
+    GTEST_SKIP() << "libg2p was built without the 3D view (three.js missing: scripts/install-deps.sh)";
+  const std::string run = fs::path(page).parent_path().string();
+  const std::string dir = test::scratch_dir("SummaryBrowserCorrection");
+  const nlohmann::json before = nlohmann::json::parse(test::read_file(run + "/run.json"));
+  ASSERT_EQ(before["parts"][0]["material"], "Wood");
+  const test::ValidatorRun v =
+      test::run_summary_browser(page, "--correct 0:Plastic:1100 --download " + test::quote(dir + "/overrides.json"));
+  SKIP_WITHOUT_BROWSER(v);
+  ASSERT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
+  const nlohmann::json fix = nlohmann::json::parse(test::read_file(dir + "/overrides.json"));
+  EXPECT_EQ(fix["format"], "g2p-overrides");
+  ASSERT_EQ(fix["overrides"].size(), 1u) << fix.dump();
+  EXPECT_EQ(fix["overrides"][0]["part"], 0);
+  EXPECT_EQ(fix["overrides"][0]["was"]["class"], "Wood");
+  const test::ToolRun r = test::run_tool("export " + test::quote(run) + " --overrides " +
+                                         test::quote(dir + "/overrides.json") + " -o " + test::quote(dir + "/fixed"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(dir + "/fixed/report.json"));
+  const nlohmann::json* handle = nullptr;
+  for (const nlohmann::json& p : report["parts"])
+    if (p["material"] == "Plastic") handle = &p;
+  ASSERT_NE(handle, nullptr) << report.dump(1);
+  EXPECT_DOUBLE_EQ((*handle)["density_kg_m3"].get<double>(), 1100.0);
+  EXPECT_EQ((*handle)["sources"]["density"], "user");
+  EXPECT_EQ(report["parts"].size(), before["parts"].size());
+}
+
 // The check itself: a view that shows nothing must fail it.
 TEST(SummaryBrowser, ABlankViewFailsTheCheck) {
   const std::string& page = hammer_page();

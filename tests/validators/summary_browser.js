@@ -10,6 +10,13 @@
 // --screenshot saves the whole page at the end; --screenshot-top the first
 // 1280 x 900 pixels while the mouse rests on a part (the picture in README.md).
 //
+// --correct PART:CLASS[:DENSITY] --download OUT.json uses the correction
+// control as a person would: clicks part PART in the list, chooses CLASS (and
+// types DENSITY in kg/m^3), adds the correction, checks that the picture
+// changes (the part takes its new class's colour) and saves the overrides file
+// the page downloads as OUT.json (instead of the toggle checks); with
+// --screenshot-top, the picture is taken once the correction is listed.
+//
 // --draw-only checks only that the view draws, and times it: the seconds from
 // opening the page to a ready view (ready_s) and one frame (frame_ms).
 // --no-webgl starts Chromium without WebGL and checks that the page says so
@@ -20,12 +27,15 @@ const path = require('path');
 const { chromium } = require('playwright-core');
 
 const args = process.argv.slice(2);
-const page_path = args.find((a, i) => !a.startsWith('--') && !/^--screenshot/.test(args[i - 1] || ''));
+const page_path = args.find((a, i) => !a.startsWith('--') &&
+  !/^--(screenshot|correct|download)/.test(args[i - 1] || ''));
 const option = (name) => (args.includes(name) ? args[args.indexOf(name) + 1] : null);
 const shot = option('--screenshot');
 const top_shot = option('--screenshot-top');
 const no_webgl = args.includes('--no-webgl');
 const draw_only = args.includes('--draw-only');
+const correct = option('--correct');
+const download_to = option('--download');
 if (!page_path) {
   console.error('usage: node summary_browser.js PAGE.html [--screenshot OUT.png] [--screenshot-top OUT.png] [--no-webgl | --draw-only]');
   process.exit(2);
@@ -95,7 +105,7 @@ async function main() {
   });
   const result = { page: page_path, checks: [] };
   try {
-    const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+    const page = await browser.newPage({ viewport: { width: 1280, height: 900 }, acceptDownloads: true });
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
     page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
@@ -178,6 +188,36 @@ async function main() {
         await frames(page);
         result.checks.push(`${what} changes the picture (${(100 * after.changed).toFixed(1)} % of the pixels)`);
         return after;
+      }
+      if (correct) {
+        const [part, cls, density] = correct.split(':');
+        const item = section.locator('.g2p-parts li').nth(Number(part));
+        check(await item.count() === 1, `the parts list has no part ${part}`);
+        await item.locator('span').last().click();  // pins the part: its correction form appears
+        const form = section.locator('.g2p-fix');
+        check(await form.count() === 1, 'clicking a part shows no correction form (.g2p-fix)');
+        await form.locator('select[name=g2p-fix-class]').selectOption(cls);
+        if (density) await form.locator('input[name=g2p-fix-density]').fill(density);
+        await form.locator('button.g2p-fix-add').click();
+        await page.mouse.move(box.x + 2, box.y + 2);
+        await frames(page);
+        const recoloured = await pixels(decoder, await canvas.screenshot(), 'recoloured', 'base');
+        check(recoloured.changed > 0.002, `the corrected part did not take its new colour (${(100 * recoloured.changed).toFixed(3)} % of the pixels changed)`);
+        result.checks.push(`a correction recolours the part (${(100 * recoloured.changed).toFixed(1)} % of the pixels)`);
+        if (top_shot) await page.screenshot({ path: top_shot });  // the correction control, for the docs
+        const listed = await section.locator('.g2p-fixes li').allInnerTexts();
+        check(listed.length === 1 && listed[0].includes(cls), `the corrections list shows ${JSON.stringify(listed)}`);
+        const [download] = await Promise.all([
+          page.waitForEvent('download', { timeout: 10000 }),
+          section.locator('button.g2p-fix-download').click(),
+        ]).catch(() => { throw new CheckFailed('the download button gave no file'); });
+        check(download.suggestedFilename() === 'overrides.json', `the file is called ${download.suggestedFilename()}`);
+        if (download_to) await download.saveAs(download_to);
+        result.download = download_to;
+        result.checks.push('the correction downloads as overrides.json');
+        result.seconds = (Date.now() - start) / 1000;
+        console.log(JSON.stringify(result));
+        return;
       }
       const hidden = await toggled('input[name=part0]', 'unticking part 0');
       check(hidden.object < base.object, 'unticking part 0 did not take anything away from the picture');

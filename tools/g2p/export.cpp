@@ -38,10 +38,35 @@ int run_export(const ExportArgs& args) {
   }
   // A `g2p properties` folder is used as it is; any other source runs stages 5 and 6 first.
   Result<PropertiesOutput> previous = Status::NotFound("");
+  // With --overrides, the stages after the change run again: complete and
+  // properties when a class changes, properties alone otherwise.
   if (is_properties_folder(args.source.source)) {
     previous = load_properties_output("export", args.source.source, exit_code);
     if (!previous.ok()) return exit_code;
-    std::cout << "using the closed parts and properties of " << args.source.source << "\n";
+    LabelledObject& object = previous->object;
+    if (!args.source.overrides.empty()) {
+      if (!apply_overrides_file("export", args.source.overrides, object.model.mesh, object.table, object.faces,
+                                object.overrides, exit_code)
+               .ok())
+        return exit_code;
+      finish_overrides(object.model.mesh.num_faces(), object.faces.parts, object.faces.labels, object.table,
+                       object.overrides);
+      for (const std::string& n : object.overrides.notes) std::cout << "correction: " << n << "\n";
+      if (object.overrides.changed_classes) {
+        std::cout << "classes changed: closing the parts again\n";
+        Result<Completion> done = run_completion("export", args.completer, object, exit_code);
+        if (!done.ok()) return exit_code;
+        previous->completion = std::move(*done);
+      } else {
+        std::cout << "using the closed parts of " << args.source.source << "; estimating the properties again\n";
+      }
+      Result<PropertiesReport> report =
+          run_estimation("export", args.estimator, object, previous->completion, exit_code);
+      if (!report.ok()) return exit_code;
+      previous->report = std::move(*report);
+    } else {
+      std::cout << "using the closed parts and properties of " << args.source.source << "\n";
+    }
   } else {
     Result<LabelledObject> loaded = load_labelled_source("export", source, exit_code);
     if (!loaded.ok()) return exit_code;
@@ -99,6 +124,7 @@ int run_export(const ExportArgs& args) {
   Status s = write_asset(args.out, *asset, engine_formats, options);
   if (s.ok() && glb) s = write_glb(args.out + "/" + asset->name + ".glb", object->model, object->faces.parts, *asset);
   if (s.ok()) s = write_asset_report(args.out + "/report.json", *report, *asset, object->table);
+  if (s.ok()) s = write_overrides(args.out, object->overrides, object->table);
   if (!s.ok()) {
     std::cerr << "g2p export: error: " << s.to_string() << "\n";
     return kExitFailure;

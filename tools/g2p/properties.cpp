@@ -64,6 +64,7 @@ int run_properties(const PropertiesArgs& args) {
   Status s = write_completion(out + "/completed", *done, object->table);
   if (s.ok()) s = write_report(out + "/report.json", *report, object->table);
   if (s.ok()) s = write_properties_manifest(out, args.source);
+  if (s.ok()) s = write_overrides(out, object->overrides, object->table);
   if (!s.ok()) {
     std::cerr << "g2p properties: error: " << s.to_string() << "\n";
     return kExitFailure;

@@ -15,12 +15,13 @@
 #include "commands.h"
 #include "common.h"
 #include "stage_outputs.h"
+#include "stage_overrides.h"
 
 namespace g2p::cli {
 namespace {
 
 struct RefineCommandArgs {
-  std::string dir, out;
+  std::string dir, out, overrides;
   RefineArgs refine;
 };
 
@@ -117,6 +118,15 @@ int run_refine(const RefineCommandArgs& args) {
           refine_projection("refine", args.refine, *model, views, *table, options.partition, *projection, report);
       code != kExitOk)
     return code;
+  // Corrections: the folder's own (a run made with --overrides), then --overrides.
+  AppliedOverrides corrections;
+  for (const std::string& f :
+       {std::string(std::filesystem::exists(args.dir + "/overrides.json") ? args.dir + "/overrides.json" : ""),
+        args.overrides})
+    if (!f.empty() && !apply_overrides_file("refine", f, model->mesh, *table, *projection, corrections, exit_code).ok())
+      return exit_code;
+  if (!corrections.empty()) report["overrides"] = corrections.notes;
+  for (const std::string& n : corrections.notes) std::cout << "correction: " << n << "\n";
   const std::string out = args.out.empty() ? args.dir + "/refined" : args.out;
   Status s = write_projection(out, *model, views, *projection, *table, report);
   // The manifest travels along, so later stages can start from this folder.
@@ -124,6 +134,7 @@ int run_refine(const RefineCommandArgs& args) {
   refined_manifest["refined_from"] = std::filesystem::absolute(args.dir).string();
   refined_manifest["refiner"] = args.refine.name;
   if (s.ok()) s = write_text_file(out + "/project.json", refined_manifest.dump(2) + "\n");
+  if (s.ok()) s = write_overrides(out, corrections, *table);
   if (!s.ok()) return fail(s);
   std::cout << "refined with '" << args.refine.name << "': " << projection->parts.size() << " parts -> " << out << "\n";
   print_parts(*projection, *table);
@@ -138,6 +149,7 @@ void add_refine_command(CLI::App& app, Command& run) {
   cmd->add_option("dir", args->dir, "Output folder of g2p project or g2p run")->required();
   cmd->add_option("-o,--output", args->out, "Where to write the refined results (default DIR/refined)");
   add_refiner_flags(cmd, args->refine, "smooth");
+  add_overrides_flag(cmd, args->overrides);
   cmd->callback([args, &run] { run = [args] { return run_refine(*args); }; });
 }
 

@@ -22,7 +22,7 @@ namespace g2p::cli {
 namespace {
 
 struct RunArgs {
-  std::string model, out, materials, name;
+  std::string model, out, materials, name, overrides;
   ImportArgs import;
   ViewArgs views;
   SegmenterArgs segmenter;
@@ -142,6 +142,12 @@ int run_pipeline(const RunArgs& args) {
     if (!table.ok()) return usage(table.status().to_string());
     pipeline.set_material_table(std::move(*table));
   }
+  if (!args.overrides.empty()) {
+    const MaterialTable& table = pipeline.material_table();
+    Result<Overrides> overrides = read_overrides(args.overrides, table);
+    if (!overrides.ok()) return usage("--overrides " + overrides.status().message() + "; nothing was written");
+    pipeline.options().overrides = std::move(*overrides);
+  }
   if (Status s = pipeline.prepare(); !s.ok()) {
     if (s.code() == StatusCode::kInvalidArgument || s.code() == StatusCode::kNotFound) return usage(s.message());
     std::cerr << "g2p run: error: " << s.to_string() << "\n";
@@ -178,6 +184,7 @@ int run_pipeline(const RunArgs& args) {
   }
   const PipelineResult& r = *result;
   for (const std::string& w : r.warnings) std::cerr << "g2p run: warning: " << w << "\n";
+  for (const std::string& c : r.overrides_applied) std::cerr << "g2p run: correction: " << c << "\n";
   if (args.json) {
     std::cout << pipeline_summary_json(r, o) << "\n";
     return kExitOk;
@@ -201,6 +208,9 @@ void add_run_command(CLI::App& app, Command& run) {
   cmd->add_option("model", args->model, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, ...)")->required();
   cmd->add_option("-o,--output", args->out, "Output folder (must not exist unless --overwrite)")->required();
   cmd->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
+  cmd->add_option("--overrides", args->overrides,
+                  "Corrections to apply (JSON from summary.html's 3D view, docs/pipeline.md#overrides): classes, "
+                  "solid/hollow, wall thickness, density per part or face");
   cmd->add_option("--name", args->name, "Asset name (default: the model file's stem)");
   cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
       ->delimiter(',')

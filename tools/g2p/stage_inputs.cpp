@@ -36,10 +36,32 @@ void add_labelled_source_flags(CLI::App* cmd, LabelledSourceArgs& args) {
   cmd->add_option("--key", args.key, "Entry of --truth to use (default: the model file's stem)");
   cmd->add_option("--materials", args.materials,
                   "Material table JSON (default: the folder's, else the paper's 12 classes)");
+  add_overrides_flag(cmd, args.overrides);
 }
+
+namespace {
+Result<LabelledObject> load_labels(const std::string& command, const LabelledSourceArgs& args, int& exit_code);
+}  // namespace
 
 Result<LabelledObject> load_labelled_source(const std::string& command, const LabelledSourceArgs& args,
                                             int& exit_code) {
+  Result<LabelledObject> out = load_labels(command, args, exit_code);
+  if (!out.ok()) return out;
+  std::vector<std::string> files;
+  if (std::filesystem::is_directory(args.source) && std::filesystem::exists(args.source + "/overrides.json"))
+    files.push_back(args.source + "/overrides.json");
+  if (!args.overrides.empty()) files.push_back(args.overrides);
+  for (const std::string& f : files)
+    G2P_RETURN_IF_ERROR(
+        apply_overrides_file(command, f, out->model.mesh, out->table, out->faces, out->overrides, exit_code));
+  finish_overrides(out->model.mesh.num_faces(), out->faces.parts, out->faces.labels, out->table, out->overrides);
+  for (const std::string& n : out->overrides.notes) std::cout << "correction: " << n << "\n";
+  return out;
+}
+
+namespace {
+
+Result<LabelledObject> load_labels(const std::string& command, const LabelledSourceArgs& args, int& exit_code) {
   auto fail = [&](const Status& s, int code) -> Status {
     std::cerr << "g2p " << command << ": error: " << s.to_string() << "\n";
     exit_code = code;
@@ -119,6 +141,8 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
   return out;
 }
 
+}  // namespace
+
 Status write_properties_manifest(const std::string& out, const LabelledSourceArgs& source) {
   namespace fs = std::filesystem;
   const nlohmann::json j = {{"format", "g2p-properties"},
@@ -158,6 +182,10 @@ Result<PropertiesOutput> load_properties_output(const std::string& command, cons
   source.key = manifest->value("key", "");
   source.materials = manifest->value("materials", "");
   source.textures = true;
+  // The corrections this folder was made with (the source folder's own apply first).
+  std::error_code same_error;
+  if (std::filesystem::exists(dir + "/overrides.json") && !std::filesystem::equivalent(source.source, dir, same_error))
+    source.overrides = dir + "/overrides.json";
   PropertiesOutput out;
   Result<LabelledObject> object = load_labelled_source(command, source, exit_code);
   if (!object.ok()) return object.status();
@@ -270,8 +298,12 @@ Result<PropertiesReport> run_estimation(const std::string& command, const Estima
     if (!rendered.ok()) return rendered.status();
     views = std::move(*rendered);
   }
-  Result<PropertiesReport> report = estimate_properties(object.model.mesh, object.faces.parts, completion, object.table,
-                                                        **estimator, views.empty() ? nullptr : &views);
+  std::unique_ptr<PropertyEstimator> overriding;
+  if (object.overrides.resolved && object.overrides.changes_properties())
+    overriding = make_overriding_estimator(**estimator, *object.overrides.resolved);
+  Result<PropertiesReport> report =
+      estimate_properties(object.model.mesh, object.faces.parts, completion, object.table,
+                          overriding ? *overriding : **estimator, views.empty() ? nullptr : &views);
   if (!report.ok()) {
     std::cerr << "g2p " << command << ": error: " << report.status().to_string() << "\n";
     exit_code = kExitFailure;

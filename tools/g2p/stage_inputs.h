@@ -13,6 +13,7 @@
 #include "g2p/model.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
+#include "stage_overrides.h"
 
 namespace g2p::cli {
 
@@ -23,6 +24,7 @@ struct LabelledSourceArgs {
   std::string key;     // entry in labels.json (default: the file's stem)
   std::string materials;
   bool textures = false;  // decode textures (for outputs that show the model's appearance)
+  std::string overrides;  // --overrides FILE, applied after the folder's own overrides.json
 };
 void add_labelled_source_flags(CLI::App* cmd, LabelledSourceArgs& args);
 
@@ -30,10 +32,12 @@ struct LabelledObject {
   Model model;
   MaterialTable table;
   FacesFile faces;
-  std::string origin;  // "folder DIR" or "ground truth KEY of FILE"
+  std::string origin;          // "folder DIR" or "ground truth KEY of FILE"
+  AppliedOverrides overrides;  // the folder's overrides.json and --overrides, applied to `faces`
 };
 
-// Loads the object; on failure prints the error and sets exit_code.
+// Loads the object and applies its corrections (the folder's overrides.json,
+// then --overrides); on failure prints the error and sets exit_code.
 Result<LabelledObject> load_labelled_source(const std::string& command, const LabelledSourceArgs& args, int& exit_code);
 
 // --completer, --complete-set and --fallback.
@@ -65,7 +69,8 @@ struct EstimatorArgs {
 };
 void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args);
 
-// Stage 6 on a completed object; on failure prints the error and sets exit_code.
+// Stage 6 on a completed object, with the object's corrections; on failure
+// prints the error and sets exit_code.
 Result<PropertiesReport> run_estimation(const std::string& command, const EstimatorArgs& args,
                                         const LabelledObject& object, const Completion& completion, int& exit_code);
 

@@ -24,6 +24,7 @@
 #include "g2p/io.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
+#include "g2p/overrides.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/refine.h"
@@ -108,6 +109,13 @@ struct PipelineOptions {
   // 6. properties: "table" (default) or "vlm" (falls back to the table per part).
   BackendChoice estimator{"table", {}};
 
+  // Corrections a person made (summary.html, docs/pipeline.md#overrides):
+  // classes change after refine, before complete; structure, wall thickness
+  // and density replace the estimator's. Part indices refer to the parts a
+  // run with the same options makes, so a page's file applies to a rerun of
+  // its model. Empty: none.
+  Overrides overrides;
+
   // 7. decompose: each part's collision geometry, convex hulls sized for
   //    engines: "voxel-cut" (default), "hull" (one per part), or a user's.
   BackendChoice decomposer{"voxel-cut", {}};
@@ -164,10 +172,12 @@ struct G2P_API PipelineResult {
   PropertiesReport properties;
   std::vector<ConvexDecomposition> collision;  // per part (same order as completion.parts)
   SimulationAsset asset;
-  std::vector<StageReport> stages;    // in run order
-  std::vector<std::string> warnings;  // degraded optional stages, in words
-  double seconds = 0.0;               // whole run
-  std::size_t peak_rss_bytes = 0;     // largest stage peak
+  std::vector<StageReport> stages;             // in run order
+  std::vector<std::string> warnings;           // degraded optional stages, in words
+  std::vector<std::string> overrides_applied;  // what PipelineOptions::overrides changed, one line per entry
+  Overrides overrides;             // the overrides applied, as face selections (as_face_selections; overrides.json)
+  double seconds = 0.0;            // whole run
+  std::size_t peak_rss_bytes = 0;  // largest stage peak
 
   const StageReport* stage(Stage s) const;  // null if it did not run
 };
@@ -199,6 +209,7 @@ class G2P_API Pipeline {
   void set_estimator(std::shared_ptr<PropertyEstimator> estimator);
   void set_decomposer(std::shared_ptr<Decomposer> decomposer);
   void set_material_table(MaterialTable table);  // default: MaterialTable::paper_default()
+  const MaterialTable& material_table() const;   // the one runs use (overrides name its classes)
 
   // Creates and configures every named backend now: unknown names or settings
   // fail here, before any work. run() calls it; calling it first is optional.
@@ -227,7 +238,8 @@ struct OutputOptions {
 // segmented/ and projected/ (label maps, contact sheets), faces.csv,
 // labelled.ply, parts.json, refine.json, completed/ (closed parts), the
 // simulation asset (NAME.xml, NAME.urdf, NAME.sdf, NAME.glb, meshes/),
-// report.json, run.json and summary.html; project.json and properties.json
+// report.json, run.json and summary.html (and overrides.json when the run
+// applied overrides); project.json and properties.json
 // make the folder a valid source for `g2p refine/complete/export`. Everything
 // is written to a temporary folder beside `dir` and renamed into place at the
 // end: `dir` never holds a half-written run, and an existing `dir` is only

@@ -130,6 +130,9 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
   G2P_RETURN_IF_ERROR(write_asset_report(tmp + "/report.json", r.properties, r.asset, r.table));
   if (!r.model.info.path.empty()) G2P_RETURN_IF_ERROR(write_manifests(tmp, final_dir, r, o));
   if (out.intermediates) G2P_RETURN_IF_ERROR(write_intermediates(tmp + "/intermediates", r));
+  // The corrections as face selections: the stages that start from this folder apply them.
+  if (!r.overrides.empty())
+    G2P_RETURN_IF_ERROR(write_text_file(tmp + "/overrides.json", overrides_json(r.overrides, r.table)));
   G2P_RETURN_IF_ERROR(write_text_file(tmp + "/run.json", pipeline_summary_json(r, o) + "\n"));
   return write_text_file(tmp + "/summary.html", summary_html(r, o));
 }
@@ -267,6 +270,7 @@ std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions
                               {"mass_max_kg", r.properties.mass_max_kg},
                               {"center_of_mass_m", vec3(m.center_of_mass)}}},
                             {"assets", files},
+                            {"overrides", r.overrides_applied},
                             {"warnings", r.warnings}};
   return j.dump(2);
 }

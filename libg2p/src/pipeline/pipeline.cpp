@@ -118,6 +118,7 @@ void Pipeline::set_completer(std::shared_ptr<Completer> c) { impl_->completer.cu
 void Pipeline::set_estimator(std::shared_ptr<PropertyEstimator> e) { impl_->estimator.custom = std::move(e); }
 void Pipeline::set_decomposer(std::shared_ptr<Decomposer> d) { impl_->decomposer.custom = std::move(d); }
 void Pipeline::set_material_table(MaterialTable table) { impl_->table = std::move(table); }
+const MaterialTable& Pipeline::material_table() const { return impl_->table; }
 
 Status Pipeline::prepare() {
   Impl& m = *impl_;
@@ -255,6 +256,20 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     finish(clock);
   }
 
+  // A person's corrections: classes first (the parts re-form), properties in
+  // the estimator below.
+  std::unique_ptr<ResolvedOverrides> resolved;
+  if (!o.overrides.empty()) {
+    Result<ResolvedOverrides> res =
+        resolve_overrides(o.overrides, mesh.num_faces(), r.projection.parts, r.projection.labels.label, r.table);
+    if (!res.ok()) return res.status();
+    resolved = std::make_unique<ResolvedOverrides>(std::move(*res));
+    Result<std::vector<std::string>> applied = apply_class_overrides(*resolved, mesh, r.projection, r.table);
+    if (!applied.ok()) return applied.status();
+    r.overrides_applied = std::move(*applied);
+    r.overrides = as_face_selections(*resolved);
+  }
+
   if (o.last_stage == Stage::kRefine) return Status::Ok();
 
   // 5. complete: every part closed into a watertight volume.
@@ -279,11 +294,19 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   // 6. properties: density, solid or hollow, mass properties.
   {
     detail::StageClock clock(Stage::kProperties, estimator.backend(o.estimator), reset);
-    Result<PropertiesReport> report =
-        estimate_properties(mesh, r.projection.parts, r.completion, r.table, *estimator.get(), &r.views);
+    std::unique_ptr<PropertyEstimator> overriding;
+    if (resolved && o.overrides.changes_properties())
+      overriding = make_overriding_estimator(*estimator.get(), *resolved);
+    Result<PropertiesReport> report = estimate_properties(mesh, r.projection.parts, r.completion, r.table,
+                                                          overriding ? *overriding : *estimator.get(), &r.views);
     if (!report.ok()) return report.status().with_context("properties");
     r.properties = std::move(*report);
     r.properties.size = object_size(r.model);
+    if (resolved)
+      for (const PartReport& p : r.properties.parts)
+        for (const std::string& n : p.properties.notes)
+          if (n.rfind("overrides entry", 0) == 0)
+            r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n);
     clock.report().notes = r.properties.notes;
     // The vlm estimator never fails a part: it falls back to the table, which
     // is a degraded optional stage the caller should hear about.

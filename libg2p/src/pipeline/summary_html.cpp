@@ -57,6 +57,8 @@ const char* kStyle =
     ".warn{color:#a40000}.note{color:#555;font-size:.9em}"
     ".banner{border:2px solid #c0392b;background:#fdecea;padding:.5em 1em;margin:1em 0}"
     ".banner h2{margin:.2em 0;font-size:1.1em;color:#a40000}.banner ul{margin:.3em 0;padding-left:1.2em}"
+    ".corrections{border:2px solid #1f5fbf;background:#eaf1fb;padding:.5em 1em;margin:1em 0}"
+    ".corrections h2{margin:.2em 0;font-size:1.1em;color:#1f3f8f}"
     ".legend{display:flex;flex-wrap:wrap;gap:.2em 1.1em;font-size:.9em;margin:.3em 0 1em}.legend .absent{color:#999}"
     ".views{display:grid;grid-template-columns:repeat(auto-fill,minmax(380px,1fr));gap:12px}"
     ".views figure{margin:0;border:1px solid #ddd;padding:4px}.views figcaption{font-size:.85em;color:#444}"
@@ -68,7 +70,10 @@ const char* kStyle =
     ".g2p-side{width:300px;font-size:.9em}.g2p-toggles label{display:block}"
     ".g2p-parts{list-style:none;padding:0;max-height:220px;overflow:auto;border-top:1px solid #ddd;"
     "border-bottom:1px solid #ddd}.g2p-parts li{padding:1px 2px}.g2p-parts li span:last-child{cursor:pointer}"
-    ".g2p-parts li.sel{background:#e8eefc}.g2p-info table{margin:.3em 0}.g2p-info th{text-align:left}";
+    ".g2p-parts li.sel{background:#e8eefc}.g2p-info table{margin:.3em 0}.g2p-info th{text-align:left}"
+    ".g2p-fix{border:1px solid #bcd;background:#f4f8fd;padding:.3em .5em;margin:.4em 0}.g2p-fix label{display:block;"
+    "margin:.15em 0}.g2p-fix input{width:6em}.g2p-fixes ol{padding-left:1.4em;margin:.3em 0}"
+    ".g2p-fixes code{font-size:.85em;word-break:break-all}";
 
 // Where the object lies in a view: a square around the pixels that show it
 // (from the face-ID buffer), in pixels, so the page can show it large.
@@ -256,6 +261,11 @@ std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
     << number(r.properties.size.extent_m.z()) << " m (height last; scale from " << escape(size_source(r.model.info))
     << "). Run time " << number(r.seconds, "%.2f") << " s.</p>\n";
   warnings_banner(h, r);
+  if (!r.overrides_applied.empty()) {
+    h << "<div class=\"corrections\" id=\"g2p-corrections\"><h2>Corrections applied</h2><ul>\n";
+    for (const std::string& c : r.overrides_applied) h << "<li>" << escape(c) << "</li>\n";
+    h << "</ul></div>\n";
+  }
   h << viewer.section;
   parts_table(h, r);
   views_section(h, r);

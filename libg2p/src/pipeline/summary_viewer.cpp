@@ -1,6 +1,7 @@
 #include "pipeline/summary_viewer.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -94,8 +95,17 @@ nlohmann::json viewer_json(const PipelineResult& r, std::size_t max_triangles, s
     parts.push_back(std::move(j));
   }
   const Eigen::Vector3d& com = r.properties.object.center_of_mass;
+  // For the correction control: the classes a part may take, and what the
+  // overrides file it writes must name (docs/pipeline.md#overrides).
+  nlohmann::json classes = nlohmann::json::array();
+  for (int c = 0; c < r.table.size(); ++c)
+    classes.push_back({{"name", r.table[c].name}, {"color", css_color(r.table[c].color)}});
+  const std::string model =
+      r.model.info.path.empty() ? std::string() : std::filesystem::path(r.model.info.path).filename().string();
   return {{"format", "g2p-summary-view"},
           {"version", 1},
+          {"model", model},
+          {"classes", std::move(classes)},
           {"triangles", total},
           {"triangles_drawn", drawn},
           {"center_of_mass_m", {com.x(), com.y(), com.z()}},
@@ -145,7 +155,8 @@ SummaryViewer summary_viewer(const PipelineResult& r, std::size_t max_triangles)
       "<p class=\"g2p-status note\">The 3D view needs JavaScript and WebGL; the rest of the page is complete "
       "without them.</p>\n"
       "<div class=\"g2p-viewer\" hidden><div class=\"g2p-canvas\"></div><div class=\"g2p-side\">"
-      "<div class=\"g2p-toggles\"></div><ul class=\"g2p-parts\"></ul><div class=\"g2p-info\"></div></div></div>\n"
+      "<div class=\"g2p-toggles\"></div><ul class=\"g2p-parts\"></ul><div class=\"g2p-info\"></div>"
+      "<div class=\"g2p-fixes\"></div></div></div>\n"
       "<p class=\"note\">Drag to turn, scroll to zoom, right-drag to move. Parts in their class's colour; ";
   if (drawn < total)
     v.section += "the surface is simplified to " + with_commas(drawn) + " of its " + with_commas(total) +

@@ -1,0 +1,141 @@
+// --overrides as a user gives it: `g2p run` applies a correction file, the
+// run's folder keeps it, the stage commands rerun only what follows the
+// change, and a bad file changes and writes nothing.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "support/test_data.h"
+#include "support/tool_run.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string hammer() { return test::quote(test::source_path("examples/data/hammer.obj")); }
+
+nlohmann::json json_of(const std::string& path) { return nlohmann::json::parse(test::read_file(path)); }
+
+// The hammer's handle (part 0 of a default run, 92 faces of wood) becomes
+// plastic; its steel head becomes a hollow casting of 7000 kg/m^3.
+const char* kFix = R"({"format": "g2p-overrides", "version": 1, "model": "hammer.obj", "faces_total": 104,
+  "overrides": [{"part": 0, "was": {"class": "Wood", "faces": 92}, "class": "Plastic"},
+                {"part": 1, "was": {"class": "Metal"}, "structure": "hollow", "wall_thickness_m": 0.004,
+                 "density_kg_m3": 7000}]})";
+
+TEST(ToolOverrides, RunAppliesTheCorrectionsAndTheStageCommandsAgree) {
+  const std::string dir = test::scratch_dir("ToolOverrides");
+  test::write_file(dir + "/fix.json", kFix);
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/plain") + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json plain = json_of(dir + "/plain/run.json");
+  ASSERT_EQ(plain["parts"].size(), 2u);
+  ASSERT_EQ(plain["parts"][0]["material"], "Wood");
+
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/fixed") + " -q --overrides " +
+                     test::quote(dir + "/fix.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("correction: entry 1: part 0 (Wood) is now Plastic (92 faces changed class)"), std::string::npos)
+      << r.err;
+  const nlohmann::json fixed = json_of(dir + "/fixed/run.json");
+  ASSERT_EQ(fixed["parts"].size(), 2u);
+  EXPECT_EQ(fixed["parts"][0]["material"], "Plastic");
+  EXPECT_EQ(fixed["parts"][1]["material"], "Metal");
+  EXPECT_EQ(fixed["parts"][1]["structure"], "hollow");
+  EXPECT_DOUBLE_EQ(fixed["parts"][1]["density_kg_m3"].get<double>(), 7000.0);
+  EXPECT_DOUBLE_EQ(fixed["parts"][1]["wall_thickness_m"].get<double>(), 0.004);
+  EXPECT_EQ(fixed["overrides"].size(), 2u);
+  const double mass = fixed["object"]["mass_kg"].get<double>();
+  EXPECT_LT(mass, 0.8 * plain["object"]["mass_kg"].get<double>());  // a hollow head weighs far less
+  // report.json says where the values came from; summary.html lists the corrections.
+  const nlohmann::json report = json_of(dir + "/fixed/report.json");
+  EXPECT_EQ(report["parts"][1]["sources"]["density"], "user") << report["parts"][1].dump();
+  EXPECT_NE(test::read_file(dir + "/fixed/summary.html").find("Corrections applied"), std::string::npos);
+  // The folder keeps them as face selections.
+  const nlohmann::json kept = json_of(dir + "/fixed/overrides.json");
+  EXPECT_EQ(kept["format"], "g2p-overrides");
+  EXPECT_EQ(kept["overrides"][0]["faces"], nlohmann::json::parse("[[0, 91]]"));
+
+  // `g2p export` from the plain run's folder with the same file: complete,
+  // properties and export run again, and agree with the corrected run.
+  r = test::run_tool("export " + test::quote(dir + "/plain") + " --overrides " + test::quote(dir + "/fix.json") +
+                     " -o " + test::quote(dir + "/exported"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NEAR(json_of(dir + "/exported/report.json")["object"]["mass_kg"].get<double>(), mass, 1e-9 * mass);
+  // `g2p export` from the corrected run's folder: its overrides.json applies again.
+  r = test::run_tool("export " + test::quote(dir + "/fixed") + " -o " + test::quote(dir + "/refixed"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NEAR(json_of(dir + "/refixed/report.json")["object"]["mass_kg"].get<double>(), mass, 1e-9 * mass);
+  // `g2p properties`, then `g2p export` from its folder.
+  r = test::run_tool("properties " + test::quote(dir + "/plain") + " --overrides " + test::quote(dir + "/fix.json") +
+                     " -o " + test::quote(dir + "/props"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("7000 kg/m^3 (user)"), std::string::npos) << r.out;
+  r = test::run_tool("export " + test::quote(dir + "/props") + " -o " + test::quote(dir + "/props-exported"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("using the closed parts and properties"), std::string::npos) << r.out;
+  EXPECT_NEAR(json_of(dir + "/props-exported/report.json")["object"]["mass_kg"].get<double>(), mass, 1e-9 * mass);
+  // `g2p refine` applies the classes to the refined labels.
+  r = test::run_tool("refine " + test::quote(dir + "/plain") + " --overrides " + test::quote(dir + "/fix.json") +
+                     " -o " + test::quote(dir + "/refined"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(test::read_file(dir + "/refined/faces.csv").find(",Plastic,"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir + "/refined/overrides.json"));
+}
+
+TEST(ToolOverrides, ADensityChangeReusesTheClosedParts) {
+  const std::string dir = test::scratch_dir("ToolOverridesReuse");
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/run") + " -q --save-intermediates");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double before = json_of(dir + "/run/run.json")["parts"][1]["mass_kg"].get<double>();
+  test::write_file(dir + "/denser.json",
+                   R"({"format": "g2p-overrides", "version": 1, "overrides": [{"part": 1, "density_kg_m3": 15600}]})");
+  r = test::run_tool("export " + test::quote(dir + "/run") + " --overrides " + test::quote(dir + "/denser.json") +
+                     " -o " + test::quote(dir + "/out"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("using the closed parts of"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("completed "), std::string::npos) << r.out;  // no completion ran
+  const nlohmann::json report = json_of(dir + "/out/report.json");
+  // Steel (7800 kg/m^3 by the table) twice as dense: twice the mass.
+  EXPECT_NEAR(report["parts"][1]["mass_kg"].get<double>(), 2.0 * before, 1e-6 * before) << report.dump();
+}
+
+TEST(ToolOverrides, ABadFileIsRejectedNamingTheEntryAndNothingIsWritten) {
+  const std::string dir = test::scratch_dir("ToolOverridesBad");
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/run") + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const struct {
+    std::string entries, expected;
+  } cases[] = {
+      {R"({"part": 5, "class": "Wood"})", "entry 1: part 5 does not exist (the run has 2 parts"},
+      {R"({"part": 0, "class": "Wood"}, {"faces": [[100, 200]], "class": "Glass"})",
+       "entry 2: face 200 does not exist"},
+      {R"({"part": 0, "class": "Mithril"})", "entry 1: unknown class 'Mithril'"},
+      {R"({"part": 1, "density_kg_m3": -7800})", "entry 1: 'density_kg_m3' must be a positive density"},
+      {R"({"part": 0, "was": {"class": "Metal"}, "class": "Wood"})", "another model or run"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const std::string file = dir + "/bad" + std::to_string(i++) + ".json";
+    test::write_file(file, R"({"format": "g2p-overrides", "version": 1, "overrides": [)" + c.entries + "]}");
+    for (const std::string command : {"export", "properties"}) {
+      const std::string out = dir + "/" + command + std::to_string(i);
+      r = test::run_tool(command + " " + test::quote(dir + "/run") + " --overrides " + test::quote(file) + " -o " +
+                         test::quote(out));
+      EXPECT_EQ(r.exit_code, 2) << command << " " << c.entries << "\n" << r.out << r.err;
+      EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+      EXPECT_FALSE(fs::exists(out)) << out;
+    }
+    const std::string out = dir + "/run-again" + std::to_string(i);
+    r = test::run_tool("run " + hammer() + " -q -o " + test::quote(out) + " --overrides " + test::quote(file));
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << out;
+  }
+}
+
+}  // namespace
+}  // namespace g2p

@@ -6,6 +6,7 @@
 //   OUT/obj/, OUT/ply/, OUT/stl/   the first kFacesPerMaterial faces as meshes
 //   OUT/faces_csv/  the Avocado's faces.csv, its ground-truth classes as parts
 //   OUT/labels_json/  labels.json and a cameras.json of the default views
+//   OUT/overrides_json/  an overrides file for the fuzzer's grid (fuzz/corpus has more)
 // scripts/fuzz.sh adds Debian's assimp-testmodels of each format.
 //
 //   g2p_fuzz_seeds SHARED_ASSETS_DIR OUT_DIR
@@ -127,7 +128,7 @@ std::string glb_to_gltf(const std::string& glb) {
 int main(int argc, char** argv) {
   if (argc != 3) return fail("usage: g2p_fuzz_seeds SHARED_ASSETS_DIR OUT_DIR");
   const fs::path assets = argv[1], out = argv[2];
-  for (const char* d : {"glb", "gltf", "obj", "ply", "stl", "faces_csv", "labels_json"})
+  for (const char* d : {"glb", "gltf", "obj", "ply", "stl", "faces_csv", "labels_json", "overrides_json"})
     fs::create_directories(out / d);
   std::ifstream labels_in(assets / "labels.json");
   if (!labels_in) return fail((assets / "labels.json").string() + ": cannot open (is ../shared beside the checkout?)");
@@ -196,6 +197,14 @@ int main(int argc, char** argv) {
     }
   }
   if (g2p::Status s = g2p::write_text_file((out / "labels_json" / "labels.json").string(), labels_text.str()); !s.ok())
+    return fail(s.message());
+  if (g2p::Status s = g2p::write_text_file(
+          (out / "overrides_json" / "grid.json").string(),
+          R"({"format": "g2p-overrides", "version": 1, "faces_total": 32, "overrides": [)"
+          R"({"part": 0, "was": {"class": "Wood", "faces": 16}, "class": "Stone", "density_kg_m3": 2600},)"
+          R"({"faces": [[16, 19]], "structure": "hollow", "wall_thickness_m": 0.003}]})"
+          "\n");
+      !s.ok())
     return fail(s.message());
   std::printf("g2p_fuzz_seeds: %d seeds from %s in %s\n", written + 1, assets.string().c_str(), out.string().c_str());
   return 0;

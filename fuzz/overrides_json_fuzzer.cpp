@@ -3,7 +3,8 @@
 // What parses must write back to the same text, and resolving and applying it
 // on a small labelled grid (4 x 4 squares, two classes, two parts) must leave
 // every face a class of the table, every face in exactly one part, and the
-// estimator's values positive.
+// estimator's values positive; the same corrections as face selections
+// (a folder's overrides.json) must give the same classes and properties.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -92,5 +93,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!faces.ok() || !g2p::apply_class_overrides(*faces, h.mesh, h.graph, h.labels, h.face_part, h.parts, table).ok() ||
       h.labels != g.labels)
     g2p::fuzz::violated("overrides: face selections differ from the overrides");
+  const std::unique_ptr<g2p::PropertyEstimator> e2 = g2p::make_overriding_estimator(base, *faces);
+  for (std::size_t i = 0; i < g.parts.size(); ++i) {
+    g2p::PropertyInput a{&g.mesh, &g.parts[i], nullptr, &table}, b{&h.mesh, &h.parts[i], nullptr, &table};
+    g2p::Result<g2p::PartProperties> pa = e->estimate(a), pb = e2->estimate(b);
+    if (!pa.ok() || !pb.ok() || pa->structure != pb->structure || pa->wall_thickness_m != pb->wall_thickness_m ||
+        pa->density_kg_m3 != pb->density_kg_m3)
+      g2p::fuzz::violated("overrides: face selections give other properties than the overrides");
+  }
   return 0;
 }

@@ -103,7 +103,8 @@ function partDetails(p) {
 // Corrections (docs/pipeline.md#overrides): a form for the pinned part, the
 // list of corrections so far, and a button that downloads them as the
 // overrides file `g2p run/refine/properties/export --overrides` apply.
-function correctionForm(p, index, classes, onAdd) {
+// `existing`: the part's correction so far, which the form starts from and replaces.
+function correctionForm(p, index, classes, existing, onAdd) {
   const form = text('div', undefined, 'g2p-fix');
   form.append(text('b', 'Correct this part'));
   const field = (label, input) => {
@@ -112,33 +113,38 @@ function correctionForm(p, index, classes, onAdd) {
     form.append(l);
     return input;
   };
+  const was = existing || {};
   const cls = document.createElement('select');
   cls.name = 'g2p-fix-class';
+  cls.append(new Option(`${p.material} (as is)`, '', false, !was.class));  // also for a class outside the table
   for (const c of classes) {
-    const o = new Option(c.name, c.name, false, c.name === p.material);
-    cls.append(o);
+    if (c.name !== p.material) cls.append(new Option(c.name, c.name, false, c.name === was.class));
   }
   field('class', cls);
   const structure = document.createElement('select');
   structure.name = 'g2p-fix-structure';
-  for (const [v, t] of [['', 'as estimated'], ['solid', 'solid'], ['hollow', 'hollow']]) structure.append(new Option(t, v));
+  for (const [v, t] of [['', 'as estimated'], ['solid', 'solid'], ['hollow', 'hollow']]) {
+    structure.append(new Option(t, v, false, v === (was.structure || '')));
+  }
   field('structure', structure);
   const wall = document.createElement('input');
   Object.assign(wall, { type: 'number', name: 'g2p-fix-wall-mm', min: '0', step: 'any', placeholder: 'as estimated' });
+  if (was.wall_thickness_m) wall.value = String(was.wall_thickness_m * 1000);
   field('wall (mm)', wall);
   const density = document.createElement('input');
   Object.assign(density, { type: 'number', name: 'g2p-fix-density', min: '0', step: 'any', placeholder: 'as estimated' });
+  if (was.density_kg_m3) density.value = String(was.density_kg_m3);
   field('density (kg/m\u00b3)', density);
   const error = text('div', '', 'warn');
   const add = text('button', 'Add correction', 'g2p-fix-add');
   add.type = 'button';
   add.addEventListener('click', () => {
     const entry = { part: p.part, was: { class: p.material, faces: p.faces } };
-    if (cls.value !== p.material) entry.class = cls.value;
+    if (cls.value) entry.class = cls.value;
     if (structure.value) entry.structure = structure.value;
     const mm = wall.value === '' ? null : Number(wall.value);
     const rho = density.value === '' ? null : Number(density.value);
-    if (mm !== null && !(mm > 0 && mm <= 10000)) { error.textContent = 'the wall must be more than 0 mm'; return; }
+    if (mm !== null && !(mm > 0 && mm <= 10000)) { error.textContent = 'the wall must be more than 0 and at most 10000 mm'; return; }
     if (mm !== null && structure.value === 'solid') { error.textContent = 'a solid part has no wall'; return; }
     if (rho !== null && !(rho > 0 && rho <= 30000)) { error.textContent = 'the density must be between 0 and 30000 kg/m\u00b3'; return; }
     if (mm !== null) entry.wall_thickness_m = mm / 1000;
@@ -322,7 +328,10 @@ function start(section, model) {
   }
   function show(i) {
     info.replaceChildren(i >= 0 ? partDetails(parts[i].data) : text('span', 'Hover over or click a part for its details.'));
-    if (i >= 0 && i === pinned && model.classes) info.append(correctionForm(parts[i].data, i, model.classes, addFix));
+    if (i >= 0 && i === pinned && model.classes) {
+      const existing = fixes.find((f) => f.part === parts[i].data.part);
+      info.append(correctionForm(parts[i].data, i, model.classes, existing, addFix));
+    }
     parts.forEach((p, k) => {
       p.classMaterial.emissive.setHex(k === i ? 0x404040 : 0);
       if (p.lookMaterial) p.lookMaterial.emissive.setHex(k === i ? 0x404040 : 0);

@@ -63,6 +63,8 @@ TEST(Overrides, ABadEntryIsRejectedNamingTheEntryAndTheKey) {
       {R"({"part": 0, "structure": "solid", "wall_thickness_m": 0.002})", "wall thickness for a solid part"},
       {R"({"part": 0, "wall_thickness_m": 0})", "'wall_thickness_m' must be a positive thickness"},
       {R"({"part": 0, "note": "nothing"})", "changes nothing"},
+      {R"({"faces": [5], "was": {"class": "Metal"}, "class": "Wood"})", "'was' checks a 'part'"},
+      {R"({"part": 0, "was": {"faces": 4294967388}, "class": "Wood"})", "'was' holds 'faces'"},
   };
   for (const auto& c : cases) {
     const std::string e = error_of(file(c.entries));
@@ -72,6 +74,8 @@ TEST(Overrides, ABadEntryIsRejectedNamingTheEntryAndTheKey) {
   EXPECT_NE(error_of(R"({"format": "g2p-overrides", "version": 2, "overrides": []})").find("reads version 1"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"format": "g2p-run", "version": 1})").find("not an overrides file"), std::string::npos);
+  EXPECT_NE(error_of(R"({"format": 1, "version": 1, "overrides": []})").find("not an overrides file"),
+            std::string::npos);
   EXPECT_NE(error_of("{oops").find("not JSON"), std::string::npos);
 }
 
@@ -92,6 +96,11 @@ TEST(Overrides, WrittenAndReadBackTheSame) {
   EXPECT_EQ(b->entries[0].note, "granite head");
   EXPECT_EQ(b->entries[0].was_faces, 12);
   EXPECT_DOUBLE_EQ(b->entries[1].density_kg_m3, 950.0);
+  // Overlapping ranges come back merged: each face once.
+  Result<Overrides> c =
+      parse_overrides(file(R"({"faces": [[10, 20], 3, [0, 2], [15, 30], 12], "class": "Wood"})"), table());
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  EXPECT_EQ(c->entries[0].faces, (std::vector<std::array<int, 2>>{{0, 3}, {10, 30}}));
 }
 
 TEST(Overrides, ResolvingChecksThatTheFileWasMadeForThisRun) {
@@ -116,6 +125,22 @@ TEST(Overrides, ResolvingChecksThatTheFileWasMadeForThisRun) {
   EXPECT_NE(resolve_error(R"({"format": "g2p-overrides", "version": 1, "faces_total": 99, "overrides": []})")
                 .find("made for a model of 99 faces"),
             std::string::npos);
+  // Read with the paper's table, applied to a run with another: classes are looked up by name again.
+  Result<MaterialTable> two = MaterialTable::from_json(
+      R"({"classes": [{"name": "Metal", "color": [9, 9, 9], "density_kg_m3": 7800, "density_range_kg_m3": [7000, 8000]},
+                      {"name": "Wood", "color": [9, 9, 9], "density_kg_m3": 700, "density_range_kg_m3": [350, 1000]}]})");
+  ASSERT_TRUE(two.ok()) << two.status().to_string();
+  Result<Overrides> stone =
+      parse_overrides(file(R"({"part": 0, "class": "Stone"}, {"part": 1, "class": "Wood"})"), table());
+  ASSERT_TRUE(stone.ok());
+  Result<ResolvedOverrides> r = resolve_overrides(*stone, n, h.parts, h.labels, *two);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("entry 1: class 'Stone' is not in the run's material table"), std::string::npos)
+      << r.status().message();
+  stone->entries.erase(stone->entries.begin());
+  r = resolve_overrides(*stone, n, h.parts, h.labels, *two);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->overrides.entries[0].label, two->find("Wood"));
 }
 
 TEST(Overrides, AClassChangeReformsOnlyThePartsItTouches) {
@@ -200,11 +225,39 @@ TEST(Overrides, TheEstimatorTakesThePersonsValuesForTheSelectedPartsOnly) {
   EXPECT_EQ(p0->density_source, ValueSource::kUser);
   EXPECT_EQ(p0->thickness_source, ValueSource::kUser);
   ASSERT_FALSE(p0->notes.empty());
-  EXPECT_NE(p0->notes.back().find("overrides entry 1: hollow, 3 mm walls, 2500 kg/m^3 (cast)"), std::string::npos)
+  EXPECT_NE(p0->notes.back().find("correction: hollow, 3 mm walls, 2500 kg/m^3 (cast)"), std::string::npos)
       << p0->notes.back();
   EXPECT_EQ(p1->structure, Structure::kSolid);
   EXPECT_DOUBLE_EQ(p1->density_kg_m3, 1000);
   EXPECT_EQ(p1->density_source, ValueSource::kTable);
+}
+
+TEST(Overrides, EntriesThatSetDifferentValuesOfOnePartAddUp) {
+  const Labelled h = hammer();
+  // A density first, then (another correction) the part made hollow: both stand.
+  Result<Overrides> o = parse_overrides(
+      file(
+          R"({"part": 0, "density_kg_m3": 7000}, {"part": 0, "structure": "hollow"}, {"faces": [[0, 3]], "density_kg_m3": 900})"),
+      table());
+  ASSERT_TRUE(o.ok());
+  Result<ResolvedOverrides> r = resolve_overrides(*o, h.model.mesh.num_faces(), h.parts, h.labels, table());
+  ASSERT_TRUE(r.ok());
+  FixedEstimator base;
+  PropertyInput in{&h.model.mesh, &h.parts[0], nullptr, &table()};
+  Result<PartProperties> p = make_overriding_estimator(base, *r)->estimate(in);
+  ASSERT_TRUE(p.ok());
+  EXPECT_EQ(p->structure, Structure::kHollow);
+  EXPECT_DOUBLE_EQ(p->wall_thickness_m, table()[h.parts[0].label].wall_thickness_m);  // the class's wall
+  EXPECT_DOUBLE_EQ(p->density_kg_m3, 900);  // the later density, on four of its faces, wins
+  // As face selections (a folder's overrides.json), the same values.
+  const Overrides faces = as_face_selections(*r);
+  Result<ResolvedOverrides> r2 = resolve_overrides(faces, h.model.mesh.num_faces(), h.parts, h.labels, table());
+  ASSERT_TRUE(r2.ok());
+  Result<PartProperties> q = make_overriding_estimator(base, *r2)->estimate(in);
+  ASSERT_TRUE(q.ok());
+  EXPECT_EQ(q->structure, p->structure);
+  EXPECT_DOUBLE_EQ(q->wall_thickness_m, p->wall_thickness_m);
+  EXPECT_DOUBLE_EQ(q->density_kg_m3, p->density_kg_m3);
 }
 
 }  // namespace

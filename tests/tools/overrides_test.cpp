@@ -131,10 +131,60 @@ TEST(ToolOverrides, ABadFileIsRejectedNamingTheEntryAndNothingIsWritten) {
     }
     const std::string out = dir + "/run-again" + std::to_string(i);
     r = test::run_tool("run " + hammer() + " -q -o " + test::quote(out) + " --overrides " + test::quote(file));
-    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--overrides " + file), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("nothing was written"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out)) << out;
   }
+}
+
+// Chains of commands: corrections carried by folders apply once, a folder
+// written again without corrections drops its old ones, and a folder whose
+// corrections changed after its properties were estimated is refused, not used.
+TEST(ToolOverrides, FoldersCarryTheirCorrectionsAndNothingElse) {
+  const std::string dir = test::scratch_dir("ToolOverridesChain");
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/run") + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  test::write_file(dir + "/plastic.json",
+                   R"({"format": "g2p-overrides", "version": 1, "overrides": [{"part": 0, "class": "Plastic"}]})");
+  test::write_file(dir + "/denser.json",
+                   R"({"format": "g2p-overrides", "version": 1, "overrides": [{"part": 1, "density_kg_m3": 15600}]})");
+  // A properties folder made with a class change; a density change on top keeps its closed parts.
+  r = test::run_tool("properties " + test::quote(dir + "/run") + " --overrides " + test::quote(dir + "/plastic.json") +
+                     " -o " + test::quote(dir + "/props"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = test::run_tool("export " + test::quote(dir + "/props") + " --overrides " + test::quote(dir + "/denser.json") +
+                     " -o " + test::quote(dir + "/out"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("using the closed parts of"), std::string::npos) << r.out;
+  const nlohmann::json report = json_of(dir + "/out/report.json");
+  EXPECT_EQ(report["parts"][0]["material"], "Plastic");
+  EXPECT_DOUBLE_EQ(report["parts"][1]["density_kg_m3"].get<double>(), 15600.0);
+  // The carried corrections once each: the class change and the density.
+  EXPECT_EQ(json_of(dir + "/out/overrides.json")["overrides"].size(), 2u)
+      << test::read_file(dir + "/out/overrides.json");
+
+  // `g2p properties` into the same folder again, without corrections: the old ones go.
+  r = test::run_tool("properties " + test::quote(dir + "/run") + " -o " + test::quote(dir + "/props"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/props/overrides.json"));
+  EXPECT_EQ(json_of(dir + "/props/report.json")["parts"][0]["material"], "Wood");
+
+  // `g2p complete --overrides` into a kept run folder records them beside the closed parts; a
+  // folder whose own corrections changed after its report was made is refused.
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/kept") + " -q --save-intermediates");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::run_tool("complete " + test::quote(dir + "/kept") + " --overrides " + test::quote(dir + "/plastic.json") +
+                     " -o " + test::quote(dir + "/kept/completed"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/kept/completed/overrides.json"));
+  test::write_file(dir + "/kept/overrides.json", test::read_file(dir + "/plastic.json"));
+  r = test::run_tool("export " + test::quote(dir + "/kept") + " -o " + test::quote(dir + "/kept-out"));
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("part 0 is Plastic by its labels and corrections but Wood in report.json"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/kept-out"));
 }
 
 }  // namespace

@@ -31,7 +31,11 @@ int run_complete(const CompleteArgs& args) {
   Result<Completion> done = run_completion("complete", args.completer, *object, exit_code);
   if (!done.ok()) return exit_code;
   const std::string out = args.out.empty() ? args.source.source + "/completed" : args.out;
-  if (Status s = write_completion(out, *done, object->table, args.formats); !s.ok()) {
+  Status s = write_completion(out, *done, object->table, args.formats);
+  // The corrections the closed parts were made with, for the record (the
+  // closed meshes alone do not carry classes on to later commands).
+  if (s.ok()) s = write_overrides(out, object->overrides, object->table);
+  if (!s.ok()) {
     std::cerr << "g2p complete: error: " << s.to_string() << "\n";
     return kExitFailure;
   }

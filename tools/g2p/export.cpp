@@ -45,13 +45,16 @@ int run_export(const ExportArgs& args) {
     if (!previous.ok()) return exit_code;
     LabelledObject& object = previous->object;
     if (!args.source.overrides.empty()) {
+      const std::size_t known = object.overrides.notes.size();  // printed while loading
+      object.overrides.changed_classes = false;                 // the folder's closed parts fit what was loaded
       if (!apply_overrides_file("export", args.source.overrides, object.model.mesh, object.table, object.faces,
                                 object.overrides, exit_code)
                .ok())
         return exit_code;
       finish_overrides(object.model.mesh.num_faces(), object.faces.parts, object.faces.labels, object.table,
                        object.overrides);
-      for (const std::string& n : object.overrides.notes) std::cout << "correction: " << n << "\n";
+      for (std::size_t i = known; i < object.overrides.notes.size(); ++i)
+        std::cout << "correction: " << object.overrides.notes[i] << "\n";
       if (object.overrides.changed_classes) {
         std::cout << "classes changed: closing the parts again\n";
         Result<Completion> done = run_completion("export", args.completer, object, exit_code);

@@ -179,6 +179,15 @@ int run_pipeline(const RunArgs& args) {
     std::cerr << "g2p run: interrupted after the run; the output is complete\n";
   if (!written.ok()) {
     printer.end_line();
+    // A file that does not fit the run (a missing part, a failed "was" check)
+    // is the user's input, like a bad flag.
+    const std::string& m = written.message();
+    std::size_t at = m.find(": overrides entry ");
+    if (at == std::string::npos) at = m.find(": overrides: ");
+    if (!args.overrides.empty() && written.code() == StatusCode::kInvalidArgument && at != std::string::npos) {
+      std::cerr << "g2p run: --overrides " << args.overrides << ": " << m.substr(at + 2) << "; nothing was written\n";
+      return kExitUsage;
+    }
     std::cerr << "g2p run: error: " << written.to_string() << "\n";
     return kExitFailure;
   }

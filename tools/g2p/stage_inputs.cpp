@@ -47,13 +47,14 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
                                             int& exit_code) {
   Result<LabelledObject> out = load_labels(command, args, exit_code);
   if (!out.ok()) return out;
-  std::vector<std::string> files;
-  if (std::filesystem::is_directory(args.source) && std::filesystem::exists(args.source + "/overrides.json"))
-    files.push_back(args.source + "/overrides.json");
-  if (!args.overrides.empty()) files.push_back(args.overrides);
-  for (const std::string& f : files)
+  std::vector<std::pair<std::string, bool>> files;  // path, carried
+  if (args.folder_overrides && std::filesystem::is_directory(args.source) &&
+      std::filesystem::exists(args.source + "/overrides.json"))
+    files.emplace_back(args.source + "/overrides.json", true);
+  if (!args.overrides.empty()) files.emplace_back(args.overrides, args.overrides_carried);
+  for (const auto& [f, carried] : files)
     G2P_RETURN_IF_ERROR(
-        apply_overrides_file(command, f, out->model.mesh, out->table, out->faces, out->overrides, exit_code));
+        apply_overrides_file(command, f, out->model.mesh, out->table, out->faces, out->overrides, exit_code, carried));
   finish_overrides(out->model.mesh.num_faces(), out->faces.parts, out->faces.labels, out->table, out->overrides);
   for (const std::string& n : out->overrides.notes) std::cout << "correction: " << n << "\n";
   return out;
@@ -182,10 +183,15 @@ Result<PropertiesOutput> load_properties_output(const std::string& command, cons
   source.key = manifest->value("key", "");
   source.materials = manifest->value("materials", "");
   source.textures = true;
-  // The corrections this folder was made with (the source folder's own apply first).
+  // The corrections this folder was made with: they hold the source folder's
+  // own, so those are not applied a second time.
   std::error_code same_error;
-  if (std::filesystem::exists(dir + "/overrides.json") && !std::filesystem::equivalent(source.source, dir, same_error))
+  if (std::filesystem::exists(dir + "/overrides.json") &&
+      !std::filesystem::equivalent(source.source, dir, same_error)) {
     source.overrides = dir + "/overrides.json";
+    source.overrides_carried = true;
+    source.folder_overrides = false;
+  }
   PropertiesOutput out;
   Result<LabelledObject> object = load_labelled_source(command, source, exit_code);
   if (!object.ok()) return object.status();
@@ -198,6 +204,19 @@ Result<PropertiesOutput> load_properties_output(const std::string& command, cons
   if ((*completion)["parts"].size() != np || (*report)["parts"].size() != np)
     return fail(Status::InvalidArgument(dir + ": its parts do not match the source's " + std::to_string(np) +
                                         " parts (was the source changed?)"));
+  // Each part's class too: `g2p complete --overrides` into the folder changes
+  // completed/ but not report.json.
+  for (std::size_t i = 0; i < np; ++i) {
+    const int label = out.object.faces.parts[i].label;
+    const std::string is = out.object.table.valid_label(label) ? out.object.table[label].name : "Unknown";
+    const nlohmann::json& reported = (*report)["parts"][i];
+    if (reported.contains("material") && reported["material"].is_string() && reported["material"] != is)
+      return fail(Status::InvalidArgument(dir + ": part " + std::to_string(i) + " is " + is +
+                                          " by its labels and corrections but " +
+                                          reported["material"].get<std::string>() +
+                                          " in report.json (changed after g2p properties?); run g2p properties on "
+                                          "the folder again"));
+  }
   try {
     out.completion.object_volume_m3 = (*completion)["object_volume_m3"].get<double>();
     for (std::size_t i = 0; i < np; ++i) {

@@ -23,8 +23,10 @@ struct LabelledSourceArgs {
   std::string truth;   // labels.json, for a model file
   std::string key;     // entry in labels.json (default: the file's stem)
   std::string materials;
-  bool textures = false;  // decode textures (for outputs that show the model's appearance)
-  std::string overrides;  // --overrides FILE, applied after the folder's own overrides.json
+  bool textures = false;           // decode textures (for outputs that show the model's appearance)
+  std::string overrides;           // --overrides FILE, applied after the folder's own overrides.json
+  bool folder_overrides = true;    // apply the folder's overrides.json
+  bool overrides_carried = false;  // `overrides` is another folder's overrides.json, not --overrides
 };
 void add_labelled_source_flags(CLI::App* cmd, LabelledSourceArgs& args);
 

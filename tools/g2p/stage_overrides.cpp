@@ -18,11 +18,16 @@ namespace {
 
 // Parse, check and resolve on the current parts; `apply` changes the labels.
 template <typename Apply>
-Status apply_file(const std::string& command, const std::string& path, int num_faces, const MaterialTable& table,
-                  const std::vector<Part>& parts, const std::vector<int>& labels, Apply apply,
-                  AppliedOverrides& applied, int& exit_code) {
+Status apply_file(const std::string& command, const std::string& path, bool carried, int num_faces,
+                  const MaterialTable& table, const std::vector<Part>& parts, const std::vector<int>& labels,
+                  Apply apply, AppliedOverrides& applied, int& exit_code) {
   auto fail = [&](const Status& s) {
-    std::cerr << "g2p " << command << ": error: --overrides " << s.message() << "; nothing was written\n";
+    // read_overrides names the file; the other messages get it here.
+    std::string message = s.message();
+    if (message.rfind(path, 0) != 0) message = path + ": " + message;
+    std::cerr << "g2p " << command << ": error: "
+              << (carried ? message.insert(path.size(), " (the folder's corrections)") : "--overrides " + message)
+              << "; nothing was written\n";
     exit_code = kExitUsage;
     return s;
   };
@@ -30,11 +35,13 @@ Status apply_file(const std::string& command, const std::string& path, int num_f
   Result<Overrides> parsed = read_overrides(path, table);
   if (!parsed.ok()) return fail(parsed.status());
   Result<ResolvedOverrides> resolved = resolve_overrides(*parsed, num_faces, parts, labels, table);
-  if (!resolved.ok()) return fail(resolved.status().with_context(path));
+  if (!resolved.ok()) return fail(resolved.status());
+  const std::vector<int> before = labels;
   Result<std::vector<std::string>> notes = apply(*resolved);
-  if (!notes.ok()) return fail(notes.status().with_context(path));
+  if (!notes.ok()) return fail(notes.status());
   for (const std::string& n : *notes) applied.notes.push_back(path + ": " + n);
-  applied.changed_classes = applied.changed_classes || parsed->changes_labels();
+  // Only a file that moved a face to another class needs the parts closed again.
+  applied.changed_classes = applied.changed_classes || labels != before;
   Overrides faces = as_face_selections(*resolved);
   applied.combined.faces_total = faces.faces_total;
   if (applied.combined.model.empty()) applied.combined.model = faces.model;
@@ -45,9 +52,10 @@ Status apply_file(const std::string& command, const std::string& path, int num_f
 }  // namespace
 
 Status apply_overrides_file(const std::string& command, const std::string& path, const Mesh& mesh,
-                            const MaterialTable& table, FacesFile& faces, AppliedOverrides& applied, int& exit_code) {
+                            const MaterialTable& table, FacesFile& faces, AppliedOverrides& applied, int& exit_code,
+                            bool carried) {
   return apply_file(
-      command, path, mesh.num_faces(), table, faces.parts, faces.labels,
+      command, path, carried, mesh.num_faces(), table, faces.parts, faces.labels,
       [&](const ResolvedOverrides& r) -> Result<std::vector<std::string>> {
         if (!r.overrides.changes_labels()) return std::vector<std::string>{};
         Result<FaceGraph> graph = build_face_graph(mesh);
@@ -59,9 +67,9 @@ Status apply_overrides_file(const std::string& command, const std::string& path,
 
 Status apply_overrides_file(const std::string& command, const std::string& path, const Mesh& mesh,
                             const MaterialTable& table, Projection& projection, AppliedOverrides& applied,
-                            int& exit_code) {
+                            int& exit_code, bool carried) {
   return apply_file(
-      command, path, mesh.num_faces(), table, projection.parts, projection.labels.label,
+      command, path, carried, mesh.num_faces(), table, projection.parts, projection.labels.label,
       [&](const ResolvedOverrides& r) { return apply_class_overrides(r, mesh, projection, table); }, applied,
       exit_code);
 }
@@ -75,7 +83,11 @@ void finish_overrides(int num_faces, const std::vector<Part>& parts, const std::
 }
 
 Status write_overrides(const std::string& dir, const AppliedOverrides& applied, const MaterialTable& table) {
-  if (applied.empty()) return Status::Ok();
+  if (applied.empty()) {  // a folder written again without corrections must not keep old ones
+    std::error_code ignored;
+    std::filesystem::remove(dir + "/overrides.json", ignored);
+    return Status::Ok();
+  }
   return write_text_file(dir + "/overrides.json", overrides_json(applied.combined, table));
 }
 

@@ -43,18 +43,20 @@ struct Override {
   int was_faces = -1;     // -1 = not checked
   // New values; what is left unset keeps what the stages decide.
   int label = kUnknownLabel;                // the new class (an index of the table), kUnknownLabel = keep
+  std::string class_name;                   // its name as the file gives it (resolve_overrides looks it up again)
   bool set_structure = false;               // true: `structure` applies
   Structure structure = Structure::kSolid;  // solid or hollow
   double wall_thickness_m = 0.0;            // > 0: the wall (implies hollow), metres
   double density_kg_m3 = 0.0;               // > 0: the density, kg/m^3 (its plausible range becomes this value)
   std::string note;                         // the person's words, kept in the reports
 
-  bool sets_properties() const { return set_structure || wall_thickness_m > 0 || density_kg_m3 > 0; }
+  bool sets_structure() const { return set_structure || wall_thickness_m > 0; }  // structure and wall
+  bool sets_properties() const { return sets_structure() || density_kg_m3 > 0; }
 };
 
 struct Overrides {
-  std::vector<Override> entries;  // in file order; where two select the same face, the later sets its
-                                  // class, and the later that sets properties sets its properties
+  std::vector<Override> entries;  // in file order; where two select the same face, each value (class;
+                                  // structure with wall; density) comes from the later entry that sets it
   std::string model;              // the model the run was made from (for people; not checked)
   int faces_total = -1;           // the input's face count; checked when >= 0
 
@@ -72,8 +74,9 @@ struct Overrides {
 };
 
 // Parses the JSON format above; class names are looked up in `table`
-// (case-insensitive). Fails naming the entry and the key for an unknown key
-// or class, a selection that is missing, doubled or negative, a structure
+// (case-insensitive). Face ranges come back sorted and merged. Fails naming
+// the entry and the key for an unknown key or class, a selection that is
+// missing, doubled or negative, a "was" on a face selection, a structure
 // other than solid/hollow, a wall thickness or density that is not positive
 // and finite (or a density above 30,000 kg/m^3, denser than any material), an
 // entry that changes nothing, or a version other than kOverridesVersion.
@@ -89,26 +92,29 @@ G2P_API std::string overrides_json(const Overrides& overrides, const MaterialTab
 // The overrides checked against the run they are applied to, as face sets.
 struct ResolvedOverrides {
   Overrides overrides;
-  std::vector<int> class_entry;     // per face: the last entry that selects it and sets a class, -1 for none
-  std::vector<int> property_entry;  // per face: the last entry that selects it and sets properties, -1 for none
-  std::vector<int> faces;           // per entry: how many faces it selects
+  // Per face, the last entry that selects it and sets the value, -1 for none:
+  std::vector<int> class_entry;      // the class
+  std::vector<int> structure_entry;  // solid or hollow, and the wall
+  std::vector<int> density_entry;    // the density
+  std::vector<int> faces;            // per entry: how many faces it selects
 };
 
 // Checks every entry against a run's mesh (`num_faces`) and its parts and
 // labels (the ones the file was made from: a run's final parts, or the parts
 // of a faces.csv) and turns the selections into faces. Fails naming the entry
 // when a part or face does not exist, when the face count differs from
-// faces_total, or when a "was" check does not hold (the file was made for
-// another model or run).
+// faces_total, when a class is not in `table` (the run's), or when a "was"
+// check does not hold (the file was made for another model or run). Entries'
+// labels are looked up again in `table` by their class names.
 G2P_API Result<ResolvedOverrides> resolve_overrides(const Overrides& overrides, int num_faces,
                                                     const std::vector<Part>& parts, const std::vector<int>& labels,
                                                     const MaterialTable& table);
 
 // The resolved overrides as face selections only (no part indices, no "was"
-// checks): one entry per class and per set of properties, holding the faces
-// it won. They mean the same on the run's labels and still hold once the
-// parts have re-formed, so output folders keep them (overrides.json) for the
-// stages that start from the folder.
+// checks): per entry, one for its class, one for its structure and wall and
+// one for its density, each holding the faces where that value won. They mean the same on the run's labels and still
+// hold once the parts have re-formed, so output folders keep them (overrides.json) for the stages that start from the
+// folder.
 G2P_API Overrides as_face_selections(const ResolvedOverrides& resolved);
 
 // Gives every selected face its new class and re-forms the parts as the
@@ -124,9 +130,9 @@ G2P_API Result<std::vector<std::string>> apply_class_overrides(const ResolvedOve
                                                                Projection& projection, const MaterialTable& table);
 
 // An estimator that asks `base`, then sets the structure, wall thickness and
-// density the overrides give for the part (the entries selecting any of its
-// faces, later entries winning), with ValueSource::kUser and a note naming
-// the entry. Both must outlive it.
+// density the overrides give for the part (from the entries that won any of
+// its faces, later entries winning), with ValueSource::kUser and a note
+// ("correction: hollow, 4 mm walls, 7000 kg/m^3"). Both must outlive it.
 G2P_API std::unique_ptr<PropertyEstimator> make_overriding_estimator(const PropertyEstimator& base,
                                                                      const ResolvedOverrides& resolved);
 

@@ -3,6 +3,7 @@
 // (an estimator that wraps another). docs/pipeline.md#overrides.
 #include "g2p/overrides.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -66,15 +67,27 @@ Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& 
                            "'faces' holds " + item.dump() + ": give face indices (0, 1, ...) or [first, last] ranges");
       }
     }
+    // Sorted and merged: each face once, however the ranges overlap.
+    std::sort(o.faces.begin(), o.faces.end());
+    std::vector<std::array<int, 2>> merged;
+    for (const auto& r : o.faces) {
+      if (!merged.empty() && static_cast<long long>(r[0]) <= static_cast<long long>(merged.back()[1]) + 1)
+        merged.back()[1] = std::max(merged.back()[1], r[1]);
+      else
+        merged.push_back(r);
+    }
+    o.faces = std::move(merged);
   }
   if (e.contains("was")) {
     const json& w = e["was"];
+    if (!has_part) return entry_error(origin, i, "'was' checks a 'part'; a 'faces' selection has nothing to check");
     if (!w.is_object())
       return entry_error(origin, i, "'was' must be an object like {\"class\": \"Wood\", \"faces\": 120}");
     for (auto it = w.begin(); it != w.end(); ++it) {
       if (it.key() == "class" && it.value().is_string()) {
         o.was_class = it.value().get<std::string>();
-      } else if (it.key() == "faces" && it.value().is_number_integer() && it.value().get<long long>() >= 0) {
+      } else if (it.key() == "faces" && it.value().is_number_integer() && it.value().get<long long>() >= 0 &&
+                 it.value().get<long long>() < (1LL << 31)) {
         o.was_faces = it.value().get<int>();
       } else {
         return entry_error(origin, i,
@@ -86,7 +99,8 @@ Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& 
   if (e.contains("class")) {
     const json& c = e["class"];
     if (!c.is_string()) return entry_error(origin, i, "'class' must be a class name, not " + c.dump());
-    o.label = table.find(c.get<std::string>());
+    o.class_name = c.get<std::string>();
+    o.label = table.find(o.class_name);
     if (o.label == kUnknownLabel) {
       std::string names;
       for (int k = 0; k < table.size(); ++k) names += (k ? ", " : "") + table[k].name;
@@ -130,7 +144,7 @@ Result<Overrides> parse_overrides(const std::string& text, const MaterialTable& 
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded())
     return Status::InvalidArgument(origin + ": not JSON (an overrides file is JSON, docs/pipeline.md#overrides)");
-  if (!j.is_object() || j.value("format", "") != "g2p-overrides")
+  if (!j.is_object() || !j.contains("format") || !j["format"].is_string() || j["format"] != "g2p-overrides")
     return Status::InvalidArgument(origin + ": not an overrides file (its \"format\" must be \"g2p-overrides\")");
   if (!j.contains("version") || !j["version"].is_number_integer())
     return Status::InvalidArgument(origin + ": the overrides file has no \"version\"");
@@ -190,7 +204,10 @@ std::string overrides_json(const Overrides& overrides, const MaterialTable& tabl
       if (o.was_faces >= 0) was["faces"] = o.was_faces;
       e["was"] = was;
     }
-    if (table.valid_label(o.label)) e["class"] = table[o.label].name;
+    if (table.valid_label(o.label))
+      e["class"] = table[o.label].name;
+    else if (!o.class_name.empty())
+      e["class"] = o.class_name;
     if (o.set_structure) e["structure"] = to_string(o.structure);
     if (o.wall_thickness_m > 0) e["wall_thickness_m"] = o.wall_thickness_m;
     if (o.density_kg_m3 > 0) e["density_kg_m3"] = o.density_kg_m3;
@@ -215,14 +232,28 @@ Result<ResolvedOverrides> resolve_overrides(const Overrides& overrides, int num_
   ResolvedOverrides r;
   r.overrides = overrides;
   r.class_entry.assign(static_cast<std::size_t>(num_faces), -1);
-  r.property_entry.assign(static_cast<std::size_t>(num_faces), -1);
+  r.structure_entry.assign(static_cast<std::size_t>(num_faces), -1);
+  r.density_entry.assign(static_cast<std::size_t>(num_faces), -1);
+  // Classes by name in the run's table (the file may have been read with another).
+  for (std::size_t i = 0; i < r.overrides.entries.size(); ++i) {
+    Override& o = r.overrides.entries[i];
+    if (o.class_name.empty() && o.label == kUnknownLabel) continue;
+    const int label =
+        o.class_name.empty() ? (table.valid_label(o.label) ? o.label : kUnknownLabel) : table.find(o.class_name);
+    if (label == kUnknownLabel)
+      return Status::InvalidArgument("overrides " + entry_name(i) + ": class '" + o.class_name +
+                                     "' is not in the run's material table");
+    o.label = label;
+  }
   r.faces.assign(overrides.entries.size(), 0);
   for (std::size_t i = 0; i < overrides.entries.size(); ++i) {
-    const Override& o = overrides.entries[i];
+    const Override& o = r.overrides.entries[i];
     const int entry = static_cast<int>(i);
     auto select = [&](int f) {
-      if (o.label != kUnknownLabel) r.class_entry[static_cast<std::size_t>(f)] = entry;
-      if (o.sets_properties()) r.property_entry[static_cast<std::size_t>(f)] = entry;
+      const std::size_t face = static_cast<std::size_t>(f);
+      if (o.label != kUnknownLabel) r.class_entry[face] = entry;
+      if (o.sets_structure()) r.structure_entry[face] = entry;
+      if (o.density_kg_m3 > 0) r.density_entry[face] = entry;
     };
     if (o.part >= 0) {
       if (o.part >= static_cast<int>(parts.size()))
@@ -249,7 +280,7 @@ Result<ResolvedOverrides> resolve_overrides(const Overrides& overrides, int num_
                                          " does not exist (the model has " + std::to_string(num_faces) +
                                          " faces, 0 to " + std::to_string(num_faces - 1) + ")");
         for (int f = range[0]; f <= range[1]; ++f) select(f);
-        r.faces[i] += range[1] - range[0] + 1;
+        r.faces[i] += range[1] - range[0] + 1;  // ranges are merged: at most num_faces in all
       }
     }
   }
@@ -280,17 +311,25 @@ Overrides as_face_selections(const ResolvedOverrides& resolved) {
       Override c;
       c.faces = ranges(resolved.class_entry, static_cast<int>(i));
       c.label = o.label;
+      c.class_name = o.class_name;
       c.note = o.note;
       if (!c.faces.empty()) out.entries.push_back(std::move(c));
     }
-    if (o.sets_properties()) {
-      Override p = o;
-      p.part = -1;
-      p.faces = ranges(resolved.property_entry, static_cast<int>(i));
-      p.was_class.clear();
-      p.was_faces = -1;
-      p.label = kUnknownLabel;
-      if (!p.faces.empty()) out.entries.push_back(std::move(p));
+    if (o.sets_structure()) {
+      Override s;
+      s.faces = ranges(resolved.structure_entry, static_cast<int>(i));
+      s.set_structure = o.set_structure;
+      s.structure = o.structure;
+      s.wall_thickness_m = o.wall_thickness_m;
+      s.note = o.note;
+      if (!s.faces.empty()) out.entries.push_back(std::move(s));
+    }
+    if (o.density_kg_m3 > 0) {
+      Override d;
+      d.faces = ranges(resolved.density_entry, static_cast<int>(i));
+      d.density_kg_m3 = o.density_kg_m3;
+      d.note = o.note;
+      if (!d.faces.empty()) out.entries.push_back(std::move(d));
     }
   }
   return out;
@@ -356,52 +395,62 @@ class OverridingEstimator final : public PropertyEstimator {
   Result<PartProperties> estimate(const PropertyInput& input) const override {
     Result<PartProperties> r = base_.estimate(input);
     if (!r.ok() || input.part == nullptr) return r;
-    // The entries that select any of the part's faces, in file order.
-    std::set<int> entries;
+    // The entries that won any of the part's faces, per value, in file order.
+    std::set<int> structure, density;
     for (int f : input.part->faces) {
       const std::size_t i = static_cast<std::size_t>(f);
-      if (i < resolved_.property_entry.size() && resolved_.property_entry[i] >= 0)
-        entries.insert(resolved_.property_entry[i]);
+      if (i < resolved_.structure_entry.size() && resolved_.structure_entry[i] >= 0)
+        structure.insert(resolved_.structure_entry[i]);
+      if (i < resolved_.density_entry.size() && resolved_.density_entry[i] >= 0)
+        density.insert(resolved_.density_entry[i]);
     }
+    if (structure.empty() && density.empty()) return r;
     PartProperties& p = *r;
-    for (int e : entries) {
+    std::set<int> used;
+    for (int e : structure) {
       const Override& o = resolved_.overrides.entries[static_cast<std::size_t>(e)];
-      std::string what;
-      if (o.set_structure || o.wall_thickness_m > 0) {
-        const Structure s = o.wall_thickness_m > 0 ? Structure::kHollow : o.structure;
-        if (s == Structure::kSolid) {
-          p.structure = Structure::kSolid;
-          p.wall_thickness_m = 0.0;
+      used.insert(e);
+      if (o.wall_thickness_m <= 0 && o.structure == Structure::kSolid) {
+        p.structure = Structure::kSolid;
+        p.wall_thickness_m = 0.0;
+        p.double_walled = false;
+      } else {
+        if (p.structure != Structure::kHollow) {  // the estimator's wall, else the class's
           p.double_walled = false;
-          what += "solid";
-        } else {
-          if (p.structure != Structure::kHollow) {  // the estimator's wall, else the class's
-            p.double_walled = false;
-            p.wall_thickness_m = input.table != nullptr && input.table->valid_label(p.label)
-                                     ? (*input.table)[p.label].wall_thickness_m
-                                     : p.wall_thickness_m;
-          }
-          p.structure = Structure::kHollow;
-          if (o.wall_thickness_m > 0) {
-            p.wall_thickness_m = o.wall_thickness_m;
-            p.thickness_source = ValueSource::kUser;
-          }
-          std::ostringstream t;
-          t << "hollow, " << p.wall_thickness_m * 1000.0 << " mm walls";
-          what += t.str();
+          p.wall_thickness_m = input.table != nullptr && input.table->valid_label(p.label)
+                                   ? (*input.table)[p.label].wall_thickness_m
+                                   : p.wall_thickness_m;
+          if (!(p.wall_thickness_m > 0)) p.wall_thickness_m = MaterialClass{}.wall_thickness_m;
         }
-        p.structure_source = ValueSource::kUser;
+        p.structure = Structure::kHollow;
+        if (o.wall_thickness_m > 0) {
+          p.wall_thickness_m = o.wall_thickness_m;
+          p.thickness_source = ValueSource::kUser;
+        }
       }
-      if (o.density_kg_m3 > 0) {
-        p.density_kg_m3 = p.density_min_kg_m3 = p.density_max_kg_m3 = o.density_kg_m3;
-        p.density_source = ValueSource::kUser;
-        std::ostringstream d;
-        d << (what.empty() ? "" : ", ") << o.density_kg_m3 << " kg/m^3";
-        what += d.str();
-      }
-      p.notes.push_back("overrides entry " + std::to_string(e + 1) + ": " + what +
-                        (o.note.empty() ? "" : " (" + o.note + ")"));
+      p.structure_source = ValueSource::kUser;
     }
+    for (int e : density) {
+      const Override& o = resolved_.overrides.entries[static_cast<std::size_t>(e)];
+      used.insert(e);
+      p.density_kg_m3 = p.density_min_kg_m3 = p.density_max_kg_m3 = o.density_kg_m3;
+      p.density_source = ValueSource::kUser;
+    }
+    std::ostringstream what;
+    what << "correction: ";
+    if (!structure.empty()) {
+      if (p.structure == Structure::kSolid)
+        what << "solid";
+      else
+        what << "hollow, " << p.wall_thickness_m * 1000.0 << " mm walls";
+    }
+    if (!density.empty()) what << (structure.empty() ? "" : ", ") << p.density_kg_m3 << " kg/m^3";
+    std::string notes;
+    for (int e : used) {
+      const std::string& n = resolved_.overrides.entries[static_cast<std::size_t>(e)].note;
+      if (!n.empty() && notes.find(n) == std::string::npos) notes += (notes.empty() ? "" : "; ") + n;
+    }
+    p.notes.push_back(what.str() + (notes.empty() ? "" : " (" + notes + ")"));
     return r;
   }
 

@@ -305,7 +305,7 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     if (resolved)
       for (const PartReport& p : r.properties.parts)
         for (const std::string& n : p.properties.notes)
-          if (n.rfind("overrides entry", 0) == 0)
+          if (n.rfind("correction: ", 0) == 0)
             r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n);
     clock.report().notes = r.properties.notes;
     // The vlm estimator never fails a part: it falls back to the table, which

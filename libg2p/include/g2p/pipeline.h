@@ -90,8 +90,10 @@ struct PipelineOptions {
   ViewOptions views;
   RenderOptions render;
 
-  // 2. segment: "pbr" (weight-free default), "onnx", "oracle", or a user's.
-  BackendChoice segmenter{"pbr", {}};
+  // 2. segment: "hybrid" (default: `pbr` on per-part materials, the network
+  //    where one material covers several parts), "pbr", "learned", "onnx",
+  //    "oracle", or a user's (docs/segment.md).
+  BackendChoice segmenter{"hybrid", {}};
 
   // 3. project: votes, flood fill and parts.
   ProjectOptions project;

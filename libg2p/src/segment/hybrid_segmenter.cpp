@@ -6,7 +6,9 @@
 //
 // The rule, per face (docs/segment.md, "hybrid"):
 //  1. its names name a class (read as `pbr` and `learned` read them): `pbr`;
-//  2. its material covers several parts, that is it covers at least `share`
+//  2. no face of the model is named (scope=model, the default; with
+//     scope=material, this face's names only) and its material covers
+//     several parts, that is it covers at least `share`
 //     of the model's surface area (faces without a material count as one
 //     material): the network decides; when that material's PBR values were
 //     authored, `pbr`'s probabilities for the pixel, raised to `prior`, weigh
@@ -45,6 +47,12 @@ struct HybridOptions {
   // Name-evidence threshold (0 to 1] for a face's names to name a class, as
   // `learned`'s names setting; 2 = names never decide.
   double names = 0.9;
+  // Where names count (scope=model|material): `model` reads a model of which
+  // any face is named with `pbr` throughout (a curated asset: its unnamed
+  // materials are parts too), and leaves rule 2 to models nothing names, as
+  // generated meshes come; `material` applies rule 2 per material, named
+  // model or not (the first candidate, docs/accuracy.md).
+  bool model_scope = true;
 };
 
 class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings {
@@ -63,10 +71,12 @@ class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings
         o.prior = v;
       } else if (key == "names" && (value == "off" || (number && v > 0 && v <= 1))) {
         o.names = value == "off" ? 2.0 : v;
+      } else if (key == "scope" && (value == "model" || value == "material")) {
+        o.model_scope = value == "model";
       } else {
         return Status::InvalidArgument("hybrid: bad setting " + key + "=" + value +
                                        " (known: model_card=FILE, flip=on|off, share=(0,1], prior=[0,1], "
-                                       "names=(0,1]|off)");
+                                       "names=(0,1]|off, scope=model|material)");
       }
     }
     options_ = o;
@@ -179,6 +189,7 @@ class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings
       if (named[f]) continue;  // 1: names decide
       const int m = mesh.face_source[f].material;
       const bool authored = slot(m) > 0 && detail::pbr_authored(model.materials[static_cast<std::size_t>(m)]);
+      if (options_.model_scope && any_named) continue;  // 3: a curated asset: `pbr`
       if (total > 0 && area[slot(m)] >= options_.share * total)
         by_network_[f] = authored && options_.prior > 0 ? 2 : 1;  // 2: several parts
       else if (!authored && !any_named)

@@ -1,4 +1,4 @@
-// The `hybrid` segmenter (the default): a real multi-material asset merged into
+// The `hybrid` segmenter: a real multi-material asset merged into
 // one material, as image-to-3D generators emit it (a baked base-colour atlas,
 // no names, metallic at glTF's default of 1), is decomposed by the network;
 // named per-part assets keep `pbr`'s labels; without its network it falls
@@ -74,11 +74,10 @@ double accuracy(const Mesh& mesh, const std::vector<int>& labels, const std::vec
   return total > 0 ? right / total : 0;
 }
 
-TEST(HybridSegmenter, TheDefaultDecomposesAChairMergedIntoOneAtlasMaterial) {
+TEST(HybridSegmenter, DecomposesAChairMergedIntoOneAtlasMaterial) {
   const Chair& chair = sheen_chair();
   ASSERT_FALSE(chair.truth.empty());
   ASSERT_EQ(chair.merged.materials.size(), 1u);
-  EXPECT_EQ(PipelineOptions().segmenter.name, "hybrid");
 
   // The old default reads one material, metallic 1: one class, Metal, everywhere.
   Result<PipelineResult> old = Pipeline(through_projection("pbr")).run(chair.merged);
@@ -87,10 +86,10 @@ TEST(HybridSegmenter, TheDefaultDecomposesAChairMergedIntoOneAtlasMaterial) {
   ASSERT_EQ(old_area.size(), 1u);
   EXPECT_EQ(old_area.begin()->first, MaterialTable::paper_default().find("Metal"));
 
-  // The default (no segmenter named): the network decides per pixel. Measured on
+  // `hybrid`: the network decides per pixel. Measured on
   // 2026-11-25: 3 classes over 5 % of the area, 52 % of the labelled area
   // right (pbr 0.3 %); the bounds leave room for other CPUs' float noise.
-  Result<PipelineResult> r = Pipeline(through_projection("")).run(chair.merged);
+  Result<PipelineResult> r = Pipeline(through_projection("hybrid")).run(chair.merged);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   EXPECT_TRUE(r->warnings.empty()) << r->warnings.front();
   const std::map<int, double> area = area_per_class(r->model.mesh, r->projection.labels.label);
@@ -99,8 +98,8 @@ TEST(HybridSegmenter, TheDefaultDecomposesAChairMergedIntoOneAtlasMaterial) {
   EXPECT_GE(large, 2) << "classes over 5 % of the area: " << large;
   const double acc = accuracy(r->model.mesh, r->projection.labels.label, chair.truth);
   const double old_acc = accuracy(old->model.mesh, old->projection.labels.label, chair.truth);
-  EXPECT_GT(acc, 0.4) << "default " << acc << ", pbr " << old_acc;
-  EXPECT_GT(acc, old_acc + 0.3) << "default " << acc << ", pbr " << old_acc;
+  EXPECT_GT(acc, 0.4) << "hybrid " << acc << ", pbr " << old_acc;
+  EXPECT_GT(acc, old_acc + 0.3) << "hybrid " << acc << ", pbr " << old_acc;
 }
 
 TEST(HybridSegmenter, NamedPerPartAssetsKeepPbrsLabels) {
@@ -148,7 +147,7 @@ TEST(HybridSegmenter, AMeshWithoutUvsOrMaterialsGetsTheNetwork) {
   plain.materials.clear();
   for (FaceSource& s : plain.mesh.face_source) s.material = -1;
   for (SourcePrimitive& p : plain.primitives) p.material = -1;
-  Result<PipelineResult> r = Pipeline(through_projection("")).run(plain);
+  Result<PipelineResult> r = Pipeline(through_projection("hybrid")).run(plain);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   Result<PipelineResult> pbr = Pipeline(through_projection("pbr")).run(plain);
   ASSERT_TRUE(pbr.ok());
@@ -156,7 +155,7 @@ TEST(HybridSegmenter, AMeshWithoutUvsOrMaterialsGetsTheNetwork) {
   // Measured: 17 % of the labelled area right, pbr 0 % (grey, no colour to read).
   const double acc = accuracy(r->model.mesh, r->projection.labels.label, chair.truth);
   const double old_acc = accuracy(pbr->model.mesh, pbr->projection.labels.label, chair.truth);
-  EXPECT_GT(acc, old_acc) << "default " << acc << ", pbr " << old_acc;
+  EXPECT_GT(acc, old_acc) << "hybrid " << acc << ", pbr " << old_acc;
 }
 
 }  // namespace

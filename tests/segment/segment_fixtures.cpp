@@ -2,6 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
 #include "support/test_data.h"
 
 namespace g2p::test {
@@ -46,6 +52,85 @@ int majority_label(const Model& model, const std::vector<View>& views, const std
   for (const auto& [label, n] : votes)
     if (n > count) best = label, count = n;
   return best;
+}
+
+namespace {
+
+// The mean sRGB colour of a material as rendered: its texture's mean times its
+// factor (linear factor, so raised to 1/2.2 against sRGB bytes).
+std::array<std::uint8_t, 3> mean_colour(const SourceMaterial& mat) {
+  std::array<double, 3> c{255, 255, 255};
+  if (!mat.base_color_texture.empty()) {
+    const ImageU8& t = *mat.base_color_texture.image;
+    c = {0, 0, 0};
+    for (int y = 0; y < t.height(); ++y)
+      for (int x = 0; x < t.width(); ++x)
+        for (int k = 0; k < 3; ++k) c[k] += t.at(x, y, k);
+    for (double& v : c) v /= static_cast<double>(t.width()) * t.height();
+  }
+  std::array<std::uint8_t, 3> out{};
+  for (int k = 0; k < 3; ++k)
+    out[k] = static_cast<std::uint8_t>(std::clamp(c[k] * std::pow(mat.base_color[k], 1 / 2.2), 0.0, 255.0));
+  return out;
+}
+
+}  // namespace
+
+Model one_atlas_material(const Model& source) {
+  Model m = source;
+  const Mesh& in = source.mesh;
+  const int tiles = std::max<int>(1, static_cast<int>(source.materials.size()));
+  auto atlas = std::make_shared<ImageU8>();
+  atlas->reset(8 * tiles, 8, 4, 255);
+  for (int t = 0; t < static_cast<int>(source.materials.size()); ++t) {
+    const std::array<std::uint8_t, 3> c = mean_colour(source.materials[static_cast<std::size_t>(t)]);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 8 * t; x < 8 * t + 8; ++x)
+        for (int k = 0; k < 3; ++k) atlas->at(x, y, k) = c[static_cast<std::size_t>(k)];
+  }
+  Mesh& out = m.mesh;
+  out.positions.clear();
+  out.normals.clear();
+  out.uvs.clear();
+  for (int f = 0; f < in.num_faces(); ++f) {
+    const int material = in.face_source[static_cast<std::size_t>(f)].material;
+    const Eigen::Vector2f uv((std::max(material, 0) + 0.5f) / static_cast<float>(tiles), 0.5f);
+    for (int i = 0; i < 3; ++i) {
+      const int v = in.triangles[static_cast<std::size_t>(f)][i];
+      out.positions.push_back(in.positions[static_cast<std::size_t>(v)]);
+      if (in.has_normals()) out.normals.push_back(in.normals[static_cast<std::size_t>(v)]);
+      out.uvs.push_back(uv);
+    }
+    out.triangles[static_cast<std::size_t>(f)] = Eigen::Vector3i(3 * f, 3 * f + 1, 3 * f + 2);
+    out.face_source[static_cast<std::size_t>(f)].material = 0;
+  }
+  for (SourcePrimitive& p : m.primitives) {
+    p.material = 0;
+    p.first_vertex = 3 * p.first_face;
+    p.num_vertices = 3 * p.num_faces;
+  }
+  SourceMaterial merged;
+  merged.base_color_texture.uri = "*0";
+  merged.base_color_texture.image = atlas;
+  m.materials = {merged};  // metallic 1, roughness 1: glTF's defaults
+  anonymize_names(m);
+  return m;
+}
+
+std::string write_atlas_obj(const Model& model, const std::string& dir, const std::string& name) {
+  const Mesh& mesh = model.mesh;
+  std::ostringstream obj;
+  obj << "mtllib " << name << ".mtl\n";
+  for (const Eigen::Vector3f& p : mesh.positions) obj << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+  for (const Eigen::Vector2f& uv : mesh.uvs) obj << "vt " << uv.x() << " " << 1.f - uv.y() << "\n";  // OBJ: v up
+  obj << "usemtl material_0\n";
+  for (const Eigen::Vector3i& t : mesh.triangles)
+    obj << "f " << t[0] + 1 << "/" << t[0] + 1 << " " << t[1] + 1 << "/" << t[1] + 1 << " " << t[2] + 1 << "/"
+        << t[2] + 1 << "\n";
+  write_file(dir + "/" + name + ".obj", obj.str());
+  write_file(dir + "/" + name + ".mtl", "newmtl material_0\nKd 1 1 1\nmap_Kd " + name + ".png\n");
+  EXPECT_TRUE(write_image(dir + "/" + name + ".png", *model.materials.at(0).base_color_texture.image).ok());
+  return dir + "/" + name + ".obj";
 }
 
 }  // namespace g2p::test

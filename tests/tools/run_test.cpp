@@ -12,9 +12,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
+#include "g2p/io.h"
+#include "segment/segment_fixtures.h"
 #include "support/test_data.h"
 #include "support/tool_run.h"
 
@@ -281,6 +284,24 @@ TEST_P(ToolRunSignal, CancelsAndWritesNothing) {
 
 // Ctrl-C, and TERM as `timeout`, CI runners and containers send it.
 INSTANTIATE_TEST_SUITE_P(IntAndTerm, ToolRunSignal, ::testing::Values(SIGINT, SIGTERM));
+
+// A real multi-material chair merged into one material with a baked colour
+// atlas and no names, as image-to-3D generators emit it: with `--segmenter
+// hybrid`, `g2p run` finds more than one material (issue #31).
+TEST(ToolRun, HybridDecomposesAGeneratedLookingMesh) {
+  const std::string dir = test::scratch_dir("ToolRunGenerated");
+  Result<Model> chair = load_model(test::asset_path("SheenChair"));
+  ASSERT_TRUE(chair.ok()) << chair.status().to_string();
+  const std::string obj = test::write_atlas_obj(test::one_atlas_material(*chair), dir, "chair");
+  test::ToolRun r = test::run_tool("run " + test::quote(obj) + " --up z --segmenter hybrid -o " +
+                                   test::quote(dir + "/out") + kQuick + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  std::set<std::string> materials;
+  for (const auto& part : j["parts"]) materials.insert(part["material"].get<std::string>());
+  EXPECT_GE(materials.size(), 2u) << j["parts"].dump();
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+}
 
 TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {
   test::ToolRun r = test::run_tool("run --help");

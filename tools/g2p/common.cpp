@@ -104,11 +104,13 @@ Result<std::vector<View>> render_with_flags(const std::string& command, const Mo
 }
 
 void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args) {
-  cmd->add_option("--segmenter", args.name, "Segmenter backend: pbr (default), learned, auto, onnx, oracle");
+  cmd->add_option("--segmenter", args.name, "Segmenter backend: pbr (default), hybrid, learned, auto, onnx, oracle");
   cmd->add_option(
       "--set", args.settings,
       "Segmenter setting KEY=VALUE, repeatable (onnx: model_card=FILE, flip=on|off; learned, auto: the same and "
-      "names=T|off, pbr=on|off; oracle: labels=FILE, key=NAME; pbr: names=on|off, temperature=T)");
+      "names=T|off, pbr=on|off; hybrid: model_card, flip, names, share=S, prior=W, scope=model|material; oracle: "
+      "labels=FILE, key=NAME; "
+      "pbr: names=on|off, temperature=T)");
 }
 
 Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,

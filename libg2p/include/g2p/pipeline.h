@@ -91,7 +91,9 @@ struct PipelineOptions {
   ViewOptions views;
   RenderOptions render;
 
-  // 2. segment: "pbr" (weight-free default), "onnx", "oracle", or a user's.
+  // 2. segment: "pbr" (weight-free default), "hybrid" (`pbr` on per-part
+  //    materials, the network where one material covers several parts),
+  //    "learned", "onnx", "oracle", or a user's (docs/segment.md).
   BackendChoice segmenter{"pbr", {}};
 
   // 3. project: votes, flood fill and parts.

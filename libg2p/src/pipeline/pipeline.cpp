@@ -11,6 +11,7 @@
 
 #include "g2p/pipeline.h"
 #include "pipeline/stage_clock.h"
+#include "segment/backends.h"
 
 namespace g2p {
 
@@ -195,6 +196,9 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   {
     detail::StageClock clock(Stage::kSegment, segmenter.backend(o.segmenter), reset);
     G2P_RETURN_IF_ERROR(segmenter.get()->set_model(r.model, r.table).with_context("segment"));
+    // A built-in backend that degraded (the default falls back to `pbr` without its network) says why.
+    if (const auto* notes = dynamic_cast<const detail::SegmenterWarnings*>(segmenter.get()))
+      for (const std::string& w : notes->warnings()) r.warnings.push_back("segment: " + w);
     const std::size_t n = r.views.size();
     r.label_maps.resize(n);
     for (std::size_t i = 0; i < n; ++i) {

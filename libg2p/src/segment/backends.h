@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "g2p/segment.h"
@@ -14,6 +15,7 @@ std::unique_ptr<Segmenter> make_onnx_segmenter();
 std::unique_ptr<Segmenter> make_oracle_segmenter();
 std::unique_ptr<Segmenter> make_learned_segmenter();
 std::unique_ptr<Segmenter> make_auto_segmenter();
+std::unique_ptr<Segmenter> make_hybrid_segmenter();
 
 namespace detail {
 
@@ -37,6 +39,32 @@ struct NameScores {
   std::vector<std::vector<float>> mesh;      // [source mesh][class]; empty rows for meshes no primitive names
 };
 NameScores pbr_name_scores(const Model& model, const MaterialTable& table);
+
+// The card of the network libg2p ships (g2p-materials.json in $G2P_MODEL_DIR,
+// the source tree's libg2p/data/models or the installed share/g2p/models), or
+// "" when none is found.
+std::string shipped_model_card();
+
+// Whether an author set the material's PBR values: read from a format with PBR
+// materials, and not glTF's defaults (a metallic-roughness texture,
+// transmission, or metallic/roughness other than (1, 1)). An OBJ's metallic 0
+// and roughness from its Phong exponent are the importer's, not evidence.
+bool pbr_authored(const SourceMaterial& material);
+
+// Per face (empty without face provenance): its names name a class, read as
+// `pbr` reads them (pbr_name_scores): its material's and its mesh's scores
+// summed, one class reaching kPbrNameWeight x `threshold` and no other above
+// kPbrNameWeight x 0.5.
+std::vector<char> faces_named(const Model& model, const MaterialTable& table, double threshold);
+
+// Implemented by built-in segmenters that can degrade (the default `hybrid`
+// falls back to `pbr` when its network cannot run). The pipeline adds these
+// to PipelineResult::warnings after set_model.
+class SegmenterWarnings {
+ public:
+  virtual ~SegmenterWarnings() = default;
+  virtual std::vector<std::string> warnings() const = 0;  // of the last configure and set_model
+};
 
 }  // namespace detail
 

@@ -40,7 +40,10 @@ namespace {
 
 constexpr const char* kShippedCard = "g2p-materials.json";
 
-// The shipped network's card, or "" when none is found.
+}  // namespace
+
+namespace detail {
+
 std::string shipped_model_card() {
   std::vector<std::string> dirs;
   if (const char* env = std::getenv("G2P_MODEL_DIR"); env != nullptr && *env != '\0') dirs.emplace_back(env);
@@ -57,6 +60,39 @@ std::string shipped_model_card() {
   }
   return {};
 }
+
+bool pbr_authored(const SourceMaterial& mat) {
+  return mat.pbr_from_file && (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f ||
+                               mat.metallic < 1.f || mat.roughness < 1.f);
+}
+
+std::vector<char> faces_named(const Model& model, const MaterialTable& table, double threshold) {
+  const NameScores scores = pbr_name_scores(model, table);
+  const Mesh& mesh = model.mesh;
+  const int k = table.size();
+  std::vector<float> sum(static_cast<std::size_t>(k));
+  std::vector<char> named(
+      mesh.face_source.size() == static_cast<std::size_t>(mesh.num_faces()) ? mesh.face_source.size() : 0, 0);
+  for (std::size_t f = 0; f < named.size(); ++f) {
+    const FaceSource& src = mesh.face_source[f];
+    std::fill(sum.begin(), sum.end(), 0.f);
+    if (src.material >= 0 && src.material < static_cast<int>(model.materials.size()))
+      for (int c = 0; c < k; ++c) sum[c] += scores.material[static_cast<std::size_t>(src.material)][c];
+    if (src.mesh >= 0 && static_cast<std::size_t>(src.mesh) < scores.mesh.size() &&
+        scores.mesh[static_cast<std::size_t>(src.mesh)].size() == sum.size())
+      for (int c = 0; c < k; ++c) sum[c] += scores.mesh[static_cast<std::size_t>(src.mesh)][c];
+    const auto top = std::max_element(sum.begin(), sum.end());
+    if (top == sum.end() || *top < kPbrNameWeight * threshold) continue;
+    bool alone = true;
+    for (auto c = sum.begin(); c != sum.end(); ++c) alone &= c == top || *c <= kPbrNameWeight * 0.5f;
+    named[f] = alone;
+  }
+  return named;
+}
+
+}  // namespace detail
+
+namespace {
 
 class LearnedSegmenter final : public Segmenter {
  public:
@@ -83,7 +119,7 @@ class LearnedSegmenter final : public Segmenter {
       }
     }
     if (network.count("model_card") == 0) {
-      const std::string card = shipped_model_card();
+      const std::string card = detail::shipped_model_card();
       if (card.empty()) return Status::Ok();  // set_model says what is missing
       network["model_card"] = card;
     }
@@ -101,41 +137,14 @@ class LearnedSegmenter final : public Segmenter {
     // quarter), plus 0.7 of that weight for the mesh and node names, in
     // `pbr`'s score units (4 per unit of evidence). A face is named when one
     // class reaches 4 x `names` and no other exceeds 4 x 0.5.
-    const detail::NameScores scores = detail::pbr_name_scores(model, table);
     std::vector<char> authored(model.materials.size(), 0);
-    for (std::size_t m = 0; m < model.materials.size(); ++m) {
-      const SourceMaterial& mat = model.materials[m];
-      // PBR values an author set: read from a file that has PBR materials, and
-      // not glTF's defaults (a metallic-roughness texture, transmission, or
-      // metallic/roughness other than (1, 1)). An OBJ's metallic 0 and its
-      // roughness from the Phong exponent are the importer's, not evidence.
-      authored[m] = trust_pbr_ && mat.pbr_from_file &&
-                    (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f || mat.metallic < 1.f ||
-                     mat.roughness < 1.f);
-    }
-    const Mesh& mesh = model.mesh;
-    const int k = table.size();
-    std::vector<float> sum(static_cast<std::size_t>(k));
-    named_.assign(mesh.face_source.size() == static_cast<std::size_t>(mesh.num_faces()) ? mesh.face_source.size() : 0,
-                  0);
+    for (std::size_t m = 0; m < model.materials.size(); ++m)
+      authored[m] = trust_pbr_ && detail::pbr_authored(model.materials[m]);
+    named_ = detail::faces_named(model, table, threshold_);
     for (std::size_t f = 0; f < named_.size(); ++f) {
-      const FaceSource& src = mesh.face_source[f];
-      const bool has_material = src.material >= 0 && src.material < static_cast<int>(model.materials.size());
-      if (has_material && authored[static_cast<std::size_t>(src.material)]) {
+      const int material = model.mesh.face_source[f].material;
+      if (material >= 0 && material < static_cast<int>(authored.size()) && authored[static_cast<std::size_t>(material)])
         named_[f] = 1;
-        continue;
-      }
-      std::fill(sum.begin(), sum.end(), 0.f);
-      if (has_material)
-        for (int c = 0; c < k; ++c) sum[c] += scores.material[static_cast<std::size_t>(src.material)][c];
-      if (src.mesh >= 0 && static_cast<std::size_t>(src.mesh) < scores.mesh.size() &&
-          scores.mesh[static_cast<std::size_t>(src.mesh)].size() == sum.size())
-        for (int c = 0; c < k; ++c) sum[c] += scores.mesh[static_cast<std::size_t>(src.mesh)][c];
-      const auto top = std::max_element(sum.begin(), sum.end());
-      if (top == sum.end() || *top < detail::kPbrNameWeight * threshold_) continue;
-      bool alone = true;
-      for (auto c = sum.begin(); c != sum.end(); ++c) alone &= c == top || *c <= detail::kPbrNameWeight * 0.5f;
-      named_[f] = alone;
     }
     // Every face named or authored: the network's labels would be replaced
     // everywhere. `auto`: any face is, and `pbr` labels the whole model; none

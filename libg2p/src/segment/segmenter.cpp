@@ -25,6 +25,7 @@ Registry<Segmenter>& segmenter_registry() {
     (void)r->add("oracle", &make_oracle_segmenter);
     (void)r->add("learned", &make_learned_segmenter);
     (void)r->add("auto", &make_auto_segmenter);
+    (void)r->add("hybrid", &make_hybrid_segmenter);
     return r;
   }();
   return *registry;

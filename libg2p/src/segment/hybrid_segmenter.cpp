@@ -1,0 +1,214 @@
+// The `hybrid` segmenter, the pipeline's default: `pbr` where a model's
+// materials are its parts, the network libg2p ships where one material covers
+// several parts (issue #31), as image-to-3D meshes arrive: one material with a
+// baked base-colour atlas, no names, and metallic at glTF's default or one
+// scalar for the whole object.
+//
+// The rule, per face (docs/segment.md, "hybrid"):
+//  1. its names name a class (read as `pbr` and `learned` read them): `pbr`;
+//  2. no face of the model is named (scope=model, the default; with
+//     scope=material, this face's names only) and its material covers
+//     several parts, that is it covers at least `share`
+//     of the model's surface area (faces without a material count as one
+//     material): the network decides; when that material's PBR values were
+//     authored, `pbr`'s probabilities for the pixel, raised to `prior`, weigh
+//     the network's (a prior, never the decision on its own);
+//  3. its material's PBR values were authored, or some face of the model is
+//     named: `pbr` (per-part materials, as the default always read them);
+//  4. otherwise (nothing named or authored anywhere): the network.
+// A model whose every face falls under 1 or 3 is labelled by `pbr` alone and
+// the network is neither loaded nor run.
+//
+// When the network cannot run (no card found, a card or network file that
+// cannot be read or loaded), the backend labels everything as `pbr` does and
+// says why in warnings() (the pipeline reports it in PipelineResult::warnings).
+//
+// Settings: model_card = FILE, flip = on|off (as `learned`); share, prior and
+// names (HybridOptions).
+#include <algorithm>
+#include <cmath>
+
+#include "core/settings.h"
+#include "segment/backends.h"
+
+namespace g2p {
+namespace {
+
+struct HybridOptions {
+  // Share of the model's surface area (0 to 1) at or above which an unnamed
+  // material is taken to cover more than one physical part. 0.5: a material
+  // that is most of the object is rarely one part of it; per-part assets
+  // spread their area over several materials.
+  double share = 0.5;
+  // Exponent (0 to 1) on `pbr`'s probabilities of a several-part material
+  // whose PBR was authored, multiplied into the network's: 0 = the network
+  // alone, 1 = both count the same.
+  double prior = 0.5;
+  // Name-evidence threshold (0 to 1] for a face's names to name a class, as
+  // `learned`'s names setting; 2 = names never decide.
+  double names = 0.9;
+  // Where names count (scope=model|material): `model` reads a model of which
+  // any face is named with `pbr` throughout (a curated asset: its unnamed
+  // materials are parts too), and leaves rule 2 to models nothing names, as
+  // generated meshes come; `material` applies rule 2 per material, named
+  // model or not (the first candidate, docs/accuracy.md).
+  bool model_scope = true;
+};
+
+class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings {
+ public:
+  Status configure(const BackendSettings& settings) override {
+    BackendSettings network;
+    HybridOptions o;
+    for (const auto& [key, value] : settings) {
+      double v = 0;
+      const bool number = detail::parse_double(value, v);
+      if (key == "model_card" || (key == "flip" && (value == "on" || value == "off"))) {
+        network[key] = value;
+      } else if (key == "share" && number && v > 0 && v <= 1) {
+        o.share = v;
+      } else if (key == "prior" && number && v >= 0 && v <= 1) {
+        o.prior = v;
+      } else if (key == "names" && (value == "off" || (number && v > 0 && v <= 1))) {
+        o.names = value == "off" ? 2.0 : v;
+      } else if (key == "scope" && (value == "model" || value == "material")) {
+        o.model_scope = value == "model";
+      } else {
+        return Status::InvalidArgument("hybrid: bad setting " + key + "=" + value +
+                                       " (known: model_card=FILE, flip=on|off, share=(0,1], prior=[0,1], "
+                                       "names=(0,1]|off, scope=model|material)");
+      }
+    }
+    options_ = o;
+    warnings_.clear();
+    network_.reset();
+    if (network.count("model_card") == 0) {
+      const std::string card = detail::shipped_model_card();
+      if (card.empty()) {
+        warnings_.push_back(
+            "hybrid: the shipped network's card g2p-materials.json was not found ($G2P_MODEL_DIR, the source tree, "
+            "share/g2p/models); every material is labelled as 'pbr' labels it");
+        return Status::Ok();
+      }
+      network["model_card"] = card;
+    }
+    std::unique_ptr<Segmenter> net = detail::make_deferred_onnx_segmenter();
+    if (const Status s = net->configure(network); !s.ok()) {  // a card or network file missing or unreadable
+      warnings_.push_back("hybrid: the network cannot run (" + s.message() +
+                          "); every material is labelled as 'pbr' labels it");
+      return Status::Ok();
+    }
+    network_ = std::move(net);
+    return Status::Ok();
+  }
+
+  Status set_model(const Model& model, const MaterialTable& table) override {
+    model_ = nullptr;
+    G2P_RETURN_IF_ERROR(pbr_->set_model(model, table));
+    decide_faces(model, table);
+    use_network_ =
+        network_ != nullptr && std::any_of(by_network_.begin(), by_network_.end(), [](char n) { return n != 0; });
+    if (use_network_) {
+      if (const Status s = network_->set_model(model, table); !s.ok()) {
+        warnings_.push_back("hybrid: the network cannot run (" + s.message() +
+                            "); every material is labelled as 'pbr' labels it");
+        network_.reset();
+        use_network_ = false;
+      }
+    }
+    model_ = &model;
+    return Status::Ok();
+  }
+
+  Status segment_into(const View& view, LabelMap& out) const override {
+    if (model_ == nullptr) return Status::InvalidArgument("hybrid: set_model first");
+    if (!use_network_) return pbr_->segment_into(view, out);
+    G2P_RETURN_IF_ERROR(network_->segment_into(view, out));
+    const bool any_pbr = std::any_of(by_network_.begin(), by_network_.end(), [](char n) { return n != 1; });
+    if (!any_pbr) return Status::Ok();
+    LabelMap by_pbr;
+    G2P_RETURN_IF_ERROR(pbr_->segment_into(view, by_pbr));
+    const bool probabilities = !out.probabilities.empty() && !by_pbr.probabilities.empty() &&
+                               out.probabilities.channels() == by_pbr.probabilities.channels();
+    const int k = probabilities ? out.probabilities.channels() : 0;
+    for (int y = 0; y < view.face_id.height(); ++y)
+      for (int x = 0; x < view.face_id.width(); ++x) {
+        const int f = view.face_id.at(x, y);
+        if (f < 0) continue;
+        const char how = f < static_cast<int>(by_network_.size()) ? by_network_[static_cast<std::size_t>(f)] : 0;
+        if (how == 1) continue;  // the network alone
+        if (how == 0 || !probabilities) {
+          out.labels.at(x, y) = by_pbr.labels.at(x, y);
+          if (probabilities) std::copy_n(by_pbr.probabilities.pixel(x, y), k, out.probabilities.pixel(x, y));
+          continue;
+        }
+        // how == 2: the network weighed by `pbr`'s probabilities raised to `prior`.
+        float* p = out.probabilities.pixel(x, y);
+        const float* q = by_pbr.probabilities.pixel(x, y);
+        double total = 0;
+        for (int c = 0; c < k; ++c) {
+          p[c] *= static_cast<float>(std::pow(std::max(q[c], 1e-6f), options_.prior));
+          total += p[c];
+        }
+        if (total <= 0) continue;
+        int best = 0;
+        for (int c = 0; c < k; ++c) {
+          p[c] = static_cast<float>(p[c] / total);
+          if (p[c] > p[best]) best = c;
+        }
+        out.labels.at(x, y) = best;
+      }
+    return Status::Ok();
+  }
+
+  std::vector<std::string> warnings() const override { return warnings_; }
+
+ private:
+  // by_network_ per face: 0 = `pbr`, 1 = the network, 2 = the network with
+  // `pbr` as a prior.
+  void decide_faces(const Model& model, const MaterialTable& table) {
+    const Mesh& mesh = model.mesh;
+    const std::vector<char> named = detail::faces_named(model, table, options_.names);
+    by_network_.assign(named.size(), 0);
+    if (named.empty()) {  // no provenance: one material over everything
+      by_network_.assign(static_cast<std::size_t>(mesh.num_faces()), 1);
+      return;
+    }
+    // Area per material; slot 0 holds the faces without one.
+    const std::size_t n = model.materials.size();
+    std::vector<double> area(n + 1, 0.0);
+    double total = 0;
+    const auto slot = [&](int m) { return m >= 0 && m < static_cast<int>(n) ? static_cast<std::size_t>(m) + 1 : 0; };
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const double a = face_area(mesh, f);
+      area[slot(mesh.face_source[static_cast<std::size_t>(f)].material)] += a;
+      total += a;
+    }
+    const bool any_named = std::any_of(named.begin(), named.end(), [](char c) { return c != 0; });
+    for (std::size_t f = 0; f < named.size(); ++f) {
+      if (named[f]) continue;  // 1: names decide
+      const int m = mesh.face_source[f].material;
+      const bool authored = slot(m) > 0 && detail::pbr_authored(model.materials[static_cast<std::size_t>(m)]);
+      if (options_.model_scope && any_named) continue;  // 3: a curated asset: `pbr`
+      if (total > 0 && area[slot(m)] >= options_.share * total)
+        by_network_[f] = authored && options_.prior > 0 ? 2 : 1;  // 2: several parts
+      else if (!authored && !any_named)
+        by_network_[f] = 1;  // 4: nothing speaks anywhere
+      // else 3: a per-part material: `pbr`
+    }
+  }
+
+  HybridOptions options_;
+  std::unique_ptr<Segmenter> network_;  // null when it cannot run
+  std::unique_ptr<Segmenter> pbr_ = make_pbr_segmenter();
+  std::vector<std::string> warnings_;  // why the network cannot run; kept for every later model
+  const Model* model_ = nullptr;
+  std::vector<char> by_network_;
+  bool use_network_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Segmenter> make_hybrid_segmenter() { return std::make_unique<HybridSegmenter>(); }
+
+}  // namespace g2p

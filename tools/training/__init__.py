@@ -27,6 +27,7 @@ LAYERS = (
     # validation scores
     "metrics",
     "colour_baseline",
+    "val_labels",
     # export: what a run writes, int8 weights, weights recovered from an export, run folders read back as networks
     "export",
     "quantize",

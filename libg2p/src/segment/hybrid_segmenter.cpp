@@ -1,4 +1,4 @@
-// The `hybrid` segmenter, the pipeline's default: `pbr` where a model's
+// The `hybrid` segmenter (`--segmenter hybrid`; not the default, docs/accuracy.md): `pbr` where a model's
 // materials are its parts, the network libg2p ships where one material covers
 // several parts (issue #31), as image-to-3D meshes arrive: one material with a
 // baked base-colour atlas, no names, and metallic at glTF's default or one

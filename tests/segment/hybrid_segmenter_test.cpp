@@ -158,5 +158,102 @@ TEST(HybridSegmenter, AMeshWithoutUvsOrMaterialsGetsTheNetwork) {
   EXPECT_GT(acc, old_acc) << "hybrid " << acc << ", pbr " << old_acc;
 }
 
+// Share of the object's pixels, over 3 views, that `hybrid` with `settings`
+// labels as `pbr` does (1 = `pbr`'s labels throughout).
+double share_labelled_as_pbr(const Model& model, const BackendSettings& settings) {
+  const MaterialTable& table = MaterialTable::paper_default();
+  auto hybrid = make_segmenter("hybrid", settings);
+  auto pbr = make_segmenter("pbr");
+  if (!hybrid.ok() || !pbr.ok()) return -1;
+  if (!(*hybrid)->set_model(model, table).ok() || !(*pbr)->set_model(model, table).ok()) return -1;
+  double same = 0, total = 0;
+  for (const View& v : test::render(model, 3, 96)) {
+    Result<LabelMap> a = (*hybrid)->segment(v), b = (*pbr)->segment(v);
+    if (!a.ok() || !b.ok()) return -1;
+    for (int y = 0; y < v.face_id.height(); ++y)
+      for (int x = 0; x < v.face_id.width(); ++x) {
+        if (v.face_id.at(x, y) < 0) continue;
+        total += 1;
+        same += a->labels.at(x, y) == b->labels.at(x, y);
+      }
+  }
+  return total > 0 ? same / total : -1;
+}
+
+// The candidate-4 settings (docs/accuracy.md): one material over the whole
+// object, read per region only when an image can show its regions.
+const BackendSettings kWholeWithColour = {{"share", "0.99"}, {"colour", "on"}, {"unnamed", "pbr"}};
+
+TEST(HybridSegmenter, ColourOnLeavesAFlatColouredMaterialToPbr) {
+  const Chair& chair = sheen_chair();
+  ASSERT_FALSE(chair.truth.empty());
+  // The atlas goes to the network under either setting.
+  EXPECT_LT(share_labelled_as_pbr(chair.merged, kWholeWithColour), 0.9);
+  // One flat colour (no texture): no image can tell its parts apart, so
+  // colour=on reads it as `pbr` does; colour=off still gives it to the network.
+  Model flat = chair.merged;
+  flat.materials[0].base_color_texture = Texture{};
+  flat.materials[0].base_color = Eigen::Vector4f(0.55f, 0.4f, 0.25f, 1.f);
+  EXPECT_EQ(share_labelled_as_pbr(flat, kWholeWithColour), 1.0);
+  EXPECT_LT(share_labelled_as_pbr(flat, {{"share", "0.99"}, {"colour", "off"}}), 0.9);
+  // No colour at all (the importer's default: white, untextured): the
+  // network, as `pbr` has nothing to read either.
+  Model plain = flat;
+  plain.materials[0].base_color = Eigen::Vector4f::Ones();
+  EXPECT_LT(share_labelled_as_pbr(plain, kWholeWithColour), 0.9);
+}
+
+TEST(HybridSegmenter, AtlasChartsTellsABakedAtlasFromAHandMadeLayout) {
+  // A real TRELLIS output (data/generated, MIT): one material, a baked atlas
+  // of 57 UV charts, no names.
+  Result<Model> trellis = load_model(test::source_path("data/generated/models/trellis_shell_chair.glb"));
+  ASSERT_TRUE(trellis.ok()) << trellis.status().to_string();
+  ASSERT_EQ(trellis->materials.size(), 1u);
+  BackendSettings settings = kWholeWithColour;
+  settings["atlas_charts"] = "16";
+  EXPECT_LT(share_labelled_as_pbr(*trellis, settings), 0.9);
+  // Asked for more charts than its layout has, it counts as a hand-made
+  // texture on one part, and `pbr` reads it.
+  settings["atlas_charts"] = "58";
+  EXPECT_EQ(share_labelled_as_pbr(*trellis, settings), 1.0);
+  settings["atlas_charts"] = "57";
+  EXPECT_LT(share_labelled_as_pbr(*trellis, settings), 0.9);
+  EXPECT_EQ(make_segmenter("hybrid", {{"atlas_charts", "1.5"}}).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(HybridSegmenter, ScopeSaysWhetherANamedModelsUnnamedMaterialGoesToTheNetwork) {
+  const Chair& chair = sheen_chair();
+  ASSERT_FALSE(chair.truth.empty());
+  // The atlas chair with a few faces given a second material whose name
+  // names a class: the model is now named somewhere.
+  Model named = chair.merged;
+  SourceMaterial oak = named.materials[0];
+  oak.name = "oak wood";
+  oak.base_color_texture = Texture{};
+  named.materials.push_back(oak);
+  const int marked = std::max(1, named.mesh.num_faces() / 50);
+  for (int f = 0; f < marked; ++f) named.mesh.face_source[static_cast<std::size_t>(f)].material = 1;
+  // scope=model (the default): a named model is read by `pbr` throughout.
+  EXPECT_EQ(share_labelled_as_pbr(named, {{"scope", "model"}}), 1.0);
+  // scope=material: the large unnamed atlas still goes to the network.
+  EXPECT_LT(share_labelled_as_pbr(named, {{"scope", "material"}}), 0.9);
+  EXPECT_EQ(make_segmenter("hybrid", {{"scope", "object"}}).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(HybridSegmenter, UnnamedSaysWhetherAModelNothingNamesGoesToTheNetwork) {
+  // Several flat-coloured materials, none covering most of the surface, no
+  // names, PBR not authored (as an OBJ's Phong materials): rule 4.
+  Model boxes = test::boxes({{"", {0.8f, 0.1f, 0.1f, 1.f}, 1.f, 1.f},
+                             {"", {0.1f, 0.2f, 0.8f, 1.f}, 1.f, 1.f},
+                             {"", {0.9f, 0.9f, 0.2f, 1.f}, 1.f, 1.f}},
+                            "hybrid_unnamed");
+  ASSERT_EQ(boxes.materials.size(), 3u);
+  anonymize_names(boxes);
+  for (SourceMaterial& m : boxes.materials) m.pbr_from_file = false;
+  EXPECT_EQ(share_labelled_as_pbr(boxes, {{"unnamed", "pbr"}}), 1.0);
+  EXPECT_LT(share_labelled_as_pbr(boxes, {{"unnamed", "network"}}), 1.0);
+  EXPECT_EQ(make_segmenter("hybrid", {{"unnamed", "yes"}}).status().code(), StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace g2p

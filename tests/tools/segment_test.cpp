@@ -55,6 +55,27 @@ TEST(ToolSegment, BadSegmenterArguments) {
   EXPECT_EQ(run_tool("segment " + hammer + " -o /tmp/x --segmenter onnx").exit_code, 2);  // no model card
 }
 
+// A backend that degrades (`hybrid` without its network) says so in both
+// tools, once per run, and goes on as `pbr`.
+TEST(ToolSegment, ADegradedBackendSaysSoInSegmentAndEval) {
+  const std::string dir = test::scratch_dir("ToolSegment.Degraded");
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  const std::string no_card = " --segmenter hybrid --set model_card=" + quote(dir + "/missing/g2p-materials.json");
+  test::ToolRun r =
+      run_tool("segment " + hammer + " -o " + quote(dir + "/out") + " --views 1 --resolution 32" + no_card);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("g2p segment: warning: hybrid: the network cannot run"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("missing/g2p-materials.json"), std::string::npos) << r.err;
+
+  r = run_tool("eval seg --assets " + quote(std::filesystem::path(test::labels_json_path()).parent_path().string()) +
+               " --models Avocado SheenChair --views 1 --resolution 32" + no_card);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string warning = "g2p eval seg: warning: hybrid: the network cannot run";
+  const std::size_t first = r.err.find(warning);
+  ASSERT_NE(first, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(warning, first + 1), std::string::npos) << "said once: " << r.err;
+}
+
 // The eval tool's mIoU equals one computed here from independently counted pixels.
 TEST(ToolEval, ReproducesAHandComputedMeanIoU) {
   const std::string assets = test::scratch_dir("ToolEval.Assets");

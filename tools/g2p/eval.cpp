@@ -90,6 +90,7 @@ int run_eval_seg(const EvalArgs& args) {
   CalibrationBins calibration;
   nlohmann::json per_model = nlohmann::json::object();
   std::vector<ConfusionMatrix> model_matrices_3d;  // for the bootstrap interval
+  std::vector<std::string> warned;                 // the predictor's warnings shown so far
   for (const std::string& key : keys) {
     // A key that is a model file's path relative to `assets` (a generated
     // dataset's labels.json), else the shared assets' NAME/NAME.glb.
@@ -115,6 +116,12 @@ int run_eval_seg(const EvalArgs& args) {
       std::cerr << "g2p eval seg: error: " << key << ": " << s.to_string() << "\n";
       return kExitFailure;
     }
+    // A backend that degraded says why, once: its scores are not its own.
+    for (const std::string& w : (*predictor)->warnings())
+      if (std::find(warned.begin(), warned.end(), w) == warned.end()) {
+        std::cerr << "g2p eval seg: warning: " << w << "\n";
+        warned.push_back(w);
+      }
     ConfusionMatrix matrix(table->size());
     LabelMap truth, predicted;
     std::vector<LabelMap> predictions;

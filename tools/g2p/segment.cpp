@@ -35,6 +35,7 @@ int run_segment(const SegmentArgs& args) {
     std::cerr << "g2p segment: error: " << s.to_string() << "\n";
     return s.code() == StatusCode::kInvalidArgument ? kExitUsage : kExitFailure;
   }
+  for (const std::string& w : (*segmenter)->warnings()) std::cerr << "g2p segment: warning: " << w << "\n";
   std::vector<LabelMap> maps(views->size());
   for (std::size_t i = 0; i < views->size(); ++i) {
     if (Status s = (*segmenter)->segment_into((*views)[i], maps[i]); !s.ok()) {

@@ -43,6 +43,10 @@ class G2P_API Segmenter {
   // Labels one rendered view of that model: its RGB and, when present, its
   // face IDs and material buffers. Reuses `out`'s memory.
   virtual Status segment_into(const View& view, LabelMap& out) const = 0;
+  // What degraded since configure (a fallback taken, and why), for the caller
+  // to show; `hybrid` without its network labels as `pbr` and says so here.
+  // The pipeline adds them to PipelineResult::warnings. Default: none.
+  virtual std::vector<std::string> warnings() const;
 
   // Convenience: a new LabelMap.
   Result<LabelMap> segment(const View& view) const;

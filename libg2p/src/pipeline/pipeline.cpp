@@ -196,9 +196,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   {
     detail::StageClock clock(Stage::kSegment, segmenter.backend(o.segmenter), reset);
     G2P_RETURN_IF_ERROR(segmenter.get()->set_model(r.model, r.table).with_context("segment"));
-    // A built-in backend that degraded (`hybrid` falls back to `pbr` without its network) says why.
-    if (const auto* notes = dynamic_cast<const detail::SegmenterWarnings*>(segmenter.get()))
-      for (const std::string& w : notes->warnings()) r.warnings.push_back("segment: " + w);
+    // A backend that degraded (`hybrid` falls back to `pbr` without its network) says why.
+    for (const std::string& w : segmenter.get()->warnings()) r.warnings.push_back("segment: " + w);
     const std::size_t n = r.views.size();
     r.label_maps.resize(n);
     for (std::size_t i = 0; i < n; ++i) {

@@ -57,15 +57,6 @@ bool pbr_authored(const SourceMaterial& material);
 // kPbrNameWeight x 0.5.
 std::vector<char> faces_named(const Model& model, const MaterialTable& table, double threshold);
 
-// Implemented by built-in segmenters that can degrade (`hybrid`
-// falls back to `pbr` when its network cannot run). The pipeline adds these
-// to PipelineResult::warnings after set_model.
-class SegmenterWarnings {
- public:
-  virtual ~SegmenterWarnings() = default;
-  virtual std::vector<std::string> warnings() const = 0;  // of the last configure and set_model
-};
-
 }  // namespace detail
 
 }  // namespace g2p

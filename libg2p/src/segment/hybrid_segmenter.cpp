@@ -27,8 +27,10 @@
 // names (HybridOptions).
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "core/settings.h"
+#include "g2p/project.h"
 #include "segment/backends.h"
 
 namespace g2p {
@@ -53,9 +55,25 @@ struct HybridOptions {
   // generated meshes come; `material` applies rule 2 per material, named
   // model or not (the first candidate, docs/accuracy.md).
   bool model_scope = true;
+  // colour=on|off: whether rule 2 also needs the image to be able to show the
+  // material's regions: its base colour varies over the surface (a base-colour
+  // texture) or there is no colour to read at all (no material, or the
+  // importer's default: white, untextured, PBR not authored). A flat-coloured
+  // material is one part as far as any image can tell, and `pbr` reads it.
+  bool colour = false;
+  // With colour=on, the fewest UV charts (connected pieces of the material's
+  // surface whose shared edges carry the same UVs on both sides) for its
+  // texture to count as a baked atlas that shows regions. A hand-made layout
+  // has a few charts (a towel 2, a skirt 9); an atlas baked by an image-to-3D
+  // pipeline hundreds. 0 = any texture counts.
+  int atlas_charts = 0;
+  // unnamed=network|pbr: rule 4, whether a model that nothing names or
+  // authors goes to the network as a whole (`network`) or is read per
+  // material by `pbr`.
+  bool unnamed_network = true;
 };
 
-class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings {
+class HybridSegmenter final : public Segmenter {
  public:
   Status configure(const BackendSettings& settings) override {
     BackendSettings network;
@@ -73,10 +91,17 @@ class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings
         o.names = value == "off" ? 2.0 : v;
       } else if (key == "scope" && (value == "model" || value == "material")) {
         o.model_scope = value == "model";
+      } else if (key == "colour" && (value == "on" || value == "off")) {
+        o.colour = value == "on";
+      } else if (key == "atlas_charts" && number && v >= 0 && v <= 1e6 && v == std::floor(v)) {
+        o.atlas_charts = static_cast<int>(v);
+      } else if (key == "unnamed" && (value == "network" || value == "pbr")) {
+        o.unnamed_network = value == "network";
       } else {
-        return Status::InvalidArgument("hybrid: bad setting " + key + "=" + value +
-                                       " (known: model_card=FILE, flip=on|off, share=(0,1], prior=[0,1], "
-                                       "names=(0,1]|off, scope=model|material)");
+        return Status::InvalidArgument(
+            "hybrid: bad setting " + key + "=" + value +
+            " (known: model_card=FILE, flip=on|off, share=(0,1], prior=[0,1], "
+            "names=(0,1]|off, scope=model|material, colour=on|off, atlas_charts=N, unnamed=network|pbr)");
       }
     }
     options_ = o;
@@ -184,18 +209,81 @@ class HybridSegmenter final : public Segmenter, public detail::SegmenterWarnings
       area[slot(mesh.face_source[static_cast<std::size_t>(f)].material)] += a;
       total += a;
     }
+    // Per slot: can an image show the material's regions (colour=on)?
+    std::vector<char> shows_regions(n + 1, 1);
+    for (std::size_t m = 0; m < n; ++m) shows_regions[m + 1] = shows_regions_in_images(model.materials[m]);
+    if (options_.colour && options_.atlas_charts > 0 && mesh.has_uvs()) {
+      std::vector<char> textured_and_large(n + 1, 0);
+      for (std::size_t m = 0; m < n; ++m)
+        textured_and_large[m + 1] =
+            !model.materials[m].base_color_texture.empty() && total > 0 && area[m + 1] >= options_.share * total;
+      if (std::any_of(textured_and_large.begin(), textured_and_large.end(), [](char c) { return c != 0; })) {
+        const std::vector<int> charts = uv_charts_per_slot(mesh, n);
+        for (std::size_t k = 1; k <= n; ++k)
+          if (textured_and_large[k] && charts[k] < options_.atlas_charts) shows_regions[k] = 0;
+      }
+    }
     const bool any_named = std::any_of(named.begin(), named.end(), [](char c) { return c != 0; });
     for (std::size_t f = 0; f < named.size(); ++f) {
       if (named[f]) continue;  // 1: names decide
       const int m = mesh.face_source[f].material;
       const bool authored = slot(m) > 0 && detail::pbr_authored(model.materials[static_cast<std::size_t>(m)]);
       if (options_.model_scope && any_named) continue;  // 3: a curated asset: `pbr`
-      if (total > 0 && area[slot(m)] >= options_.share * total)
+      const bool several_parts =
+          total > 0 && area[slot(m)] >= options_.share * total && (!options_.colour || shows_regions[slot(m)] != 0);
+      if (several_parts)
         by_network_[f] = authored && options_.prior > 0 ? 2 : 1;  // 2: several parts
-      else if (!authored && !any_named)
+      else if (options_.unnamed_network && !authored && !any_named)
         by_network_[f] = 1;  // 4: nothing speaks anywhere
       // else 3: a per-part material: `pbr`
     }
+  }
+
+  // colour=on: a base-colour texture shows regions; so does no colour at all
+  // (the importer's default material), where `pbr` has nothing to read either.
+  static bool shows_regions_in_images(const SourceMaterial& mat) {
+    if (!mat.base_color_texture.empty()) return true;
+    const bool white = (mat.base_color.head<3>() - Eigen::Vector3f::Ones()).cwiseAbs().maxCoeff() < 1e-3f;
+    return white && !detail::pbr_authored(mat);
+  }
+
+  // UV charts per material slot (slot 0: faces without a material): faces of
+  // one material joined across every edge they share (welded positions) whose
+  // two ends carry the same UVs in both faces.
+  static std::vector<int> uv_charts_per_slot(const Mesh& mesh, std::size_t num_materials) {
+    std::vector<int> charts(num_materials + 1, 0);
+    Result<FaceGraph> graph = build_face_graph(mesh);
+    if (!graph.ok()) return charts;
+    const auto slot = [&](int f) {
+      const int m = mesh.face_source[static_cast<std::size_t>(f)].material;
+      return m >= 0 && static_cast<std::size_t>(m) < num_materials ? static_cast<std::size_t>(m) + 1 : 0;
+    };
+    std::vector<int> parent(static_cast<std::size_t>(mesh.num_faces()));
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto root = [&parent](int f) {
+      while (parent[static_cast<std::size_t>(f)] != f)
+        f = parent[static_cast<std::size_t>(f)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(f)])];
+      return f;
+    };
+    const std::vector<int>& welded = graph->welded_vertex;
+    for (int f = 0; f < mesh.num_faces(); ++f)
+      for (int k = graph->offsets[static_cast<std::size_t>(f)]; k < graph->offsets[static_cast<std::size_t>(f) + 1];
+           ++k) {
+        const int g = graph->neighbors[static_cast<std::size_t>(k)];
+        if (g <= f || slot(g) != slot(f)) continue;
+        int same = 0;  // corners of f with a corner of g at the same place and the same UV
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            const int a = mesh.triangles[static_cast<std::size_t>(f)][i];
+            const int b = mesh.triangles[static_cast<std::size_t>(g)][j];
+            same += welded[static_cast<std::size_t>(a)] == welded[static_cast<std::size_t>(b)] &&
+                    (mesh.uvs[static_cast<std::size_t>(a)] - mesh.uvs[static_cast<std::size_t>(b)]).norm() < 1e-5f;
+          }
+        if (same >= 2) parent[static_cast<std::size_t>(root(f))] = root(g);
+      }
+    for (int f = 0; f < mesh.num_faces(); ++f)
+      if (root(f) == f) ++charts[slot(f)];
+    return charts;
   }
 
   HybridOptions options_;

@@ -11,6 +11,8 @@ Status Segmenter::configure(const BackendSettings& settings) {
   return Status::InvalidArgument("this segmenter takes no settings (got '" + settings.begin()->first + "')");
 }
 
+std::vector<std::string> Segmenter::warnings() const { return {}; }
+
 Result<LabelMap> Segmenter::segment(const View& view) const {
   LabelMap out;
   G2P_RETURN_IF_ERROR(segment_into(view, out));

@@ -265,6 +265,52 @@ TEST(Exporters, KhronosValidatorFindsNoErrorInTheGlb) {
   EXPECT_NE(v.run.out.find(": 0 errors, 0 warnings"), std::string::npos) << v.run.out;
 }
 
+TEST(Exporters, GlbWritesVertexColoursAsColor0) {
+  SimulationAsset asset;
+  Model model;
+  std::vector<Part> parts;
+  asset = hammer_asset(kMetal, &model, &parts);
+  // A colour that varies with height and is never white.
+  auto colour_at = [](const Eigen::Vector3f& p) { return Eigen::Vector4f(0.2f + p.z(), 0.3f, 0.9f, 1.f); };
+  for (const Eigen::Vector3f& p : model.mesh.positions) model.mesh.colors.push_back(colour_at(p));
+  const std::string path = test::scratch_dir("ExportGlbColours") + "/hammer.glb";
+  ASSERT_TRUE(write_glb(path, model, parts, asset).ok());
+
+  // Part primitives carry COLOR_0 (VEC4 float, one per vertex); hull primitives do not.
+  const std::string bytes = test::read_file(path);
+  std::uint32_t json_length = 0;
+  std::memcpy(&json_length, bytes.data() + 12, 4);
+  const nlohmann::json doc = nlohmann::json::parse(bytes.substr(20, json_length));
+  int coloured = 0;
+  for (const auto& mesh : doc["meshes"])
+    for (const auto& prim : mesh["primitives"]) {
+      if (!prim["attributes"].contains("COLOR_0")) continue;
+      ++coloured;
+      const auto& a = doc["accessors"][prim["attributes"]["COLOR_0"].get<int>()];
+      EXPECT_EQ(a["type"], "VEC4");
+      EXPECT_EQ(a["componentType"], 5126);
+      EXPECT_EQ(a["count"], doc["accessors"][prim["attributes"]["POSITION"].get<int>()]["count"]);
+    }
+  EXPECT_EQ(coloured, 2);  // the head's and the handle's
+
+  // Read back (linear glTF colours, unchanged): each vertex has its colour, the hulls' are white.
+  Result<Model> back = load_model(path);
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  ASSERT_TRUE(back->mesh.has_colors());
+  int matched = 0;
+  for (int v = 0; v < back->mesh.num_vertices(); ++v) {
+    const Eigen::Vector4f& c = back->mesh.colors[static_cast<std::size_t>(v)];
+    if (c.isOnes()) continue;
+    ++matched;
+    EXPECT_TRUE(c.isApprox(colour_at(back->mesh.positions[static_cast<std::size_t>(v)]), 1e-4f))
+        << "vertex " << v << ": " << c.transpose();
+  }
+  EXPECT_GE(matched, 16);  // at least the head box's corners
+  const test::ValidatorRun validator = test::run_gltf_validator(path);
+  if (validator.available)
+    EXPECT_NE(validator.run.out.find(": 0 errors, 0 warnings"), std::string::npos) << validator.run.out;
+}
+
 TEST(Exporters, BadInputIsRefused) {
   const SimulationAsset asset = hammer_asset(kMetal);
   EXPECT_EQ(write_asset(test::scratch_dir("ExportBad"), asset, {"fbx"}).code(), StatusCode::kInvalidArgument);

@@ -1,8 +1,10 @@
 // Import of every supported format family, units, axes and triangulation.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <set>
 
@@ -12,6 +14,8 @@
 
 namespace g2p {
 namespace {
+
+namespace fs = std::filesystem;
 
 double volume(const Mesh& m) { return test::signed_volume(m.positions, m.triangles); }
 
@@ -147,6 +151,136 @@ TEST(ImportGlb, GeneratedHammerKeepsBothMaterials) {
   EXPECT_EQ(faces[0], 12);      // box head
   EXPECT_EQ(faces[1], 24 * 4);  // cylinder handle: sides and caps
   EXPECT_GT(volume(model->mesh), 0.0);
+}
+
+// sRGB-encoded to linear (IEC 61966-2-1), the reference the importer must match.
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+// An ASCII PLY of two unit squares side by side in the file's z = 0 plane,
+// x in [-1, 0] coloured `left` and x in [0, 1] coloured `right` (8-bit sRGB,
+// four vertices each).
+std::string two_colour_ply(const std::array<int, 3>& left, const std::array<int, 3>& right) {
+  std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 4\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  for (int half = 0; half < 2; ++half) {
+    const std::array<int, 3>& c = half == 0 ? left : right;
+    const int x0 = half - 1;
+    for (const auto& [x, y] : {std::pair{x0, -1}, {x0 + 1, -1}, {x0 + 1, 1}, {x0, 1}})
+      ply += std::to_string(x) + " " + std::to_string(y) + " 0 " + std::to_string(c[0]) + " " + std::to_string(c[1]) +
+             " " + std::to_string(c[2]) + "\n";
+  }
+  return ply + "3 0 1 2\n3 0 2 3\n3 4 5 6\n3 4 6 7\n";
+}
+
+TEST(ImportPly, VertexColoursAreReadPerVertexAsSrgbAndConvertedToLinear) {
+  const std::string dir = test::scratch_dir("ImportPly.VertexColours");
+  const std::array<int, 3> left{200, 30, 30}, right{30, 60, 230};
+  test::write_file(dir + "/halves.ply", two_colour_ply(left, right));
+  for (const bool isolate : {true, false}) {  // the child-process reader (the default) and in-process
+    ImportOptions options;
+    options.isolate_reader = isolate;
+    Result<Model> model = load_model(dir + "/halves.ply", options);
+    ASSERT_TRUE(model.ok()) << model.status().to_string();
+    const Mesh& mesh = model->mesh;
+    ASSERT_TRUE(mesh.has_colors()) << "isolate_reader " << isolate;
+    ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
+    ASSERT_EQ(mesh.num_vertices(), 8);
+    // Each triangle lies in one square; all its vertices carry that square's colour.
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
+      float cx = 0.f;
+      for (int k = 0; k < 3; ++k) cx += mesh.positions[static_cast<std::size_t>(t[k])].x() / 3.f;
+      const std::array<int, 3>& want = cx < 0.f ? left : right;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector4f& c = mesh.colors[static_cast<std::size_t>(t[k])];
+        for (int ch = 0; ch < 3; ++ch)
+          EXPECT_NEAR(c[ch], srgb_to_linear(want[static_cast<std::size_t>(ch)] / 255.f), 1e-4)
+              << "face " << f << " vertex " << t[k] << " channel " << ch << " isolate_reader " << isolate;
+        EXPECT_FLOAT_EQ(c[3], 1.f);  // no alpha in the file: opaque
+      }
+    }
+  }
+}
+
+TEST(ImportPly, DebianFloatColourPlyIsBlue) {
+  // assimp-testmodels' float-color.ply: one triangle, float RGBA (0, 0, 1, 1) at every vertex.
+  Result<Model> model = load_model(test::assimp_model("PLY/float-color.ply"));
+  ASSERT_TRUE(model.ok()) << model.status().to_string();
+  ASSERT_EQ(model->mesh.colors.size(), 3u);
+  for (const Eigen::Vector4f& c : model->mesh.colors)
+    EXPECT_TRUE(c.isApprox(Eigen::Vector4f(0, 0, 1, 1))) << c.transpose();
+}
+
+// Also: assimp 5.2 joins no vertices in a scene with colours (its join
+// ignores them), so the importer joins OBJ's per-corner vertices itself.
+TEST(ImportObj, VertexColoursAfterPositionsAreSrgbAndCornersAreJoined) {
+  const std::string dir = test::scratch_dir("ImportObj.VertexColours");
+  test::write_file(dir + "/quad.obj",
+                   "v 0 0 0 0.5 0 1\nv 1 0 0 0.5 0 1\nv 0 1 0 0.25 1 0\nv 1 1 0 0.25 1 0\nf 1 2 4\nf 1 4 3\n");
+  Result<Model> model = load_model(dir + "/quad.obj");
+  ASSERT_TRUE(model.ok()) << model.status().to_string();
+  ASSERT_EQ(model->mesh.num_faces(), 2);
+  EXPECT_EQ(model->mesh.num_vertices(), 4);  // the shared diagonal is one pair of vertices
+  ASSERT_EQ(model->mesh.colors.size(), model->mesh.positions.size());
+  for (int v = 0; v < model->mesh.num_vertices(); ++v) {
+    const bool green = model->mesh.positions[static_cast<std::size_t>(v)].z() > 0.5f;  // file y = 1 -> +Z
+    const Eigen::Vector4f want =
+        green ? Eigen::Vector4f(srgb_to_linear(0.25f), 1, 0, 1) : Eigen::Vector4f(srgb_to_linear(0.5f), 0, 1, 1);
+    EXPECT_TRUE(model->mesh.colors[static_cast<std::size_t>(v)].isApprox(want, 1e-5f))
+        << "vertex " << v << ": " << model->mesh.colors[static_cast<std::size_t>(v)].transpose();
+  }
+}
+
+// A .gltf with its .bin: one triangle with a float COLOR_0 of `components`
+// (3: VEC3, 4: VEC4) values per vertex, taken from `colors`.
+void write_coloured_gltf(const std::string& path, int components, const std::vector<Eigen::Vector4f>& colors) {
+  const float positions[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  std::string bin(reinterpret_cast<const char*>(positions), sizeof positions);
+  for (const Eigen::Vector4f& c : colors)
+    bin.append(reinterpret_cast<const char*>(c.data()), sizeof(float) * components);
+  const std::string name = fs::path(path).stem().string() + ".bin";
+  test::write_file(fs::path(path).replace_extension(".bin").string(), bin);
+  const std::string colour_bytes = std::to_string(bin.size() - sizeof positions);
+  test::write_file(path,
+                   R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}}]}],
+  "buffers": [{"uri": ")" +
+                       name + R"(", "byteLength": )" + std::to_string(bin.size()) + R"(}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                  {"buffer": 0, "byteOffset": 36, "byteLength": )" +
+                       colour_bytes + R"(}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC)" +
+                       std::to_string(components) + R"("}]})");
+}
+
+TEST(ImportGltf, Color0IsLinearAndVec3MeansOpaque) {
+  // glTF 2.0 §3.7.2.1 (Meshes, Overview): COLOR_0 is VEC3 or VEC4, linear,
+  // and multiplies the base colour.
+  const std::string dir = test::scratch_dir("ImportGltf.Color0");
+  const std::vector<Eigen::Vector4f> colors = {
+      {0.5f, 0.25f, 1.f, 0.75f}, {0.f, 1.f, 0.f, 0.5f}, {0.2f, 0.2f, 0.2f, 1.f}};
+  for (const int components : {3, 4}) {
+    const std::string path = dir + "/vec" + std::to_string(components) + ".gltf";
+    write_coloured_gltf(path, components, colors);
+    Result<Model> model = load_model(path);
+    ASSERT_TRUE(model.ok()) << model.status().to_string();
+    const Mesh& mesh = model->mesh;
+    ASSERT_EQ(mesh.colors.size(), 3u);
+    for (std::size_t v = 0; v < 3; ++v) {
+      Eigen::Vector4f want = colors[v];  // values as written: no sRGB conversion
+      if (components == 3) want[3] = 1.f;
+      // File (x, y, z), Y up, is (x, -z, y) in libg2p's frame; find the vertex by position.
+      const Eigen::Vector3f at(v == 1 ? 1.f : 0.f, 0.f, v == 2 ? 1.f : 0.f);
+      std::size_t i = 0;
+      while (i < 3 && !(mesh.positions[i] - at).isZero(1e-6f)) ++i;
+      ASSERT_LT(i, 3u) << "vertex " << v << " not found";
+      EXPECT_TRUE(mesh.colors[i].isApprox(want, 1e-6f))
+          << "VEC" << components << " vertex " << v << ": " << mesh.colors[i].transpose();
+    }
+  }
 }
 
 // One file of each other format family that assimp reads.

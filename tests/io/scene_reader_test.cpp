@@ -49,6 +49,7 @@ void expect_same_model(const Model& a, const Model& b) {
   EXPECT_TRUE(a.mesh.positions == b.mesh.positions) << "positions differ";
   EXPECT_TRUE(a.mesh.normals == b.mesh.normals) << "normals differ";
   EXPECT_TRUE(a.mesh.uvs == b.mesh.uvs) << "texture coordinates differ";
+  EXPECT_TRUE(a.mesh.colors == b.mesh.colors) << "vertex colours differ";
   EXPECT_TRUE(a.mesh.triangles == b.mesh.triangles) << "triangles differ";
   EXPECT_TRUE(a.mesh.face_source == b.mesh.face_source) << "face provenance differs";
   EXPECT_TRUE(a.mesh.face_flags == b.mesh.face_flags) << "face flags differ";
@@ -102,8 +103,8 @@ TEST_P(ReadInAChild, GivesTheModelAnInProcessParseGives) {
 
 INSTANTIATE_TEST_SUITE_P(Assets, ReadInAChild,
                          testing::Values("SheenChair", "GlamVelvetSofa", "GlassHurricaneCandleHolder", "Avocado",
-                                         "WaterBottle", "OBJ/spider.obj", "PLY/cube.ply", "STL/Spider_ascii.stl",
-                                         "FBX/box.fbx", "Collada/duck.dae"));
+                                         "WaterBottle", "OBJ/spider.obj", "PLY/cube.ply", "PLY/float-color.ply",
+                                         "STL/Spider_ascii.stl", "FBX/box.fbx", "Collada/duck.dae"));
 
 TEST(ReadInAChild, WorksFromMemoryToo) {
   const std::string bytes = test::read_file(test::asset_path("Avocado"));
@@ -176,6 +177,28 @@ TEST(AssimpHang, TheReaderIsStoppedAfterTheTimeLimitWithAMessageNamingIt) {
   EXPECT_NE(msg.find("G2P_READ_TIMEOUT"), std::string::npos) << msg;
   EXPECT_GE(seconds, 2.0);
   EXPECT_LT(seconds, 60.0);  // stopped, not left to run
+}
+
+// Every colour set assimp read crosses the transport intact, and absent sets stay absent.
+TEST(SceneTransport, VertexColourSetsSurviveEncodeAndDecode) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(test::assimp_model("PLY/float-color.ply"), 0);
+  ASSERT_NE(scene, nullptr);
+  ASSERT_GE(scene->mNumMeshes, 1u);
+  const aiMesh& original = *scene->mMeshes[0];
+  ASSERT_NE(original.mColors[0], nullptr) << "the file has vertex colours";
+  Result<detail::OwnedScene> decoded = detail::decode_scene(detail::encode_scene(*scene));
+  ASSERT_TRUE(decoded.ok()) << decoded.status().to_string();
+  ASSERT_EQ((*decoded)->mNumMeshes, scene->mNumMeshes);
+  const aiMesh& copy = *(*decoded)->mMeshes[0];
+  ASSERT_EQ(copy.mNumVertices, original.mNumVertices);
+  for (unsigned k = 0; k < AI_MAX_NUMBER_OF_COLOR_SETS; ++k) {
+    ASSERT_EQ(copy.mColors[k] == nullptr, original.mColors[k] == nullptr) << "colour set " << k;
+    for (unsigned v = 0; original.mColors[k] != nullptr && v < original.mNumVertices; ++v)
+      EXPECT_TRUE(copy.mColors[k][v] == original.mColors[k][v]) << "colour set " << k << " vertex " << v;
+  }
+  EXPECT_EQ(copy.mColors[0][0].b, 1.f);  // float-color.ply's vertices are blue
+  EXPECT_EQ(copy.mColors[0][0].r, 0.f);
 }
 
 // The bytes between the child and the caller: a truncated or corrupted

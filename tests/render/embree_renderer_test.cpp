@@ -231,6 +231,78 @@ TEST(EmbreeRenderer, TexturedQuadShowsItsTextureAtTheExpectedPixels) {
   EXPECT_NEAR(shifted_view->base_color.at(48, 16, 1), 0.f, 1e-3);
 }
 
+// Two squares in the file's z = 0 plane (Y up, so facing the front camera
+// after import): x in [-1, 0] red, x in [0, 1] blue, as 8-bit sRGB vertex
+// colours, with no texture (PLY has no materials: assimp's default one).
+constexpr const char* kTwoColourPly = R"(ply
+format ascii 1.0
+element vertex 8
+property float x
+property float y
+property float z
+property uchar red
+property uchar green
+property uchar blue
+element face 4
+property list uchar int vertex_indices
+end_header
+-1 -1 0 220 40 40
+0 -1 0 220 40 40
+0 1 0 220 40 40
+-1 1 0 220 40 40
+0 -1 0 40 40 220
+1 -1 0 40 40 220
+1 1 0 40 40 220
+0 1 0 40 40 220
+3 0 1 2
+3 0 2 3
+3 4 5 6
+3 4 6 7
+)";
+
+TEST(EmbreeRenderer, VertexColoursShowOnAMaterialWithoutTexture) {
+  const std::string dir = test::scratch_dir("EmbreeRenderer.VertexColours");
+  test::write_file(dir + "/halves.ply", kTwoColourPly);
+  Result<Model> model = load_model(dir + "/halves.ply");  // the child-process reader, the default
+  ASSERT_TRUE(model.ok()) << model.status().to_string();
+  ASSERT_TRUE(model->mesh.has_colors());
+  for (const SourceMaterial& m : model->materials) ASSERT_TRUE(m.base_color_texture.empty());
+
+  auto renderer = embree();
+  ASSERT_TRUE(renderer->set_model(*model).ok());
+  Result<View> view = renderer->render(front_camera(64, 1.0));
+  ASSERT_TRUE(view.ok()) << view.status().to_string();
+  const int left_x = 16, right_x = 48, y = 32;
+  ASSERT_GE(view->face_id.at(left_x, y), 0);
+  ASSERT_GE(view->face_id.at(right_x, y), 0);
+  // The base colour buffer is the material's base colour times the vertex colour.
+  for (const int x : {left_x, right_x}) {
+    const int f = view->face_id.at(x, y);
+    const int m = model->mesh.face_source[static_cast<std::size_t>(f)].material;
+    const Eigen::Vector3f factor =
+        m >= 0 ? Eigen::Vector3f(model->materials[static_cast<std::size_t>(m)].base_color.head<3>())
+               : Eigen::Vector3f::Ones();
+    const Eigen::Vector4f& vertex = model->mesh.colors[static_cast<std::size_t>(model->mesh.triangles[f][0])];
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(view->base_color.at(x, y, c), factor[c] * vertex[c], 1e-4) << "pixel " << x << "," << y;
+  }
+  // Red on the left, blue on the right, in the material buffer and in the shaded image.
+  EXPECT_GT(view->base_color.at(left_x, y, 0), 5.f * view->base_color.at(left_x, y, 2));
+  EXPECT_GT(view->base_color.at(right_x, y, 2), 5.f * view->base_color.at(right_x, y, 0));
+  const std::uint8_t* left = view->rgb.pixel(left_x, y);
+  const std::uint8_t* right = view->rgb.pixel(right_x, y);
+  EXPECT_GT(left[0], left[2] + 60) << "left half should look red";
+  EXPECT_GT(right[2], right[0] + 60) << "right half should look blue";
+
+  // Without its colours the same mesh renders the two halves alike.
+  Model plain = *model;
+  plain.mesh.colors.clear();
+  ASSERT_TRUE(renderer->set_model(plain).ok());
+  Result<View> grey = renderer->render(front_camera(64, 1.0));
+  ASSERT_TRUE(grey.ok());
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(grey->base_color.at(left_x, y, c), grey->base_color.at(right_x, y, c), 1e-6);
+}
+
 TEST(EmbreeRenderer, AlphaMaskCutsOutAndTransmissionShowsWhatIsBehind) {
   test::GltfBuilder g;
   const int tex = g.add_texture(quadrant_png(/*alpha_left=*/0));

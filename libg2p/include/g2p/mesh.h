@@ -32,6 +32,10 @@ struct Mesh {
   // glTF: (0, 0) is the top-left corner of a texture, v grows downwards (files
   // with OpenGL-style v-up coordinates, such as OBJ, are flipped on import).
   std::vector<Eigen::Vector2f> uvs;
+  // Per vertex, first colour set; empty or positions.size(). Linear RGBA in
+  // [0, 1] (sRGB colours in the file are converted on import, see import.md).
+  // Multiplies the material's base colour, as glTF COLOR_0 does.
+  std::vector<Eigen::Vector4f> colors;
   std::vector<Eigen::Vector3i> triangles;  // counter-clockwise seen from outside; indices into positions
   std::vector<FaceSource> face_source;     // per triangle; empty for meshes built without provenance
   std::vector<std::uint8_t> face_flags;    // per triangle, FaceFlag bits; empty = no flags
@@ -40,6 +44,7 @@ struct Mesh {
   int num_faces() const { return static_cast<int>(triangles.size()); }
   bool has_normals() const { return !normals.empty(); }
   bool has_uvs() const { return !uvs.empty(); }
+  bool has_colors() const { return !colors.empty(); }
   bool is_degenerate(int face) const {
     return !face_flags.empty() && (face_flags[static_cast<std::size_t>(face)] & kFaceDegenerate);
   }

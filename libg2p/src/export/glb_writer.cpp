@@ -38,7 +38,7 @@ class GlbBuilder {
     json a = {{"bufferView", v},
               {"componentType", 5126},
               {"count", values.size() / static_cast<std::size_t>(components)},
-              {"type", components == 3 ? "VEC3" : "VEC2"}};
+              {"type", "VEC" + std::to_string(components)}};
     if (with_bounds) {
       std::vector<float> lo(static_cast<std::size_t>(components), 1e30f),
           hi(static_cast<std::size_t>(components), -1e30f);
@@ -154,7 +154,7 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
     json primitives = json::array();
     for (const auto& [material, faces] : by_material) {
       std::map<int, std::uint32_t> remap;
-      std::vector<float> pos, nrm, uv;
+      std::vector<float> pos, nrm, uv, rgba;
       std::vector<std::uint32_t> idx;
       for (int f : faces)
         for (int c = 0; c < 3; ++c) {
@@ -170,12 +170,17 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
             if (mesh.has_uvs())
               uv.insert(uv.end(),
                         {mesh.uvs[static_cast<std::size_t>(v)].x(), mesh.uvs[static_cast<std::size_t>(v)].y()});
+            if (mesh.has_colors()) {
+              const Eigen::Vector4f& c = mesh.colors[static_cast<std::size_t>(v)];
+              rgba.insert(rgba.end(), {c[0], c[1], c[2], c[3]});
+            }
           }
           idx.push_back(it->second);
         }
       json prim = {{"attributes", {{"POSITION", g.accessor(pos, 3, true)}}}, {"indices", g.indices(idx)}};
       if (!nrm.empty()) prim["attributes"]["NORMAL"] = g.accessor(nrm, 3, false);
       if (!uv.empty()) prim["attributes"]["TEXCOORD_0"] = g.accessor(uv, 2, false);
+      if (!rgba.empty()) prim["attributes"]["COLOR_0"] = g.accessor(rgba, 4, false);  // linear, as Mesh::colors
       if (material >= 0 && material < static_cast<int>(model.materials.size())) prim["material"] = material;
       primitives.push_back(prim);
     }

@@ -17,12 +17,14 @@
 #include <new>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "assimp_convert.h"
 #include "g2p/io.h"
 #include "gltf_layout.h"
 #include "real_size.h"
+#include "render/shading.h"
 #include "scene_reader.h"
 #include "triangulate.h"
 
@@ -99,6 +101,17 @@ void resolve_frame(const aiScene& scene, const std::string& ext, const ImportOpt
   Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
   t.topLeftCorner<3, 3>() = (options.z_up ? up_to_z(info.up_axis) : Eigen::Matrix3d::Identity()) * info.unit_scale_m;
   info.file_to_model = t;
+}
+
+// The bytes of what the importer reads of vertex `v`: equal bytes, equal vertices.
+std::string vertex_key(const aiMesh& m, unsigned v) {
+  std::string key;
+  auto add = [&key](const void* p, std::size_t n) { key.append(static_cast<const char*>(p), n); };
+  add(&m.mVertices[v], sizeof(aiVector3D));
+  if (m.mNormals != nullptr) add(&m.mNormals[v], sizeof(aiVector3D));
+  if (m.mTextureCoords[0] != nullptr) add(&m.mTextureCoords[0][v], sizeof(aiVector3D));
+  if (m.mColors[0] != nullptr) add(&m.mColors[0][v], sizeof(aiColor4D));
+  return key;
 }
 
 // Walks the scene graph and appends every mesh instance to the model.
@@ -208,11 +221,22 @@ class SceneFlattener {
       return Status::Unsupported("more than " + std::to_string(options_.max_faces) +
                                  " triangles (ImportOptions::max_faces)");
 
-    // Vertices, transformed into libg2p's frame.
+    // Vertices, transformed into libg2p's frame. assimp joins no vertices in
+    // a scene with colours (scene_reader.cpp); equal ones are joined here.
     const bool has_normals = src.mNormals != nullptr;
     const bool has_uvs = src.mTextureCoords[0] != nullptr;
+    const aiColor4D* colors = src.mColors[0];  // the first colour set, as glTF's COLOR_0
     bool bad_normals = false;
+    std::vector<int> kept(static_cast<std::size_t>(nv));  // local index of each file vertex after joining
+    std::unordered_map<std::string, int> first_with_key;
     for (int v = 0; v < nv; ++v) {
+      kept[static_cast<std::size_t>(v)] = mesh.num_vertices() - prim.first_vertex;
+      if (join_vertices_) {
+        auto [it, added] =
+            first_with_key.emplace(vertex_key(src, static_cast<unsigned>(v)), kept[static_cast<std::size_t>(v)]);
+        kept[static_cast<std::size_t>(v)] = it->second;
+        if (!added) continue;
+      }
       const aiVector3D& p = src.mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         return Status::ParseError(where + " vertex " + std::to_string(v) + ": non-finite position " + vec_str(p));
@@ -242,14 +266,26 @@ class SceneFlattener {
       } else {
         mesh.uvs.emplace_back(0.f, 0.f);
       }
+      Eigen::Vector4f color = Eigen::Vector4f::Ones();  // white: a neutral factor where a mesh has none
+      if (colors != nullptr) {
+        const aiColor4D& c = colors[v];
+        const Eigen::Vector4f read(c.r, c.g, c.b, c.a);
+        if (read.allFinite())
+          color = read.cwiseMax(0.f).cwiseMin(1.f);
+        else
+          any_bad_color_ = true;
+      }
+      mesh.colors.push_back(color);
     }
     if (bad_normals) model_.info.warnings.push_back(where + ": zero or non-finite normals recomputed");
     any_uvs_ |= has_uvs;
+    any_colors_ |= colors != nullptr;
 
     const int base = prim.first_vertex;
     for (std::size_t i = 0; i < local.size(); ++i) {
       const auto& t = local[i];
-      Eigen::Vector3i tri(base + t[0], base + t[1], base + t[2]);
+      Eigen::Vector3i tri(base + kept[static_cast<std::size_t>(t[0])], base + kept[static_cast<std::size_t>(t[1])],
+                          base + kept[static_cast<std::size_t>(t[2])]);
       if (mirrored) std::swap(tri[1], tri[2]);  // keep outward winding under reflections
       mesh.triangles.push_back(tri);
       mesh.face_source.push_back({mesh_index, local_source[i], prim.material});
@@ -263,6 +299,8 @@ class SceneFlattener {
  public:
   bool any_uvs() const { return any_uvs_; }
   bool any_bad_uv() const { return any_bad_uv_; }
+  bool any_colors() const { return any_colors_; }
+  bool any_bad_color() const { return any_bad_color_; }
 
  private:
   const aiScene& scene_;
@@ -270,8 +308,11 @@ class SceneFlattener {
   Model& model_;
   std::unordered_set<const aiNode*> on_path_;
   std::vector<bool> missing_normal_;
+  const bool join_vertices_ = detail::has_vertex_colors(scene_);  // see vertex_key
   bool any_uvs_ = false;
   bool any_bad_uv_ = false;
+  bool any_colors_ = false;
+  bool any_bad_color_ = false;
 };
 
 bool is_gltf(const std::string& ext) { return ext == "gltf" || ext == "glb"; }
@@ -380,8 +421,14 @@ Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bo
   }
   for (FaceSource& s : model.mesh.face_source)
     s.material = layout->primitives[static_cast<std::size_t>(s.mesh)].material;
-  for (SourcePrimitive& p : model.primitives)
-    p.material = layout->primitives[static_cast<std::size_t>(p.mesh)].material;
+  for (SourcePrimitive& p : model.primitives) {
+    const detail::GltfPrimitive& file = layout->primitives[static_cast<std::size_t>(p.mesh)];
+    p.material = file.material;
+    // assimp 5.2 reads a VEC3 COLOR_0 with alpha 0; glTF means RGB with alpha 1.
+    if (!file.color_has_alpha && model.mesh.has_colors())
+      for (std::int32_t v = p.first_vertex; v < p.first_vertex + p.num_vertices; ++v)
+        model.mesh.colors[static_cast<std::size_t>(v)][3] = 1.f;
+  }
   model.materials = std::move(materials);
   return Status::Ok();
 }
@@ -457,6 +504,16 @@ Result<Model> convert_scene(const aiScene& scene, const std::string& ext, const 
   }
   if (!flattener.any_uvs()) mesh.uvs.clear();
   if (flattener.any_bad_uv()) model.info.warnings.push_back("non-finite texture coordinates replaced by (0, 0)");
+  if (!flattener.any_colors()) {
+    mesh.colors.clear();
+  } else if (!is_gltf(ext)) {
+    // glTF's COLOR_0 is linear; other formats' vertex colours (PLY, OBJ, ...)
+    // are display colours, sRGB-encoded in practice (import.md). Alpha is linear.
+    for (Eigen::Vector4f& c : mesh.colors)
+      for (int k = 0; k < 3; ++k) c[k] = detail::srgb_to_linear(c[k]);
+  }
+  if (flattener.any_bad_color())
+    model.info.warnings.push_back("non-finite vertex colours replaced by white (1, 1, 1, 1)");
 
   model.info.num_degenerate_faces = flag_degenerate_faces(mesh);
   if (model.info.num_degenerate_faces > 0)

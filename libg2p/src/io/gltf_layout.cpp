@@ -97,26 +97,30 @@ SourceMaterial parse_material(const json& m) {
   return out;
 }
 
+// Accessor `index` as a JSON object, or nullptr.
+const json* accessor_at(const json& doc, const json& index) {
+  auto accessors = doc.find("accessors");
+  if (!index.is_number_integer() || accessors == doc.end() || !accessors->is_array()) return nullptr;
+  const long long i = index.get<long long>();
+  if (i < 0 || i >= static_cast<long long>(accessors->size())) return nullptr;
+  const json& a = (*accessors)[static_cast<std::size_t>(i)];
+  return a.is_object() ? &a : nullptr;
+}
+
 // The `count` of accessor `index`, or -1.
 long long accessor_count(const json& doc, const json& index) {
-  auto accessors = doc.find("accessors");
-  if (!index.is_number_integer() || accessors == doc.end() || !accessors->is_array()) return -1;
-  const long long i = index.get<long long>();
-  if (i < 0 || i >= static_cast<long long>(accessors->size())) return -1;
-  const json& a = (*accessors)[static_cast<std::size_t>(i)];
-  auto c = a.is_object() ? a.find("count") : a.end();
-  return a.is_object() && c != a.end() && c->is_number_integer() ? c->get<long long>() : -1;
+  const json* a = accessor_at(doc, index);
+  if (a == nullptr) return -1;
+  auto c = a->find("count");
+  return c != a->end() && c->is_number_integer() ? c->get<long long>() : -1;
 }
 
 // The largest index an index accessor declares (its `max`), or -1.
 long long accessor_max(const json& doc, const json& index) {
-  auto accessors = doc.find("accessors");
-  if (!index.is_number_integer() || accessors == doc.end() || !accessors->is_array()) return -1;
-  const long long i = index.get<long long>();
-  if (i < 0 || i >= static_cast<long long>(accessors->size())) return -1;
-  const json& a = (*accessors)[static_cast<std::size_t>(i)];
-  auto m = a.is_object() ? a.find("max") : a.end();
-  if (!a.is_object() || m == a.end() || !m->is_array() || m->empty() || !(*m)[0].is_number()) return -1;
+  const json* a = accessor_at(doc, index);
+  if (a == nullptr) return -1;
+  auto m = a->find("max");
+  if (m == a->end() || !m->is_array() || m->empty() || !(*m)[0].is_number()) return -1;
   return static_cast<long long>((*m)[0].get<double>());
 }
 
@@ -128,6 +132,12 @@ void check_primitive(const json& doc, const json& p, GltfPrimitive& out) {
     return;
   }
   const json* attributes = p.contains("attributes") && p["attributes"].is_object() ? &p["attributes"] : nullptr;
+  if (attributes && attributes->contains("COLOR_0")) {
+    if (const json* color = accessor_at(doc, (*attributes)["COLOR_0"])) {
+      auto type = color->find("type");
+      out.color_has_alpha = type == color->end() || *type != "VEC3";
+    }
+  }
   const long long vertices =
       attributes && attributes->contains("POSITION") ? accessor_count(doc, (*attributes)["POSITION"]) : -1;
   const bool indexed = p.contains("indices");

@@ -21,9 +21,10 @@ struct GltfPrimitive {
   int mesh = 0;       // index in the file's `meshes`
   int primitive = 0;  // index in that mesh's `primitives`
   std::string mesh_name;
-  int material = -1;         // index in the file's `materials`; -1 = none
-  long long triangles = -1;  // triangles the primitive declares; -1 if unknown
-  std::string problem;       // what is wrong with its accessors, empty if nothing
+  int material = -1;            // index in the file's `materials`; -1 = none
+  long long triangles = -1;     // triangles the primitive declares; -1 if unknown
+  std::string problem;          // what is wrong with its accessors, empty if nothing
+  bool color_has_alpha = true;  // false when COLOR_0 is VEC3 (RGB only: alpha is 1)
 };
 
 struct GltfLayout {

@@ -8,6 +8,7 @@
 // in, in memory shared with the parent, before the signal takes its course.
 #include "scene_reader.h"
 
+#include <assimp/postprocess.h>
 #include <dlfcn.h>
 #include <execinfo.h>
 #include <fcntl.h>
@@ -110,11 +111,29 @@ bool write_all(int fd, const char* p, std::size_t n) {
   return true;
 }
 
+// assimp 5.2's JoinIdenticalVertices compares no vertex colours (fixed after
+// 5.2 by assimp pull request 4872) and would merge vertices that differ only
+// in colour: a scene with colours is read without it, and the importer joins
+// equal vertices itself, colours included (assimp_import.cpp).
 const aiScene* read_in(Assimp::Importer& importer, const SceneSource& source, unsigned post_process) {
-  if (source.data != nullptr)
-    return importer.ReadFileFromMemory(source.data, source.size, post_process, source.hint.c_str());
-  return importer.ReadFile(source.path, post_process);
+  const unsigned join = post_process & aiProcess_JoinIdenticalVertices;
+  const unsigned first = post_process & ~join;
+  const aiScene* scene = source.data != nullptr
+                             ? importer.ReadFileFromMemory(source.data, source.size, first, source.hint.c_str())
+                             : importer.ReadFile(source.path, first);
+  if (scene == nullptr || join == 0 || has_vertex_colors(*scene)) return scene;
+  return importer.ApplyPostProcessing(join);
 }
+
+}  // namespace
+
+bool has_vertex_colors(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes && scene.mMeshes != nullptr; ++m)
+    if (scene.mMeshes[m] != nullptr && scene.mMeshes[m]->mColors[0] != nullptr) return true;
+  return false;
+}
+
+namespace {
 
 std::string assimp_error(const Assimp::Importer& importer) {
   std::string e = importer.GetErrorString();

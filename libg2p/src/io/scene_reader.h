@@ -40,7 +40,12 @@ class ParsedScene {
   OwnedScene owned_;
 };
 
-// Parses `source` with assimp's `post_process` steps. `isolate`: in a child
+// Whether any mesh of the scene has a first vertex colour set.
+bool has_vertex_colors(const aiScene& scene);
+
+// Parses `source` with assimp's `post_process` steps (but see read_in in
+// scene_reader.cpp: JoinIdenticalVertices is left out for a scene with
+// vertex colours). `isolate`: in a child
 // process (falls back to this process, with a warning appended to
 // `warnings`, when no child can be started). A crash, an out-of-memory or a
 // stop of the child is an error that says which.

@@ -143,6 +143,7 @@ void write_mesh(Writer& w, const aiMesh* mesh) {
     w.pod(mesh->mNumUVComponents[k]);
     w.array(mesh->mTextureCoords[k], mesh->mNumVertices);
   }
+  for (unsigned k = 0; k < AI_MAX_NUMBER_OF_COLOR_SETS; ++k) w.array(mesh->mColors[k], mesh->mNumVertices);
   const std::uint32_t faces = mesh->mFaces != nullptr ? mesh->mNumFaces : 0;
   w.pod(faces);
   for (std::uint32_t f = 0; f < faces; ++f) w.array(mesh->mFaces[f].mIndices, mesh->mFaces[f].mNumIndices);
@@ -246,6 +247,15 @@ aiMesh* read_mesh(Reader& r) {
   for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++k) {
     mesh->mNumUVComponents[k] = r.pod<unsigned>();
     mesh->mTextureCoords[k] = vectors();
+  }
+  for (unsigned k = 0; k < AI_MAX_NUMBER_OF_COLOR_SETS; ++k) {
+    unsigned n = 0;
+    aiColor4D* p = r.array<aiColor4D>(n);
+    if (p != nullptr && n != vertices) {
+      delete[] p;
+      p = nullptr;
+    }
+    mesh->mColors[k] = p;
   }
   if (mesh->mVertices == nullptr) mesh->mNumVertices = 0;
   const std::uint32_t faces = r.count(sizeof(std::uint32_t));

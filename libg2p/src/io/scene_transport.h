@@ -2,9 +2,9 @@
 // child process (where a crash inside assimp cannot take the caller down) and
 // converted in the caller. Only what libg2p's importer reads is carried: the
 // node tree (names, transforms, mesh lists), meshes (name, material, primitive
-// types, positions, normals, texture coordinates, faces), materials (every
-// property, verbatim), textures (embedded images and their file names) and the
-// scene's metadata (units, up axis). Vertex colours, tangents, bones,
+// types, positions, normals, texture coordinates, vertex colour sets, faces),
+// materials (every property, verbatim), textures (embedded images and their
+// file names) and the scene's metadata (units, up axis). Tangents, bones,
 // animations, cameras and lights are not.
 #pragma once
 

@@ -74,7 +74,10 @@ class EmbreeRenderer final : public Renderer {
 
   const SourceMaterial& material_of(int face) const {
     const int m = face_material_[static_cast<std::size_t>(face)];
-    return m >= 0 ? model_->materials[static_cast<std::size_t>(m)] : default_material_;
+    if (m >= 0) return model_->materials[static_cast<std::size_t>(m)];
+    // Vertex colours on faces without a material are the colour itself (glTF's
+    // default material has a white base colour).
+    return model_->mesh.has_colors() ? default_coloured_material_ : default_material_;
   }
 
   Eigen::Vector2f uv_at(int face, float u, float v) const {
@@ -82,6 +85,19 @@ class EmbreeRenderer final : public Renderer {
     if (!mesh.has_uvs()) return Eigen::Vector2f::Zero();
     const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(face)];
     return (1.f - u - v) * mesh.uvs[t[0]] + u * mesh.uvs[t[1]] + v * mesh.uvs[t[2]];
+  }
+
+  // Interpolated vertex colour (linear RGBA); white when the mesh has none.
+  Eigen::Vector4f color_at(int face, float u, float v) const {
+    const Mesh& mesh = model_->mesh;
+    if (!mesh.has_colors()) return Eigen::Vector4f::Ones();
+    const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(face)];
+    return (1.f - u - v) * mesh.colors[t[0]] + u * mesh.colors[t[1]] + v * mesh.colors[t[2]];
+  }
+
+  detail::SurfaceSample surface_at(const Hit& hit) const {
+    return detail::evaluate_material(material_of(hit.face), uv_at(hit.face, hit.u, hit.v),
+                                     color_at(hit.face, hit.u, hit.v));
   }
 
   // Shading normal facing the viewer (`to_viewer`), from vertex normals when
@@ -111,8 +127,9 @@ class EmbreeRenderer final : public Renderer {
       const int face = static_cast<int>(RTCHitN_primID(args->hit, args->N, i));
       const SourceMaterial& m = self->material_of(face);
       if (m.alpha_mode != AlphaMode::kMask) continue;
-      const Eigen::Vector2f uv = self->uv_at(face, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
-      if (detail::material_alpha(m, uv) < m.alpha_cutoff) args->valid[i] = 0;
+      const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+      if (detail::material_alpha(m, self->uv_at(face, u, v), self->color_at(face, u, v)[3]) < m.alpha_cutoff)
+        args->valid[i] = 0;
     }
   }
 
@@ -127,6 +144,11 @@ class EmbreeRenderer final : public Renderer {
     m.base_color = {0.8f, 0.8f, 0.8f, 1.f};
     m.metallic = 0.f;
     m.roughness = 0.6f;
+    return m;
+  }();
+  SourceMaterial default_coloured_material_ = [this] {
+    SourceMaterial m = default_material_;
+    m.base_color = Eigen::Vector4f::Ones();
     return m;
   }();
   std::mutex error_mutex_;
@@ -252,7 +274,7 @@ Status EmbreeRenderer::render_into(const Camera& camera, const RenderOptions& op
           }
           if (options.material_buffers) {
             const SourceMaterial& m = material_of(hit.face);
-            const detail::SurfaceSample s = detail::evaluate_material(m, uv_at(hit.face, hit.u, hit.v));
+            const detail::SurfaceSample s = surface_at(hit);
             for (int c = 0; c < 3; ++c) view.base_color.at(x, y, c) = s.base_color[c];
             view.base_color.at(x, y, 3) = m.alpha_mode == AlphaMode::kOpaque ? 1.f : s.alpha;
             view.metallic_roughness.at(x, y, 0) = s.metallic;
@@ -266,8 +288,7 @@ Status EmbreeRenderer::render_into(const Camera& camera, const RenderOptions& op
         Eigen::Vector3f color = Eigen::Vector3f::Zero();
         Eigen::Vector3f throughput = Eigen::Vector3f::Ones();
         for (int layer = 0; layer < options.max_layers && hit.face >= 0; ++layer) {
-          const detail::SurfaceSample s =
-              detail::evaluate_material(material_of(hit.face), uv_at(hit.face, hit.u, hit.v));
+          const detail::SurfaceSample s = surface_at(hit);
           const detail::ShadedColor lit =
               detail::shade(s, facing_normal(hit, to_viewer), to_viewer, camera_to_world, lights);
           // Transmission leaves a faint body colour, keeps the highlights and

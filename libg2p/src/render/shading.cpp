@@ -92,15 +92,16 @@ Eigen::Vector4f sample(const Texture& texture, const Eigen::Vector2f& uv, bool s
   return out;
 }
 
-float material_alpha(const SourceMaterial& material, const Eigen::Vector2f& uv) {
-  float alpha = material.base_color[3];
+float material_alpha(const SourceMaterial& material, const Eigen::Vector2f& uv, float vertex_alpha) {
+  float alpha = material.base_color[3] * vertex_alpha;
   if (!material.base_color_texture.empty()) alpha *= sample(material.base_color_texture, uv, false)[3];
   return alpha;
 }
 
-SurfaceSample evaluate_material(const SourceMaterial& m, const Eigen::Vector2f& uv) {
+SurfaceSample evaluate_material(const SourceMaterial& m, const Eigen::Vector2f& uv,
+                                const Eigen::Vector4f& vertex_color) {
   SurfaceSample s;
-  Eigen::Vector4f color = m.base_color;
+  Eigen::Vector4f color = m.base_color.cwiseProduct(vertex_color);
   if (!m.base_color_texture.empty()) color = color.cwiseProduct(sample(m.base_color_texture, uv, true));
   s.base_color = color.head<3>();
   s.alpha = m.alpha_mode == AlphaMode::kBlend ? std::clamp(color[3], 0.f, 1.f) : 1.f;

@@ -32,10 +32,13 @@ struct SurfaceSample {
 };
 
 // Evaluates a material at a point with UV `uv` (ignored without textures).
-SurfaceSample evaluate_material(const SourceMaterial& material, const Eigen::Vector2f& uv);
+// `vertex_color` (linear RGBA, the mesh's interpolated Mesh::colors) multiplies
+// the base colour factor and texture, as glTF's COLOR_0 does.
+SurfaceSample evaluate_material(const SourceMaterial& material, const Eigen::Vector2f& uv,
+                                const Eigen::Vector4f& vertex_color = Eigen::Vector4f::Ones());
 
-// Alpha of a material at `uv` (factor times texture), for MASK cut-outs.
-float material_alpha(const SourceMaterial& material, const Eigen::Vector2f& uv);
+// Alpha of a material at `uv` (factor times texture times vertex alpha), for MASK cut-outs.
+float material_alpha(const SourceMaterial& material, const Eigen::Vector2f& uv, float vertex_alpha = 1.f);
 
 // Radiance leaving the surface towards the camera under `lights` (unit
 // directions; studio_lights() by default) and the ambient terms (see shading.cpp), split so callers can weight the

@@ -173,6 +173,16 @@ class PySegmenter : public Segmenter {
       return label_map_from_python(f(view), view, num_classes_, python_class_name(this) + ".segment", out);
     });
   }
+  std::vector<std::string> warnings() const override {
+    py::gil_scoped_acquire gil;
+    py::function f = py::get_override(static_cast<const Segmenter*>(this), "warnings");
+    if (!f) return Segmenter::warnings();
+    try {
+      return f().cast<std::vector<std::string>>();
+    } catch (const std::exception& e) {  // a warning about the warnings, not a failed run
+      return {python_class_name(this) + ".warnings() did not return a list of str: " + e.what()};
+    }
+  }
 
  private:
   int num_classes_ = 0;  // of the table given to set_model; 0 = not checked
@@ -460,7 +470,8 @@ void bind_stages(py::module_& m) {
       m, "Segmenter",
       "The segment stage. Subclass it (call super().__init__()): segment(self, view) returns labels (H, W) of an "
       "integer dtype (-1 = unknown), or (labels, probabilities (H, W, C) float32), or a g2p.LabelMap; optional "
-      "set_model(self, model, table) and configure(self, settings).")
+      "set_model(self, model, table), configure(self, settings) and warnings(self) (a list of str: what degraded, "
+      "which the pipeline adds to PipelineResult.warnings).")
       .def(py::init<>())
       .def("configure", [](Segmenter& s, const BackendSettings& settings) { throw_if_error(s.configure(settings)); })
       .def(
@@ -477,7 +488,10 @@ void bind_stages(py::module_& m) {
             py::gil_scoped_release release;
             return unwrap(s.segment(view));
           },
-          py::arg("view"), "A LabelMap for the view (call set_model first).");
+          py::arg("view"), "A LabelMap for the view (call set_model first).")
+      .def(
+          "warnings", [](const Segmenter& s) { return s.warnings(); },
+          "What degraded since configure and set_model (hybrid without its network says why here).");
 
   py::class_<Refiner, PyRefiner, std::shared_ptr<Refiner>>(
       m, "Refiner",
@@ -537,7 +551,7 @@ void bind_stages(py::module_& m) {
       [](const std::string& name, const BackendSettings& settings) {
         return std::shared_ptr<Segmenter>(unwrap(make_segmenter(name, settings)));
       },
-      py::arg("name") = "pbr", py::arg("settings") = BackendSettings{});
+      py::arg("name") = "hybrid", py::arg("settings") = BackendSettings{});
   m.def(
       "make_refiner",
       [](const std::string& name, const BackendSettings& settings) {

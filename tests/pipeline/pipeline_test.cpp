@@ -63,7 +63,7 @@ TEST(Pipeline, TurnsTheHammerIntoAWoodenHandleAndASteelHead) {
     EXPECT_GE(r->stages[i].seconds, 0.0);
     EXPECT_GT(r->stages[i].peak_rss_bytes, 0u);
   }
-  EXPECT_EQ(r->stage(Stage::kSegment)->backend, "pbr");
+  EXPECT_EQ(r->stage(Stage::kSegment)->backend, "hybrid");  // the default
   EXPECT_EQ(r->stage(Stage::kRefine)->backend, "smooth");
   EXPECT_TRUE(r->warnings.empty());
   EXPECT_GT(r->seconds, 0.0);

@@ -159,7 +159,7 @@ class HammerPipelineTest(unittest.TestCase):
         for s in r.stages:
             self.assertTrue(s["ok"], s)
             self.assertGreaterEqual(s["seconds"], 0.0)
-        self.assertEqual(r.stage(g2p.Stage.SEGMENT)["backend"], "pbr")
+        self.assertEqual(r.stage(g2p.Stage.SEGMENT)["backend"], "hybrid")  # the default
         self.assertEqual(r.warnings, [])
         self.assertGreater(r.seconds, 0.0)
         self.assertEqual(self.progress[-1].stage, g2p.Stage.EXPORT)
@@ -203,6 +203,21 @@ class PythonBackendsTest(unittest.TestCase):
         # Back to the named backend.
         pipeline.set_segmenter(None)
         self.assertEqual(sorted(p["class"] for p in pipeline.run_file(HAMMER).parts), ["Metal", "Wood"])
+
+    def test_a_segmenters_warnings_reach_the_result(self):
+        class Degraded(AllPlastic):
+            def warnings(self):
+                return ["fell back to all Plastic (no camera)"]
+
+        pipeline = g2p.Pipeline(quick_options())
+        pipeline.set_segmenter(Degraded())
+        r = pipeline.run_file(HAMMER)
+        self.assertIn("segment: fell back to all Plastic (no camera)", r.warnings)
+        # A built-in backend's: hybrid without its network says why.
+        hybrid = g2p.make_segmenter("hybrid", {"model_card": "/nonexistent/g2p-materials.json"})
+        self.assertEqual(len(hybrid.warnings()), 1)
+        self.assertIn("the network cannot run", hybrid.warnings()[0])
+        self.assertEqual(g2p.make_segmenter("pbr").warnings(), [])
 
     def test_segmenter_output_is_checked(self):
         pipeline = g2p.Pipeline(quick_options())

@@ -288,12 +288,34 @@ INSTANTIATE_TEST_SUITE_P(IntAndTerm, ToolRunSignal, ::testing::Values(SIGINT, SI
 // A real multi-material chair merged into one material with a baked colour
 // atlas and no names, as image-to-3D generators emit it: with `--segmenter
 // hybrid`, `g2p run` finds more than one material (issue #31).
+// Issue #31's first item: with no segmenter option, a real image-to-3D mesh
+// (TRELLIS: one material, a baked atlas, no names, metallic 1) gets more
+// than one class; the old default read it as one class, Metal.
+TEST(ToolRun, TheDefaultDecomposesARealGeneratorMesh) {
+  const std::string dir = test::scratch_dir("ToolRunGeneratorMesh");
+  const std::string glb = test::quote(test::source_path("data/generated/models/trellis_shell_chair.glb"));
+  std::set<std::string> classes[2];
+  for (int old = 0; old < 2; ++old) {
+    test::ToolRun r =
+        test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/out" + std::to_string(old)) + kQuick +
+                       (old ? " --segmenter pbr" : "") + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    for (const auto& part : j["parts"]) classes[old].insert(part["material"].get<std::string>());
+    EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+  }
+  EXPECT_GE(classes[0].size(), 2u) << "the default";
+  EXPECT_EQ(classes[1], std::set<std::string>{"Metal"}) << "pbr";
+}
+
 TEST(ToolRun, HybridDecomposesAGeneratedLookingMesh) {
   const std::string dir = test::scratch_dir("ToolRunGenerated");
   Result<Model> chair = load_model(test::asset_path("SheenChair"));
   ASSERT_TRUE(chair.ok()) << chair.status().to_string();
   const std::string obj = test::write_atlas_obj(test::one_atlas_material(*chair), dir, "chair");
-  test::ToolRun r = test::run_tool("run " + test::quote(obj) + " --up z --segmenter hybrid -o " +
+  // The fixture's atlas is one tile per source material, a few UV charts,
+  // not a baked atlas's hundreds: atlas_charts=0 counts any texture.
+  test::ToolRun r = test::run_tool("run " + test::quote(obj) + " --up z --segmenter hybrid --set atlas_charts=0 -o " +
                                    test::quote(dir + "/out") + kQuick + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);

@@ -31,7 +31,7 @@ const PassThrough kPassThrough[] = {
     {"--longest-side", "Real longest side of every object, metres", true, false},
     {"--views", "Number of views (default 11)", true, false},
     {"--resolution", "View resolution in pixels (default 512)", true, false},
-    {"--segmenter", "Segmenter backend (default pbr)", true, false},
+    {"--segmenter", "Segmenter backend (default hybrid)", true, false},
     {"--set", "Segmenter setting KEY=VALUE (repeatable)", true, true},
     {"--refiner", "Refiner backend (default smooth)", true, false},
     {"--completer", "Completer backend (default partition)", true, false},

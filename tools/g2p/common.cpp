@@ -104,7 +104,7 @@ Result<std::vector<View>> render_with_flags(const std::string& command, const Mo
 }
 
 void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args) {
-  cmd->add_option("--segmenter", args.name, "Segmenter backend: pbr (default), hybrid, learned, auto, onnx, oracle");
+  cmd->add_option("--segmenter", args.name, "Segmenter backend: hybrid (default), pbr, learned, auto, onnx, oracle");
   cmd->add_option(
       "--set", args.settings,
       "Segmenter setting KEY=VALUE, repeatable (onnx: model_card=FILE, flip=on|off; learned, auto: the same and "

@@ -54,7 +54,7 @@ Result<std::vector<View>> render_with_flags(const std::string& command, const Mo
 
 // Which segmenter: --segmenter NAME, --set KEY=VALUE (repeatable).
 struct SegmenterArgs {
-  std::string name = "pbr";
+  std::string name = "hybrid";
   std::vector<std::string> settings;
 };
 

@@ -91,10 +91,11 @@ struct PipelineOptions {
   ViewOptions views;
   RenderOptions render;
 
-  // 2. segment: "pbr" (weight-free default), "hybrid" (`pbr` on per-part
-  //    materials, the network where one material covers several parts),
+  // 2. segment: "hybrid" (the default: `pbr` on per-part materials, the
+  //    shipped network where one material covers the whole object with a
+  //    baked atlas, as image-to-3D meshes come), "pbr" (weight-free),
   //    "learned", "onnx", "oracle", or a user's (docs/segment.md).
-  BackendChoice segmenter{"pbr", {}};
+  BackendChoice segmenter{"hybrid", {}};
 
   // 3. project: votes, flood fill and parts.
   ProjectOptions project;

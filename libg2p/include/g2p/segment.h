@@ -1,8 +1,10 @@
 // segment: stage 2 of Gen2Physics. Every rendered pixel gets one of the
 // vocabulary's material classes (the paper: a fine-tuned ViT, whose weights
-// are not public). libg2p ships a weight-free default (`pbr`), runs any ONNX
-// segmentation model (`onnx`) and reads ground truth (`oracle`); researchers
-// register their own through segmenter_registry().
+// are not public). libg2p ships a default that reads per-part materials and
+// runs its trained network where one material covers the whole object
+// (`hybrid`), a weight-free backend (`pbr`), runs any ONNX segmentation model
+// (`onnx`) and reads ground truth (`oracle`); researchers register their own
+// through segmenter_registry().
 #pragma once
 
 #include <array>
@@ -52,8 +54,9 @@ class G2P_API Segmenter {
   Result<LabelMap> segment(const View& view) const;
 };
 
-// Backends by name: "pbr" (the default), "onnx", "oracle", "learned" (a
-// network where names say nothing, names where they do; docs/training.md).
+// Backends by name: "hybrid" (the default), "pbr", "onnx", "oracle",
+// "learned" (a network where names say nothing, names where they do;
+// docs/training.md), "auto".
 G2P_API Registry<Segmenter>& segmenter_registry();
 
 // Creates a backend and applies its settings.

@@ -1,21 +1,25 @@
-// The `hybrid` segmenter (`--segmenter hybrid`; not the default, docs/accuracy.md): `pbr` where a model's
-// materials are its parts, the network libg2p ships where one material covers
-// several parts (issue #31), as image-to-3D meshes arrive: one material with a
-// baked base-colour atlas, no names, and metallic at glTF's default or one
+// The `hybrid` segmenter, the default (docs/segment.md, "hybrid"; chosen by the
+// rule of docs/accuracy.md): `pbr` where a model's materials are its parts,
+// the network libg2p ships where one material covers several parts (issue
+// #31), as image-to-3D meshes arrive: one material with a baked base-colour
+// atlas (or vertex colours), no names, and metallic at glTF's default or one
 // scalar for the whole object.
 //
-// The rule, per face (docs/segment.md, "hybrid"):
+// The rule, per face:
 //  1. its names name a class (read as `pbr` and `learned` read them): `pbr`;
 //  2. no face of the model is named (scope=model, the default; with
 //     scope=material, this face's names only) and its material covers
-//     several parts, that is it covers at least `share`
-//     of the model's surface area (faces without a material count as one
-//     material): the network decides; when that material's PBR values were
-//     authored, `pbr`'s probabilities for the pixel, raised to `prior`, weigh
-//     the network's (a prior, never the decision on its own);
+//     several parts: it covers at least `share` of the model's surface area
+//     (faces without a material count as one material) and, with colour=on,
+//     an image can show its regions (a baked atlas of at least
+//     `atlas_charts` UV charts, or no colour at all). The network decides;
+//     when that material's PBR values were authored, `pbr`'s probabilities
+//     for the pixel, raised to `prior`, weigh the network's (a prior, never
+//     the decision on its own);
 //  3. its material's PBR values were authored, or some face of the model is
-//     named: `pbr` (per-part materials, as the default always read them);
-//  4. otherwise (nothing named or authored anywhere): the network.
+//     named: `pbr` (per-part materials);
+//  4. otherwise (nothing named or authored anywhere): the network with
+//     unnamed=network, `pbr` with unnamed=pbr (the default).
 // A model whose every face falls under 1 or 3 is labelled by `pbr` alone and
 // the network is neither loaded nor run.
 //
@@ -23,8 +27,9 @@
 // cannot be read or loaded), the backend labels everything as `pbr` does and
 // says why in warnings() (the pipeline reports it in PipelineResult::warnings).
 //
-// Settings: model_card = FILE, flip = on|off (as `learned`); share, prior and
-// names (HybridOptions).
+// Settings: model_card = FILE, flip = on|off (as `learned`); the rest in
+// HybridOptions. The defaults are the fifth candidate of docs/accuracy.md;
+// share=0.5 colour=off unnamed=network is the first.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -38,10 +43,11 @@ namespace {
 
 struct HybridOptions {
   // Share of the model's surface area (0 to 1) at or above which an unnamed
-  // material is taken to cover more than one physical part. 0.5: a material
-  // that is most of the object is rarely one part of it; per-part assets
-  // spread their area over several materials.
-  double share = 0.5;
+  // material is taken to cover more than one physical part. 0.99: one
+  // material for the whole object, as every image-to-3D output of the
+  // generator set has (slivers aside); per-part assets spread their area over
+  // several materials.
+  double share = 0.99;
   // Exponent (0 to 1) on `pbr`'s probabilities of a several-part material
   // whose PBR was authored, multiplied into the network's: 0 = the network
   // alone, 1 = both count the same.
@@ -60,17 +66,17 @@ struct HybridOptions {
   // texture) or there is no colour to read at all (no material, or the
   // importer's default: white, untextured, PBR not authored). A flat-coloured
   // material is one part as far as any image can tell, and `pbr` reads it.
-  bool colour = false;
+  bool colour = true;
   // With colour=on, the fewest UV charts (connected pieces of the material's
   // surface whose shared edges carry the same UVs on both sides) for its
   // texture to count as a baked atlas that shows regions. A hand-made layout
   // has a few charts (a towel 2, a skirt 9); an atlas baked by an image-to-3D
   // pipeline hundreds. 0 = any texture counts.
-  int atlas_charts = 0;
+  int atlas_charts = 16;
   // unnamed=network|pbr: rule 4, whether a model that nothing names or
   // authors goes to the network as a whole (`network`) or is read per
   // material by `pbr`.
-  bool unnamed_network = true;
+  bool unnamed_network = false;
 };
 
 class HybridSegmenter final : public Segmenter {
@@ -212,6 +218,7 @@ class HybridSegmenter final : public Segmenter {
     // Per slot: can an image show the material's regions (colour=on)?
     std::vector<char> shows_regions(n + 1, 1);
     for (std::size_t m = 0; m < n; ++m) shows_regions[m + 1] = shows_regions_in_images(model.materials[m]);
+    const std::vector<char> coloured = vertex_colours_vary_per_slot(mesh, n);
     if (options_.colour && options_.atlas_charts > 0 && mesh.has_uvs()) {
       std::vector<char> textured_and_large(n + 1, 0);
       for (std::size_t m = 0; m < n; ++m)
@@ -223,6 +230,7 @@ class HybridSegmenter final : public Segmenter {
           if (textured_and_large[k] && charts[k] < options_.atlas_charts) shows_regions[k] = 0;
       }
     }
+    for (std::size_t k = 0; k <= n; ++k) shows_regions[k] = shows_regions[k] || coloured[k];
     const bool any_named = std::any_of(named.begin(), named.end(), [](char c) { return c != 0; });
     for (std::size_t f = 0; f < named.size(); ++f) {
       if (named[f]) continue;  // 1: names decide
@@ -245,6 +253,30 @@ class HybridSegmenter final : public Segmenter {
     if (!mat.base_color_texture.empty()) return true;
     const bool white = (mat.base_color.head<3>() - Eigen::Vector3f::Ones()).cwiseAbs().maxCoeff() < 1e-3f;
     return white && !detail::pbr_authored(mat);
+  }
+
+  // Per material slot: do the vertex colours of its faces differ (by more
+  // than 2 % in a channel)? Vertex colours are the other way a generator
+  // bakes its appearance (TripoSR).
+  static std::vector<char> vertex_colours_vary_per_slot(const Mesh& mesh, std::size_t num_materials) {
+    std::vector<char> varies(num_materials + 1, 0);
+    if (!mesh.has_colors()) return varies;
+    std::vector<Eigen::Vector4f> first(num_materials + 1);
+    std::vector<char> seen(num_materials + 1, 0);
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const int m =
+          f < static_cast<int>(mesh.face_source.size()) ? mesh.face_source[static_cast<std::size_t>(f)].material : -1;
+      const std::size_t k = m >= 0 && static_cast<std::size_t>(m) < num_materials ? static_cast<std::size_t>(m) + 1 : 0;
+      for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector4f& c =
+            mesh.colors[static_cast<std::size_t>(mesh.triangles[static_cast<std::size_t>(f)][i])];
+        if (!seen[k])
+          first[k] = c, seen[k] = 1;
+        else if ((c - first[k]).cwiseAbs().maxCoeff() > 0.02f)
+          varies[k] = 1;
+      }
+    }
+    return varies;
   }
 
   // UV charts per material slot (slot 0: faces without a material): faces of

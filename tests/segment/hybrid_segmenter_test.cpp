@@ -201,6 +201,18 @@ TEST(HybridSegmenter, ColourOnLeavesAFlatColouredMaterialToPbr) {
   flat.materials[0].base_color = Eigen::Vector4f(0.55f, 0.4f, 0.25f, 1.f);
   EXPECT_EQ(share_labelled_as_pbr(flat, kWholeWithColour), 1.0);
   EXPECT_LT(share_labelled_as_pbr(flat, {{"share", "0.99"}, {"colour", "off"}}), 0.9);
+  // Varying vertex colours on that flat material (as TripoSR bakes its
+  // appearance) show regions again: the network.
+  Model coloured = flat;
+  const Eigen::AlignedBox3d box = bounds(coloured.mesh);
+  const double middle = 0.5 * (box.min().z() + box.max().z());
+  coloured.mesh.colors.assign(coloured.mesh.positions.size(), Eigen::Vector4f::Ones());
+  for (std::size_t v = 0; v < coloured.mesh.colors.size(); ++v)
+    if (coloured.mesh.positions[v].z() > middle) coloured.mesh.colors[v] = Eigen::Vector4f(0.2f, 0.3f, 0.9f, 1.f);
+  EXPECT_LT(share_labelled_as_pbr(coloured, kWholeWithColour), 0.9);
+  // Uniform vertex colours do not.
+  coloured.mesh.colors.assign(coloured.mesh.positions.size(), Eigen::Vector4f(0.9f, 0.2f, 0.2f, 1.f));
+  EXPECT_EQ(share_labelled_as_pbr(coloured, kWholeWithColour), 1.0);
   // No colour at all (the importer's default: white, untextured): the
   // network, as `pbr` has nothing to read either.
   Model plain = flat;

@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s MODEL OUTPUT_FOLDER\n", argv[0]);
     return 2;
   }
-  g2p::PipelineOptions options;  // the offline defaults: pbr, smooth, partition, table
+  g2p::PipelineOptions options;  // the offline defaults: hybrid, smooth, partition, table
   options.formats = {"mjcf"};
   g2p::Pipeline pipeline(options);
   g2p::Result<g2p::PipelineResult> result = pipeline.run_file(argv[1]);

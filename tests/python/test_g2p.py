@@ -213,10 +213,14 @@ class PythonBackendsTest(unittest.TestCase):
         pipeline.set_segmenter(Degraded())
         r = pipeline.run_file(HAMMER)
         self.assertIn("segment: fell back to all Plastic (no camera)", r.warnings)
-        # A built-in backend's: hybrid without its network says why.
+        # A built-in backend's: hybrid without its network says why, for a
+        # model that wants it (a real TRELLIS mesh), not for the named hammer.
         hybrid = g2p.make_segmenter("hybrid", {"model_card": "/nonexistent/g2p-materials.json"})
+        hybrid.set_model(g2p.load_model(str(ROOT / "data" / "generated" / "models" / "trellis_shell_chair.glb")))
         self.assertEqual(len(hybrid.warnings()), 1)
         self.assertIn("the network cannot run", hybrid.warnings()[0])
+        hybrid.set_model(g2p.load_model(HAMMER))
+        self.assertEqual(hybrid.warnings(), [])
         self.assertEqual(g2p.make_segmenter("pbr").warnings(), [])
 
     def test_segmenter_output_is_checked(self):

@@ -125,7 +125,8 @@ TEST(HybridSegmenter, WithoutItsNetworkFallsBackToPbrAndSaysWhy) {
   const Chair& chair = sheen_chair();
   ASSERT_FALSE(chair.truth.empty());
   Result<PipelineResult> r =
-      Pipeline(through_projection("hybrid", {{"model_card", "/nonexistent/g2p-materials.json"}})).run(chair.merged);
+      Pipeline(through_projection("hybrid", {{"model_card", "/nonexistent/g2p-materials.json"}, {"atlas_charts", "0"}}))
+          .run(chair.merged);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   ASSERT_EQ(r->warnings.size(), 1u);
   EXPECT_NE(r->warnings[0].find("segment: hybrid: the network cannot run"), std::string::npos) << r->warnings[0];
@@ -133,6 +134,12 @@ TEST(HybridSegmenter, WithoutItsNetworkFallsBackToPbrAndSaysWhy) {
   Result<PipelineResult> pbr = Pipeline(through_projection("pbr")).run(chair.merged);
   ASSERT_TRUE(pbr.ok());
   EXPECT_EQ(r->projection.labels.label, pbr->projection.labels.label);
+
+  // A per-part asset never wanted the network: no warning.
+  Result<PipelineResult> named =
+      Pipeline(through_projection("hybrid", {{"model_card", "/nonexistent/g2p-materials.json"}})).run(chair.original);
+  ASSERT_TRUE(named.ok()) << named.status().to_string();
+  EXPECT_TRUE(named->warnings.empty()) << named->warnings.front();
 
   // Bad settings are errors, not fallbacks.
   EXPECT_EQ(make_segmenter("hybrid", {{"share", "0"}}).status().code(), StatusCode::kInvalidArgument);
@@ -166,12 +173,21 @@ double share_labelled_as_pbr(const Model& model, const BackendSettings& settings
   const MaterialTable& table = MaterialTable::paper_default();
   auto hybrid = make_segmenter("hybrid", settings);
   auto pbr = make_segmenter("pbr");
-  if (!hybrid.ok() || !pbr.ok()) return -1;
-  if (!(*hybrid)->set_model(model, table).ok() || !(*pbr)->set_model(model, table).ok()) return -1;
+  if (!hybrid.ok() || !pbr.ok()) {
+    ADD_FAILURE() << "make_segmenter";
+    return -1;
+  }
+  if (!(*hybrid)->set_model(model, table).ok() || !(*pbr)->set_model(model, table).ok()) {
+    ADD_FAILURE() << "set_model";
+    return -1;
+  }
   double same = 0, total = 0;
   for (const View& v : test::render(model, 3, 96)) {
     Result<LabelMap> a = (*hybrid)->segment(v), b = (*pbr)->segment(v);
-    if (!a.ok() || !b.ok()) return -1;
+    if (!a.ok() || !b.ok()) {
+      ADD_FAILURE() << "segment";
+      return -1;
+    }
     for (int y = 0; y < v.face_id.height(); ++y)
       for (int x = 0; x < v.face_id.width(); ++x) {
         if (v.face_id.at(x, y) < 0) continue;
@@ -179,6 +195,7 @@ double share_labelled_as_pbr(const Model& model, const BackendSettings& settings
         same += a->labels.at(x, y) == b->labels.at(x, y);
       }
   }
+  if (total == 0) ADD_FAILURE() << "no object pixels";
   return total > 0 ? same / total : -1;
 }
 
@@ -251,7 +268,7 @@ TEST(HybridSegmenter, ScopeSaysWhetherANamedModelsUnnamedMaterialGoesToTheNetwor
   const int marked = std::max(1, named.mesh.num_faces() / 50);
   for (int f = 0; f < marked; ++f) named.mesh.face_source[static_cast<std::size_t>(f)].material = 1;
   // scope=model (the default): a named model is read by `pbr` throughout.
-  EXPECT_EQ(share_labelled_as_pbr(named, {{"scope", "model"}}), 1.0);
+  EXPECT_EQ(share_labelled_as_pbr(named, {{"scope", "model"}, {"atlas_charts", "0"}, {"share", "0.5"}}), 1.0);
   // scope=material: the large unnamed atlas still goes to the network.
   EXPECT_LT(share_labelled_as_pbr(named, {{"scope", "material"}, {"atlas_charts", "0"}, {"share", "0.5"}}), 0.9);
   EXPECT_EQ(make_segmenter("hybrid", {{"scope", "object"}}).status().code(), StatusCode::kInvalidArgument);

@@ -285,9 +285,6 @@ TEST_P(ToolRunSignal, CancelsAndWritesNothing) {
 // Ctrl-C, and TERM as `timeout`, CI runners and containers send it.
 INSTANTIATE_TEST_SUITE_P(IntAndTerm, ToolRunSignal, ::testing::Values(SIGINT, SIGTERM));
 
-// A real multi-material chair merged into one material with a baked colour
-// atlas and no names, as image-to-3D generators emit it: with `--segmenter
-// hybrid`, `g2p run` finds more than one material (issue #31).
 // Issue #31's first item: with no segmenter option, a real image-to-3D mesh
 // (TRELLIS: one material, a baked atlas, no names, metallic 1) gets more
 // than one class; the old default read it as one class, Metal.
@@ -308,6 +305,9 @@ TEST(ToolRun, TheDefaultDecomposesARealGeneratorMesh) {
   EXPECT_EQ(classes[1], std::set<std::string>{"Metal"}) << "pbr";
 }
 
+// A real multi-material chair merged into one material with a colour atlas
+// and no names: with `--segmenter hybrid`, `g2p run` finds more than one
+// material (issue #31).
 TEST(ToolRun, HybridDecomposesAGeneratedLookingMesh) {
   const std::string dir = test::scratch_dir("ToolRunGenerated");
   Result<Model> chair = load_model(test::asset_path("SheenChair"));

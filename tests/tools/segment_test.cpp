@@ -59,16 +59,26 @@ TEST(ToolSegment, BadSegmenterArguments) {
 // tools, once per run, and goes on as `pbr`.
 TEST(ToolSegment, ADegradedBackendSaysSoInSegmentAndEval) {
   const std::string dir = test::scratch_dir("ToolSegment.Degraded");
-  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
   const std::string no_card = " --segmenter hybrid --set model_card=" + quote(dir + "/missing/g2p-materials.json");
+  // A real TRELLIS mesh (one material, a baked atlas): it wants the network.
+  const std::string trellis = quote(test::source_path("data/generated/models/trellis_shell_chair.glb"));
   test::ToolRun r =
-      run_tool("segment " + hammer + " -o " + quote(dir + "/out") + " --views 1 --resolution 32" + no_card);
+      run_tool("segment " + trellis + " -o " + quote(dir + "/out") + " --views 1 --resolution 32" + no_card);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("g2p segment: warning: hybrid: the network cannot run"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("missing/g2p-materials.json"), std::string::npos) << r.err;
+  // The hammer's named materials never wanted it: no warning.
+  const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
+  r = run_tool("segment " + hammer + " -o " + quote(dir + "/hammer") + " --views 1 --resolution 32" + no_card);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
 
+  // eval seg: Avocado without its names is one textured material (any
+  // texture counts with atlas_charts=0), SheenChair's parts are not; the
+  // warning comes once.
   r = run_tool("eval seg --assets " + quote(std::filesystem::path(test::labels_json_path()).parent_path().string()) +
-               " --models Avocado SheenChair --views 1 --resolution 32" + no_card);
+               " --models Avocado SheenChair --anonymize-names --views 1 --resolution 32 --set atlas_charts=0" +
+               no_card);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string warning = "g2p eval seg: warning: hybrid: the network cannot run";
   const std::size_t first = r.err.find(warning);

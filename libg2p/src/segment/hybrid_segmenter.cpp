@@ -112,21 +112,22 @@ class HybridSegmenter final : public Segmenter {
     }
     options_ = o;
     warnings_.clear();
+    unavailable_.clear();
     network_.reset();
     if (network.count("model_card") == 0) {
       const std::string card = detail::shipped_model_card();
       if (card.empty()) {
-        warnings_.push_back(
+        unavailable_ =
             "hybrid: the shipped network's card g2p-materials.json was not found ($G2P_MODEL_DIR, the source tree, "
-            "share/g2p/models); every material is labelled as 'pbr' labels it");
+            "share/g2p/models); every material is labelled as 'pbr' labels it";
         return Status::Ok();
       }
       network["model_card"] = card;
     }
     std::unique_ptr<Segmenter> net = detail::make_deferred_onnx_segmenter();
     if (const Status s = net->configure(network); !s.ok()) {  // a card or network file missing or unreadable
-      warnings_.push_back("hybrid: the network cannot run (" + s.message() +
-                          "); every material is labelled as 'pbr' labels it");
+      unavailable_ =
+          "hybrid: the network cannot run (" + s.message() + "); every material is labelled as 'pbr' labels it";
       return Status::Ok();
     }
     network_ = std::move(net);
@@ -137,16 +138,20 @@ class HybridSegmenter final : public Segmenter {
     model_ = nullptr;
     G2P_RETURN_IF_ERROR(pbr_->set_model(model, table));
     decide_faces(model, table);
-    use_network_ =
-        network_ != nullptr && std::any_of(by_network_.begin(), by_network_.end(), [](char n) { return n != 0; });
+    // The network's absence is news only for a model that wanted it: a
+    // curated asset is labelled by `pbr` either way.
+    warnings_.clear();
+    const bool wanted = std::any_of(by_network_.begin(), by_network_.end(), [](char n) { return n != 0; });
+    use_network_ = wanted && network_ != nullptr;
     if (use_network_) {
       if (const Status s = network_->set_model(model, table); !s.ok()) {
-        warnings_.push_back("hybrid: the network cannot run (" + s.message() +
-                            "); every material is labelled as 'pbr' labels it");
+        unavailable_ =
+            "hybrid: the network cannot run (" + s.message() + "); every material is labelled as 'pbr' labels it";
         network_.reset();
         use_network_ = false;
       }
     }
+    if (wanted && !use_network_ && !unavailable_.empty()) warnings_.push_back(unavailable_);
     model_ = &model;
     return Status::Ok();
   }
@@ -216,8 +221,11 @@ class HybridSegmenter final : public Segmenter {
       total += a;
     }
     // Per slot: can an image show the material's regions (colour=on)?
+    const bool any_named = std::any_of(named.begin(), named.end(), [](char c) { return c != 0; });
+    if (options_.model_scope && any_named) return;  // 3 throughout: a curated asset, `pbr`
     std::vector<char> shows_regions(n + 1, 1);
-    for (std::size_t m = 0; m < n; ++m) shows_regions[m + 1] = shows_regions_in_images(model.materials[m]);
+    for (std::size_t m = 0; m < n; ++m)
+      shows_regions[m + 1] = shows_regions_in_images(model.materials[m], mesh.has_uvs());
     const std::vector<char> coloured = vertex_colours_vary_per_slot(mesh, n);
     if (options_.colour && options_.atlas_charts > 0 && mesh.has_uvs()) {
       std::vector<char> textured_and_large(n + 1, 0);
@@ -231,7 +239,6 @@ class HybridSegmenter final : public Segmenter {
       }
     }
     for (std::size_t k = 0; k <= n; ++k) shows_regions[k] = shows_regions[k] || coloured[k];
-    const bool any_named = std::any_of(named.begin(), named.end(), [](char c) { return c != 0; });
     for (std::size_t f = 0; f < named.size(); ++f) {
       if (named[f]) continue;  // 1: names decide
       const int m = mesh.face_source[f].material;
@@ -249,8 +256,9 @@ class HybridSegmenter final : public Segmenter {
 
   // colour=on: a base-colour texture shows regions; so does no colour at all
   // (the importer's default material), where `pbr` has nothing to read either.
-  static bool shows_regions_in_images(const SourceMaterial& mat) {
-    if (!mat.base_color_texture.empty()) return true;
+  // Without UVs a texture renders as one texel: flat.
+  static bool shows_regions_in_images(const SourceMaterial& mat, bool has_uvs) {
+    if (!mat.base_color_texture.empty()) return has_uvs;
     const bool white = (mat.base_color.head<3>() - Eigen::Vector3f::Ones()).cwiseAbs().maxCoeff() < 1e-3f;
     return white && !detail::pbr_authored(mat);
   }
@@ -260,7 +268,7 @@ class HybridSegmenter final : public Segmenter {
   // bakes its appearance (TripoSR).
   static std::vector<char> vertex_colours_vary_per_slot(const Mesh& mesh, std::size_t num_materials) {
     std::vector<char> varies(num_materials + 1, 0);
-    if (!mesh.has_colors()) return varies;
+    if (!mesh.has_colors() || mesh.colors.size() != mesh.positions.size()) return varies;  // none, or stale
     std::vector<Eigen::Vector4f> first(num_materials + 1);
     std::vector<char> seen(num_materials + 1, 0);
     for (int f = 0; f < mesh.num_faces(); ++f) {
@@ -321,7 +329,8 @@ class HybridSegmenter final : public Segmenter {
   HybridOptions options_;
   std::unique_ptr<Segmenter> network_;  // null when it cannot run
   std::unique_ptr<Segmenter> pbr_ = make_pbr_segmenter();
-  std::vector<std::string> warnings_;  // why the network cannot run; kept for every later model
+  std::string unavailable_;            // why the network cannot run (empty: it can, or has not been asked)
+  std::vector<std::string> warnings_;  // of the last set_model: unavailable_, when that model wanted the network
   const Model* model_ = nullptr;
   std::vector<char> by_network_;
   bool use_network_ = false;

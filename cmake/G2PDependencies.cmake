@@ -16,7 +16,7 @@ g2p_require(Eigen3_FOUND libeigen3-dev)
 find_package(assimp QUIET)
 g2p_require(assimp_FOUND libassimp-dev)
 
-find_package(OpenCV 4.6 QUIET COMPONENTS core imgproc imgcodecs dnn)
+find_package(OpenCV 4.6 QUIET COMPONENTS core imgproc imgcodecs dnn ml)
 g2p_require(OpenCV_FOUND libopencv-dev)
 
 find_package(embree 3 QUIET)

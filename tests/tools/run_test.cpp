@@ -305,6 +305,32 @@ TEST(ToolRun, TheDefaultDecomposesARealGeneratorMesh) {
   EXPECT_EQ(classes[1], std::set<std::string>{"Metal"}) << "pbr";
 }
 
+// The region classifier on a real generator mesh: one decision per region,
+// the stage not degraded; without its card it says so and smooths instead.
+TEST(ToolRun, TheRegionsRefinerDecidesPerRegionOnAGeneratorMesh) {
+  const std::string dir = test::scratch_dir("ToolRunRegions");
+  const std::string glb = test::quote(test::source_path("data/generated/models/trellis_shell_chair.glb"));
+  test::ToolRun r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/out") + kQuick +
+                                   " --refiner regions --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+  std::set<std::string> classes;
+  for (const auto& part : j["parts"]) classes.insert(part["material"].get<std::string>());
+  EXPECT_GE(classes.size(), 2u) << j["parts"].dump();
+  const nlohmann::json refine = nlohmann::json::parse(test::read_file(dir + "/out/refine.json"));
+  EXPECT_EQ(refine["refiner"], "regions");
+  EXPECT_NE(refine["notes"].dump().find("decided by the classifier"), std::string::npos) << refine.dump();
+
+  r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/missing") + kQuick +
+                     " --refiner regions --refine-set card=" + test::quote(dir + "/no-such-card.json") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  j = nlohmann::json::parse(r.out);
+  const std::string warnings = j["warnings"].dump();
+  EXPECT_NE(warnings.find("no-such-card.json"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("smooth refiner ran instead"), std::string::npos) << warnings;
+}
+
 // A real multi-material chair merged into one material with a colour atlas
 // and no names: with `--segmenter hybrid`, `g2p run` finds more than one
 // material (issue #31).

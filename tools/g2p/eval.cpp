@@ -17,6 +17,7 @@
 #include "g2p/eval.h"
 #include "g2p/io.h"
 #include "g2p/project.h"
+#include "g2p/regions.h"
 #include "g2p/segment.h"
 #include "stage_outputs.h"
 
@@ -34,9 +35,47 @@ struct EvalArgs {
   std::string truth;  // labels.json elsewhere than in `assets`
   std::string split;  // only models whose entry has this "split"
   std::string json_out;
-  bool soft = false;  // soft votes (the segmenter's probabilities) instead of one vote per pixel
-  RefineArgs refine;  // the refine stage after voting (default none: the project stage alone)
+  bool soft = false;            // soft votes (the segmenter's probabilities) instead of one vote per pixel
+  RefineArgs refine;            // the refine stage after voting (default none: the project stage alone)
+  std::string region_features;  // CSV of every region's features and true class (training the region classifier)
 };
+
+// The regions of one model with their features (regions.h) and their true
+// class: the class of most of the region's labelled area, with that share and
+// the labelled share of the region, for training and checking the region
+// classifier.
+Status write_region_rows(std::ostream& out, const std::string& key, const Model& model, const std::vector<View>& views,
+                         const Projection& projection, const std::vector<int>& face_truth, const MaterialTable& table) {
+  const FaceColours colours = face_colours(model.mesh, views);
+  Result<Regions> regions = find_regions(model.mesh, projection.graph, colours);
+  if (!regions.ok()) return regions.status();
+  Result<std::vector<float>> features = region_features(model.mesh, *regions, projection.votes, colours, table);
+  if (!features.ok()) return features.status();
+  const std::size_t width = region_feature_names(table).size();
+  double total = 0.0;
+  for (const Region& r : regions->regions) total += r.area_m2;
+  std::vector<double> by_class(static_cast<std::size_t>(table.size()));
+  for (std::size_t r = 0; r < regions->regions.size(); ++r) {
+    const Region& region = regions->regions[r];
+    std::fill(by_class.begin(), by_class.end(), 0.0);
+    double labelled = 0.0;
+    for (const int f : region.faces) {
+      const int t = face_truth[static_cast<std::size_t>(f)];
+      if (t < 0 || t >= table.size()) continue;
+      const double a = face_area(model.mesh, f);
+      by_class[static_cast<std::size_t>(t)] += a;
+      labelled += a;
+    }
+    const auto best = std::max_element(by_class.begin(), by_class.end());
+    const bool known = labelled > 0.0 && *best > 0.0;
+    out << '"' << key << "\"," << r << ',' << region.faces.size() << ',' << (total > 0 ? region.area_m2 / total : 0.0)
+        << ',' << (known ? table[static_cast<int>(best - by_class.begin())].name : std::string()) << ','
+        << (known ? *best / labelled : 0.0) << ',' << (region.area_m2 > 0 ? labelled / region.area_m2 : 0.0);
+    for (std::size_t i = 0; i < width; ++i) out << ',' << (*features)[r * width + i];
+    out << '\n';
+  }
+  return out ? Status::Ok() : Status::IoError("writing the region features failed");
+}
 
 // What image-to-3D generators emit: base colour only. Metallic and roughness
 // go to glTF's defaults (1, 1), their texture and transmission are dropped.
@@ -82,6 +121,17 @@ int run_eval_seg(const EvalArgs& args) {
   if (!predictor.ok()) return exit_code;
   Result<std::unique_ptr<Refiner>> refiner = make_refiner_flag("eval seg", args.refine, exit_code);
   if (!refiner.ok()) return exit_code;
+  std::ofstream region_rows;
+  if (!args.region_features.empty()) {
+    region_rows.open(args.region_features, std::ios::binary | std::ios::trunc);
+    if (!region_rows) {
+      std::cerr << "g2p eval seg: error: --region-features " << args.region_features << ": cannot be written\n";
+      return kExitFailure;
+    }
+    region_rows << "model,region,faces,area_share,truth,truth_share,labelled_share";
+    for (const std::string& name : region_feature_names(*table)) region_rows << ',' << name;
+    region_rows << '\n';
+  }
 
   // total_3d pools every face by its area; per_model_3d scales each model's
   // matrix to one first, so that no model dominates by its size or units
@@ -146,11 +196,6 @@ int run_eval_seg(const EvalArgs& args) {
       std::cerr << "g2p eval seg: error: " << key << ": " << projection.status().to_string() << "\n";
       return kExitFailure;
     }
-    nlohmann::json refine_report;  // kept in the JSON, not printed: the table stays one line per model
-    if (const int code = apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
-                                       project_options.partition, *projection, refine_report, /*print_notes=*/false);
-        code != kExitOk)
-      return code;
     Result<std::vector<int>> material_truth =
         material_labels_from_json(text.str(), key, *table, static_cast<int>(model->materials.size()));
     if (!material_truth.ok()) {
@@ -162,6 +207,17 @@ int run_eval_seg(const EvalArgs& args) {
       const int m = model->mesh.face_source[f].material;
       if (m >= 0 && m < static_cast<int>(material_truth->size())) face_truth[f] = (*material_truth)[m];
     }
+    if (region_rows.is_open())
+      if (Status st = write_region_rows(region_rows, key, *model, *views, *projection, face_truth, *table); !st.ok()) {
+        std::cerr << "g2p eval seg: error: --region-features " << args.region_features << ": " << st.to_string()
+                  << "\n";
+        return kExitFailure;
+      }
+    nlohmann::json refine_report;  // kept in the JSON, not printed: the table stays one line per model
+    if (const int code = apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
+                                       project_options.partition, *projection, refine_report, /*print_notes=*/false);
+        code != kExitOk)
+      return code;
     ConfusionMatrix matrix_3d(table->size());
     if (Status st = matrix_3d.add_faces(model->mesh, face_truth, projection->labels.label); !st.ok()) {
       std::cerr << "g2p eval seg: error: " << st.to_string() << "\n";
@@ -445,6 +501,9 @@ void add_eval_command(CLI::App& app, Command& run) {
   add_segmenter_flags(seg, args->segmenter);
   seg->add_flag("--soft", args->soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
   add_refiner_flags(seg, args->refine, "none");
+  seg->add_option("--region-features", args->region_features,
+                  "Also write every region's features and true class to this CSV (training the region classifier, "
+                  "docs/regions.md)");
   seg->callback([args, &run] { run = [args] { return run_eval_seg(*args); }; });
 
   auto margs = std::make_shared<MassArgs>();

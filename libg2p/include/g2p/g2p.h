@@ -15,6 +15,7 @@
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/refine.h"
+#include "g2p/regions.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"

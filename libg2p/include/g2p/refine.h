@@ -44,7 +44,8 @@ struct RefineResult {
   std::vector<LabelChange> changes;  // every face whose label differs from the input
   std::vector<std::string> notes;    // what the refiner did or could not do, for the report
   // The backend could not do its work (a model server down, an unusable
-  // answer) and returned the input labels; `notes` says why. The pipeline
+  // answer, a classifier not installed) and returned the input labels, or
+  // those of the backend it fell back to; `notes` says why. The pipeline
   // reports this as a degraded stage.
   bool fell_back = false;
 };
@@ -58,8 +59,9 @@ class G2P_API Refiner {
 };
 
 // Backends by name; libg2p registers "smooth" (the offline default), "vlm"
-// (a vision-language model over an OpenAI-compatible API, docs/vlm.md) and
-// "none" (labels unchanged, for ablations).
+// (a vision-language model over an OpenAI-compatible API, docs/vlm.md),
+// "regions" (the region classifier of regions.h) and "none" (labels
+// unchanged, for ablations).
 G2P_API Registry<Refiner>& refiner_registry();
 G2P_API Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings = {});
 

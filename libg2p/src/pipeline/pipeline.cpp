@@ -243,7 +243,10 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     if (applied.ok() && refined->fell_back) {
       report.ok = false;
       report.error = refined->notes.empty() ? "the backend kept the input labels" : refined->notes.back();
-      r.warnings.push_back("refine (" + report.backend + ") failed; the projected labels stand: " + report.error);
+      // A backend that fell back to another one (regions to smooth) still changed labels.
+      r.warnings.push_back("refine (" + report.backend + ") " +
+                           (refined->changes.empty() ? "failed; the projected labels stand: " : "degraded: ") +
+                           report.error);
       r.refinement = std::move(*refined);
     } else if (!applied.ok()) {
       report.ok = false;

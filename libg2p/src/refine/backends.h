@@ -9,5 +9,6 @@ namespace g2p {
 
 std::unique_ptr<Refiner> make_smooth_refiner();
 std::unique_ptr<Refiner> make_vlm_refiner();
+std::unique_ptr<Refiner> make_regions_refiner();  // regions/regions_refiner.cpp
 
 }  // namespace g2p

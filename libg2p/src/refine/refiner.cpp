@@ -32,6 +32,7 @@ Registry<Refiner>& refiner_registry() {
     auto* r = new Registry<Refiner>();  // never destroyed: usable during static destruction
     (void)r->add("smooth", &make_smooth_refiner);
     (void)r->add("vlm", [] { return make_vlm_refiner(); });
+    (void)r->add("regions", &make_regions_refiner);
     (void)r->add("none", [] { return std::unique_ptr<Refiner>(std::make_unique<NoRefiner>()); });
     return r;
   }();

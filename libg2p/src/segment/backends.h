@@ -44,6 +44,9 @@ NameScores pbr_name_scores(const Model& model, const MaterialTable& table);
 // the source tree's libg2p/data/models or the installed share/g2p/models), or
 // "" when none is found.
 std::string shipped_model_card();
+// A file shipped beside the network (the region classifier's card and trees),
+// searched in the same folders; empty if none has it.
+std::string shipped_model_file(const std::string& name);
 
 // Whether an author set the material's PBR values: read from a format with PBR
 // materials, and not glTF's defaults (a metallic-roughness texture,

@@ -44,7 +44,9 @@ constexpr const char* kShippedCard = "g2p-materials.json";
 
 namespace detail {
 
-std::string shipped_model_card() {
+std::string shipped_model_card() { return shipped_model_file(kShippedCard); }
+
+std::string shipped_model_file(const std::string& name) {
   std::vector<std::string> dirs;
   if (const char* env = std::getenv("G2P_MODEL_DIR"); env != nullptr && *env != '\0') dirs.emplace_back(env);
 #ifdef G2P_SOURCE_MODEL_DIR
@@ -55,8 +57,8 @@ std::string shipped_model_card() {
 #endif
   for (const std::string& d : dirs) {
     std::error_code ec;
-    const std::filesystem::path card = std::filesystem::path(d) / kShippedCard;
-    if (std::filesystem::is_regular_file(card, ec)) return card.string();
+    const std::filesystem::path file = std::filesystem::path(d) / name;
+    if (std::filesystem::is_regular_file(file, ec)) return file.string();
   }
   return {};
 }

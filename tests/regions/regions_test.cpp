@@ -1,0 +1,350 @@
+// The regions step: the cut of real meshes into regions that follow their
+// materials, the features of those regions, and the region classifier
+// (trained here, saved, loaded and used as the `regions` refiner).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <random>
+#include <set>
+
+#include "g2p/project.h"
+#include "g2p/refine.h"
+#include "g2p/regions.h"
+#include "segment/segment_fixtures.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+const MaterialTable& table() { return MaterialTable::paper_default(); }
+
+// A shared asset as an image-to-3D generator writes it (one material, a
+// base-colour atlas, no names), its views, graph and per-face truth.
+struct Scene {
+  Model model;
+  std::vector<View> views;
+  FaceGraph graph;
+  std::vector<int> truth;  // per face, the source material's class
+};
+
+Scene generated(const std::string& name) {
+  Scene s;
+  const Model original = *load_model(test::asset_path(name));
+  const std::vector<int> by_material = *material_labels_from_json(test::read_file(test::labels_json_path()), name,
+                                                                  table(), static_cast<int>(original.materials.size()));
+  for (const FaceSource& f : original.mesh.face_source) s.truth.push_back(by_material[f.material]);
+  s.model = test::one_atlas_material(original);
+  s.views = test::render(s.model, 6, 192);
+  s.graph = *build_face_graph(s.model.mesh);
+  return s;
+}
+
+// Area share of the regions' faces whose truth is their region's majority.
+double purity(const Scene& s, const Regions& r) {
+  double right = 0, all = 0;
+  for (const Region& region : r.regions) {
+    std::map<int, double> by_class;
+    for (const int f : region.faces)
+      if (s.truth[f] >= 0) by_class[s.truth[f]] += face_area(s.model.mesh, f);  // "ignore" materials do not count
+    double best = 0, sum = 0;
+    for (const auto& [c, a] : by_class) best = std::max(best, a), sum += a;
+    right += best;
+    all += sum;
+  }
+  return right / all;
+}
+
+// Per face, its connected component of the graph, over the edges whose
+// faces have the same `kind` (all edges when `kind` is empty).
+std::vector<int> components(const FaceGraph& g, const std::vector<int>& kind = {}) {
+  std::vector<int> component(g.num_faces(), -1);
+  int count = 0;
+  for (int f = 0; f < g.num_faces(); ++f) {
+    if (component[f] >= 0) continue;
+    std::vector<int> stack{f};
+    component[f] = count;
+    while (!stack.empty()) {
+      const int x = stack.back();
+      stack.pop_back();
+      for (int i = g.offsets[x]; i < g.offsets[x + 1]; ++i)
+        if (component[g.neighbors[i]] < 0 && (kind.empty() || kind[g.neighbors[i]] == kind[x]))
+          component[g.neighbors[i]] = count, stack.push_back(g.neighbors[i]);
+    }
+    ++count;
+  }
+  return component;
+}
+
+TEST(Regions, FollowTheMaterialsOfAOneMaterialAtlasMesh) {
+  for (const std::string name : {"SheenChair", "GlamVelvetSofa"}) {
+    const Scene s = generated(name);
+    const FaceColours colours = face_colours(s.model.mesh, s.views);
+    Result<Regions> r = find_regions(s.model.mesh, s.graph, colours);
+    ASSERT_TRUE(r.ok()) << r.status().to_string();
+    // Every face in exactly one region, areas adding up.
+    ASSERT_EQ(r->face_region.size(), s.model.mesh.triangles.size());
+    std::vector<int> count(r->regions.size(), 0);
+    double area = 0;
+    for (std::size_t i = 0; i < r->regions.size(); ++i) {
+      area += r->regions[i].area_m2;
+      for (const int f : r->regions[i].faces) {
+        EXPECT_EQ(r->face_region[f], static_cast<int>(i));
+        ++count[i];
+      }
+    }
+    EXPECT_EQ(std::accumulate(count.begin(), count.end(), 0), s.model.mesh.num_faces());
+    double mesh_area = 0;
+    for (int f = 0; f < s.model.mesh.num_faces(); ++f) mesh_area += face_area(s.model.mesh, f);
+    EXPECT_NEAR(area, mesh_area, 1e-9 * mesh_area);
+    // The one material is cut where the atlas colours and the creases change:
+    // far fewer regions than faces, each nearly one true class.
+    EXPECT_GT(r->regions.size(), 1u) << name;
+    EXPECT_LT(r->regions.size(), s.model.mesh.triangles.size() / 20) << name;
+    const double p = purity(s, *r);
+    std::printf("%s: %zu faces, %zu regions, purity %.4f\n", name.c_str(), s.model.mesh.triangles.size(),
+                r->regions.size(), p);
+    EXPECT_GT(p, 0.97) << name;
+    // Without colour or crease cuts, a region is the seen or the unseen part
+    // of one separate piece: never two pieces, never seen and unseen faces.
+    RegionOptions whole;
+    whole.crease_deg = 180;
+    whole.colour_step = 10;
+    whole.min_area_fraction = 0;
+    Result<Regions> pieces = find_regions(s.model.mesh, s.graph, colours, whole);
+    ASSERT_TRUE(pieces.ok());
+    const std::vector<int> component = components(s.graph);
+    std::vector<int> seen_kind(s.model.mesh.num_faces());
+    for (int f = 0; f < s.model.mesh.num_faces(); ++f) seen_kind[f] = colours.pixels[f] > 0;
+    const std::vector<int> patch = components(s.graph, seen_kind);
+    std::set<int> patches;
+    for (const Region& region : pieces->regions) {
+      const int piece = component[region.faces.front()];
+      EXPECT_TRUE(patches.insert(patch[region.faces.front()]).second) << name << ": one patch, two regions";
+      for (const int f : region.faces) {
+        EXPECT_EQ(component[f], piece) << name;
+        EXPECT_EQ(patch[f], patch[region.faces.front()]) << name;
+      }
+    }
+    EXPECT_EQ(patches.size(), static_cast<std::size_t>(*std::max_element(patch.begin(), patch.end()) + 1)) << name;
+  }
+}
+
+TEST(Regions, BadOptionsAndMismatchedInputsAreRefused) {
+  const Scene s = generated("WaterBottle");
+  const FaceColours colours = face_colours(s.model.mesh, s.views);
+  RegionOptions bad;
+  bad.crease_deg = 270;
+  Result<Regions> r = find_regions(s.model.mesh, s.graph, colours, bad);
+  EXPECT_FALSE(r.ok());
+  FaceColours short_colours = colours;
+  short_colours.rgb.pop_back();
+  r = find_regions(s.model.mesh, s.graph, short_colours);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("not of this mesh"), std::string::npos) << r.status().message();
+}
+
+TEST(Regions, FeaturesDescribeVotesColourAndPlace) {
+  const Scene s = generated("SheenChair");
+  const FaceColours colours = face_colours(s.model.mesh, s.views);
+  const Regions r = *find_regions(s.model.mesh, s.graph, colours);
+  // Votes from the truth itself (an oracle): each region's vote shares are
+  // its true class mix.
+  const std::vector<LabelMap> maps = [&] {
+    auto oracle = std::move(*make_segmenter("oracle", {{"labels", test::labels_json_path()}, {"key", "SheenChair"}}));
+    const Model original = *load_model(test::asset_path("SheenChair"));
+    EXPECT_TRUE(oracle->set_model(original, table()).ok());
+    std::vector<LabelMap> out;
+    for (const View& v : s.views) out.push_back(*oracle->segment(v));
+    return out;
+  }();
+  const FaceVotes votes = *vote(s.model.mesh, s.views, maps, table().size());
+  Result<std::vector<float>> x = region_features(s.model.mesh, r, votes, colours, table());
+  ASSERT_TRUE(x.ok()) << x.status().to_string();
+  const std::vector<std::string> names = region_feature_names(table());
+  const std::size_t w = names.size();
+  ASSERT_EQ(x->size(), r.regions.size() * w);
+  auto column = [&](const std::string& n) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  const std::size_t height = column("height"), share = column("log_area_share"), value = column("value");
+  ASSERT_LT(height, w);
+  double lowest = 2, highest = -1;
+  for (std::size_t i = 0; i < r.regions.size(); ++i) {
+    const float* row = x->data() + i * w;
+    double votes_sum = 0, object_sum = 0;
+    for (int c = 0; c < table().size(); ++c) votes_sum += row[c], object_sum += row[table().size() + c];
+    EXPECT_NEAR(object_sum, 1.0, 1e-4);
+    if (votes_sum > 0) EXPECT_NEAR(votes_sum, 1.0, 1e-4);
+    EXPECT_GE(row[height], 0.f);
+    EXPECT_LE(row[height], 1.f);
+    EXPECT_LE(row[share], 0.f);
+    EXPECT_GE(row[value], 0.f);
+    EXPECT_LE(row[value], 1.f);
+    lowest = std::min<double>(lowest, row[height]), highest = std::max<double>(highest, row[height]);
+    // The votes of a pure region name its true class.
+    std::map<int, double> by_class;
+    for (const int f : r.regions[i].faces) by_class[s.truth[f]] += face_area(s.model.mesh, f);
+    if (by_class.size() == 1 && by_class.begin()->first >= 0 && votes_sum > 0) {
+      const int truth = by_class.begin()->first;
+      EXPECT_GT(row[truth], 0.9f) << "region " << i;
+    }
+  }
+  EXPECT_LT(lowest, 0.3);   // the legs
+  EXPECT_GT(highest, 0.6);  // the back
+}
+
+// Rows for training: a class decided by one feature ("height": bottom
+// regions Metal, top ones Fabric), the others noise.
+void synthetic_rows(int rows, std::vector<float>& x, std::vector<int>& y, std::vector<float>& w) {
+  const std::vector<std::string> names = region_feature_names(table());
+  const std::size_t width = names.size();
+  const std::size_t height = std::find(names.begin(), names.end(), "height") - names.begin();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int i = 0; i < rows; ++i) {
+    for (std::size_t c = 0; c < width; ++c) x.push_back(u(rng));
+    y.push_back(x[i * width + height] < 0.5f ? table().find("Metal") : table().find("Fabric"));
+    w.push_back(1.f);
+  }
+}
+
+std::string write_card(const std::string& dir) {
+  nlohmann::json classes = nlohmann::json::array();
+  for (const MaterialClass& c : table().classes()) classes.push_back(c.name);
+  const nlohmann::json card = {{"format", "g2p-region-classifier"},
+                               {"version", 1},
+                               {"classes", classes},
+                               {"features", region_feature_names(table())},
+                               {"trees", "trees.yml.gz"}};
+  std::ofstream(dir + "/card.json") << card.dump();
+  return dir + "/card.json";
+}
+
+// Trees trained on 400 synthetic rows in DIR, and their card; returns the card.
+std::string train_synthetic(const std::string& dir) {
+  std::vector<float> x, w;
+  std::vector<int> y;
+  synthetic_rows(400, x, y, w);
+  RegionTrainOptions o;
+  o.trees = 30;
+  const Status s = train_region_classifier(x, y, w, static_cast<int>(region_feature_names(table()).size()),
+                                           table().size(), o, dir + "/trees.yml.gz");
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return write_card(dir);
+}
+
+TEST(RegionClassifier, TrainsSavesLoadsAndPredicts) {
+  const std::string dir = test::scratch_dir("region_classifier");
+  Result<RegionClassifier> c = RegionClassifier::load(train_synthetic(dir), table());
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  std::vector<float> tx, tw;
+  std::vector<int> ty;
+  synthetic_rows(100, tx, ty, tw);
+  Result<std::vector<float>> p = c->predict(tx, 100);
+  ASSERT_TRUE(p.ok()) << p.status().to_string();
+  int right = 0;
+  for (int i = 0; i < 100; ++i) {
+    const float* q = p->data() + i * table().size();
+    EXPECT_NEAR(std::accumulate(q, q + table().size(), 0.f), 1.f, 1e-5);
+    right += std::max_element(q, q + table().size()) - q == ty[i];
+  }
+  EXPECT_GE(right, 90);
+  EXPECT_FALSE(c->predict(tx, 99).ok());  // the wrong row count
+}
+
+TEST(RegionClassifier, ABadCardIsNamed) {
+  const std::string dir = test::scratch_dir("region_classifier_bad");
+  Result<RegionClassifier> c = RegionClassifier::load(dir + "/missing.json", table());
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("missing.json"), std::string::npos);
+  const std::string card = write_card(dir);  // no trees file yet
+  c = RegionClassifier::load(card, table());
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("trees.yml.gz"), std::string::npos) << c.status().message();
+  std::ofstream(dir + "/other.json") << R"({"format": "g2p-region-classifier", "version": 1, "classes": ["Wood"],
+    "features": [], "trees": "trees.yml.gz"})";
+  c = RegionClassifier::load(dir + "/other.json", table());
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("other classes"), std::string::npos) << c.status().message();
+  std::ofstream(dir + "/text.json") << "not json";
+  EXPECT_FALSE(RegionClassifier::load(dir + "/text.json", table()).ok());
+}
+
+RefineInput input_of(const Scene& s, const Projection& p) {
+  RefineInput in;
+  in.mesh = &s.model.mesh;
+  in.graph = &p.graph;
+  in.votes = &p.votes;
+  in.labels = &p.labels;
+  in.views = &s.views;
+  in.table = &table();
+  return in;
+}
+
+// The scene segmented by `pbr` and projected.
+Projection pbr_projection(const Scene& s) {
+  auto segmenter = std::move(*make_segmenter("pbr"));
+  EXPECT_TRUE(segmenter->set_model(s.model, table()).ok());
+  std::vector<LabelMap> maps;
+  for (const View& v : s.views) maps.push_back(*segmenter->segment(v));
+  return *project(s.model.mesh, s.views, maps, table().size());
+}
+
+TEST(RegionsRefiner, DecidesOncePerRegion) {
+  const std::string card = train_synthetic(test::scratch_dir("regions_refiner"));
+  const Scene s = generated("SheenChair");
+  const Projection p = pbr_projection(s);
+  Result<std::unique_ptr<Refiner>> refiner = make_refiner("regions", {{"card", card}});
+  ASSERT_TRUE(refiner.ok()) << refiner.status().to_string();
+  Result<RefineResult> r = (*refiner)->refine(input_of(s, p));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_FALSE(r->fell_back);
+  // The classifier learnt "low is Metal, high is Fabric": the chair's legs
+  // become Metal and its back Fabric, whatever pbr said, and every region is
+  // one class.
+  const Regions regions = *find_regions(s.model.mesh, p.graph, face_colours(s.model.mesh, s.views));
+  for (const Region& region : regions.regions)
+    for (const int f : region.faces) EXPECT_EQ(r->labels[f], r->labels[region.faces.front()]);
+  for (int f = 0; f < s.model.mesh.num_faces(); ++f) {
+    const int l = r->labels[f];
+    EXPECT_TRUE(l == table().find("Metal") || l == table().find("Fabric")) << f;
+  }
+  int changed = 0;
+  for (const LabelChange& c : r->changes) {
+    EXPECT_EQ(r->labels[c.face], c.to);
+    EXPECT_EQ(p.labels.label[c.face], c.from);
+    EXPECT_NE(c.reason.find("region classifier"), std::string::npos);
+    ++changed;
+  }
+  EXPECT_GT(changed, 0);
+}
+
+TEST(RegionsRefiner, FallsBackToSmoothAndSaysWhy) {
+  const Scene s = generated("WaterBottle");
+  const Projection p = pbr_projection(s);
+  Result<std::unique_ptr<Refiner>> refiner = make_refiner("regions", {{"card", "/nonexistent/g2p-regions.json"}});
+  ASSERT_TRUE(refiner.ok());
+  Result<RefineResult> r = (*refiner)->refine(input_of(s, p));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_TRUE(r->fell_back);
+  ASSERT_FALSE(r->notes.empty());
+  EXPECT_NE(r->notes.back().find("/nonexistent/g2p-regions.json"), std::string::npos) << r->notes.back();
+  EXPECT_NE(r->notes.back().find("smooth"), std::string::npos) << r->notes.back();
+  // No views: no colours to read.
+  RefineInput blind = input_of(s, p);
+  blind.views = nullptr;
+  r = (*refiner)->refine(blind);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->fell_back);
+  EXPECT_FALSE(make_refiner("regions", {{"crease", "200"}}).ok());
+  EXPECT_FALSE(make_refiner("regions", {{"colour", "red"}}).ok());
+}
+
+}  // namespace
+}  // namespace g2p

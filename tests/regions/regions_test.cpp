@@ -273,7 +273,22 @@ TEST(RegionClassifier, ABadCardIsNamed) {
   ASSERT_FALSE(c.ok());
   EXPECT_NE(c.status().message().find("other classes"), std::string::npos) << c.status().message();
   std::ofstream(dir + "/text.json") << "not json";
-  EXPECT_FALSE(RegionClassifier::load(dir + "/text.json", table()).ok());
+  c = RegionClassifier::load(dir + "/text.json", table());
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("text.json"), std::string::npos) << c.status().message();
+  // A version that is not the number 1 is refused, not thrown.
+  std::ofstream(dir + "/version.json") << R"({"format": "g2p-region-classifier", "version": "1"})";
+  c = RegionClassifier::load(dir + "/version.json", table());
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("version"), std::string::npos) << c.status().message();
+  // Trees of another feature count behind a right card.
+  std::vector<float> x(5 * 40, 0.5f), w(40, 1.f);
+  std::vector<int> y(40, 0);
+  for (int i = 20; i < 40; ++i) y[i] = 1, x[i * 5] = 0.9f;
+  ASSERT_TRUE(train_region_classifier(x, y, w, 5, table().size(), {}, dir + "/trees.yml.gz").ok());
+  c = RegionClassifier::load(card, table());
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.status().message().find("features"), std::string::npos) << c.status().message();
 }
 
 RefineInput input_of(const Scene& s, const Projection& p) {
@@ -328,22 +343,38 @@ TEST(RegionsRefiner, DecidesOncePerRegion) {
 TEST(RegionsRefiner, FallsBackToSmoothAndSaysWhy) {
   const Scene s = generated("WaterBottle");
   const Projection p = pbr_projection(s);
-  Result<std::unique_ptr<Refiner>> refiner = make_refiner("regions", {{"card", "/nonexistent/g2p-regions.json"}});
-  ASSERT_TRUE(refiner.ok());
-  Result<RefineResult> r = (*refiner)->refine(input_of(s, p));
-  ASSERT_TRUE(r.ok()) << r.status().to_string();
-  EXPECT_TRUE(r->fell_back);
-  ASSERT_FALSE(r->notes.empty());
-  EXPECT_NE(r->notes.back().find("/nonexistent/g2p-regions.json"), std::string::npos) << r->notes.back();
-  EXPECT_NE(r->notes.back().find("smooth"), std::string::npos) << r->notes.back();
-  // No views: no colours to read.
+  auto expect_fallback = [&](const std::string& card, const RefineInput& in, const std::string& why) {
+    Result<std::unique_ptr<Refiner>> refiner = make_refiner("regions", {{"card", card}});
+    ASSERT_TRUE(refiner.ok()) << refiner.status().to_string();
+    Result<RefineResult> r = (*refiner)->refine(in);
+    ASSERT_TRUE(r.ok()) << r.status().to_string();
+    EXPECT_TRUE(r->fell_back) << why;
+    ASSERT_FALSE(r->notes.empty());
+    EXPECT_NE(r->notes.back().find(why), std::string::npos) << r->notes.back();
+    EXPECT_NE(r->notes.back().find("the smooth refiner ran instead"), std::string::npos) << r->notes.back();
+    EXPECT_EQ(r->labels.size(), s.model.mesh.triangles.size());
+  };
+  const std::string dir = test::scratch_dir("regions_refiner_fallback");
+  // A card that cannot be read: named.
+  std::ofstream(dir + "/broken.json") << "not json";
+  expect_fallback(dir + "/broken.json", input_of(s, p), dir + "/broken.json");
+  // A good card, but no views, or views without base colour.
+  const std::string card = train_synthetic(dir);
   RefineInput blind = input_of(s, p);
   blind.views = nullptr;
-  r = (*refiner)->refine(blind);
-  ASSERT_TRUE(r.ok());
-  EXPECT_TRUE(r->fell_back);
+  expect_fallback(card, blind, "no rendered views");
+  std::vector<View> shaded = s.views;
+  for (View& v : shaded) v.base_color = ImageF();
+  RefineInput lit = input_of(s, p);
+  lit.views = &shaded;
+  expect_fallback(card, lit, "no base-colour buffer");
+  // Wrong settings are the caller's to fix: refused, not a fallback.
+  Result<std::unique_ptr<Refiner>> missing = make_refiner("regions", {{"card", dir + "/none.json"}});
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("none.json"), std::string::npos) << missing.status().message();
   EXPECT_FALSE(make_refiner("regions", {{"crease", "200"}}).ok());
   EXPECT_FALSE(make_refiner("regions", {{"colour", "red"}}).ok());
+  EXPECT_FALSE(make_refiner("regions", {{"min_probability", "1.5"}}).ok());
 }
 
 }  // namespace

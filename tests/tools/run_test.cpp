@@ -322,13 +322,21 @@ TEST(ToolRun, TheRegionsRefinerDecidesPerRegionOnAGeneratorMesh) {
   EXPECT_EQ(refine["refiner"], "regions");
   EXPECT_NE(refine["notes"].dump().find("decided by the classifier"), std::string::npos) << refine.dump();
 
-  r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/missing") + kQuick +
-                     " --refiner regions --refine-set card=" + test::quote(dir + "/no-such-card.json") + " --json");
+  // A card that cannot be read: the run goes on with smooth and says why.
+  test::write_file(dir + "/broken-card.json", "{\"format\": \"something else\"}");
+  r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/broken") + kQuick +
+                     " --refiner regions --refine-set card=" + test::quote(dir + "/broken-card.json") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   j = nlohmann::json::parse(r.out);
   const std::string warnings = j["warnings"].dump();
-  EXPECT_NE(warnings.find("no-such-card.json"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("broken-card.json"), std::string::npos) << warnings;
   EXPECT_NE(warnings.find("smooth refiner ran instead"), std::string::npos) << warnings;
+  // A card that is not there is a mistake in the command: refused, nothing written.
+  r = test::run_tool("run " + glb + " -o " + test::quote(dir + "/missing") + kQuick +
+                     " --refiner regions --refine-set card=" + test::quote(dir + "/no-such-card.json"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("no-such-card.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/missing"));
 }
 
 // A real multi-material chair merged into one material with a colour atlas

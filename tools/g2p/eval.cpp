@@ -209,8 +209,8 @@ int run_eval_seg(const EvalArgs& args) {
     }
     if (region_rows.is_open())
       if (Status st = write_region_rows(region_rows, key, *model, *views, *projection, face_truth, *table); !st.ok()) {
-        std::cerr << "g2p eval seg: error: --region-features " << args.region_features << ": " << st.to_string()
-                  << "\n";
+        std::cerr << "g2p eval seg: error: --region-features " << args.region_features << ": " << key << ": "
+                  << st.to_string() << "\n";
         return kExitFailure;
       }
     nlohmann::json refine_report;  // kept in the JSON, not printed: the table stays one line per model

@@ -76,8 +76,9 @@ bool read_rows(const std::string& path, const g2p::MaterialTable& table, double 
     if (label < 0) return error = path + ":" + std::to_string(number) + ": unknown class '" + cells[4] + "'", false;
     try {
       if (std::stod(cells[5]) < min_purity || std::stod(cells[6]) < min_labelled) continue;
-      rows.weights.push_back(std::stof(cells[3]));
-      for (std::size_t i = first; i < cells.size(); ++i) rows.features.push_back(std::stof(cells[i]));
+      rows.weights.push_back(static_cast<float>(std::stod(cells[3])));
+      for (std::size_t i = first; i < cells.size(); ++i)
+        rows.features.push_back(static_cast<float>(std::stod(cells[i])));
     } catch (const std::exception&) {
       return error = path + ":" + std::to_string(number) + ": a value is not a number", false;
     }
@@ -118,7 +119,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   if (train.labels.empty()) {
-    std::cerr << "g2p_train_regions: error: no row with a true class in " << inputs.front() << "\n";
+    std::cerr << "g2p_train_regions: error: no row with a true class in the " << inputs.size() << " file(s)\n";
     return 1;
   }
   const int width = static_cast<int>(g2p::region_feature_names(table).size());
@@ -130,10 +131,17 @@ int main(int argc, char** argv) {
     int present = 0;
     for (const double w : by_class) present += w > 0.0;
     for (std::size_t i = 0; i < train.labels.size(); ++i)
-      train.weights[i] = static_cast<float>(train.weights[i] * all / (present * by_class[train.labels[i]]));
+      if (by_class[train.labels[i]] > 0.0)  // a class whose rows all weigh 0 stays at 0
+        train.weights[i] = static_cast<float>(train.weights[i] * all / (present * by_class[train.labels[i]]));
   }
   const std::string trees_name = "g2p-regions.yml.gz";
   const std::string trees_path = out_dir + "/" + trees_name;
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    std::cerr << "g2p_train_regions: error: -o " << out_dir << ": " << ec.message() << "\n";
+    return 1;
+  }
   if (g2p::Status s = g2p::train_region_classifier(train.features, train.labels, train.weights, width, table.size(),
                                                    options, trees_path);
       !s.ok()) {
@@ -171,7 +179,10 @@ int main(int argc, char** argv) {
   };
   const std::string card_path = out_dir + "/g2p-regions.json";
   g2p::Result<g2p::RegionClassifier> classifier = g2p::Status::NotFound("");
-  std::ofstream(card_path) << card.dump(2) << "\n";
+  if (!(std::ofstream(card_path) << card.dump(2) << "\n")) {
+    std::cerr << "g2p_train_regions: error: " << card_path << " cannot be written\n";
+    return 1;
+  }
   classifier = g2p::RegionClassifier::load(card_path, table);
   if (!classifier.ok()) {
     std::cerr << "g2p_train_regions: error: the written classifier does not load: " << classifier.status().to_string()
@@ -189,6 +200,10 @@ int main(int argc, char** argv) {
     g2p::Result<std::vector<float>> p = classifier->predict(val.features, static_cast<int>(val.labels.size()));
     if (!p.ok()) {
       std::cerr << "g2p_train_regions: error: " << p.status().to_string() << "\n";
+      return 1;
+    }
+    if (val.labels.empty()) {
+      std::cerr << "g2p_train_regions: error: --check " << check << ": no row with a true class\n";
       return 1;
     }
     // Area-weighted accuracy of the classifier and of the region's own votes.
@@ -210,7 +225,10 @@ int main(int argc, char** argv) {
                           {"models", val.models.size()},
                           {"area_weighted_accuracy", right / total},
                           {"votes_alone_accuracy", voted_right / total}};
-    std::ofstream(card_path) << card.dump(2) << "\n";
+    if (!(std::ofstream(card_path) << card.dump(2) << "\n")) {
+      std::cerr << "g2p_train_regions: error: " << card_path << " cannot be written\n";
+      return 1;
+    }
     std::printf(
         "check %s: %zu regions of %zu models; area-weighted accuracy %.2f %% (the regions' votes alone %.2f %%)\n",
         check.c_str(), val.labels.size(), val.models.size(), 100.0 * right / total, 100.0 * voted_right / total);

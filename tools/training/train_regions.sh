@@ -12,7 +12,8 @@
 #      network's votes give them with names removed and base colour only, what an image-to-3D mesh shows
 #      (g2p eval seg --segmenter learned --anonymize-names --base-color-only --region-features), in J shards;
 #   2. the same for the validation models (split "val"), to check the classifier;
-#   3. trains the random trees (g2p_train_regions) and prints their region accuracy on validation.
+#   3. trains the random trees with class-balanced weights (g2p_train_regions --balance), writes the card with their
+#      region accuracy on validation.
 #
 # About 25 minutes on 2 cores for step 1. G2P_BIN (default build/bin) is where g2p and g2p_train_regions are.
 set -euo pipefail
@@ -25,18 +26,22 @@ sh3d=$1 labels=$2 out=$3; shift 3
 jobs=2
 while [ $# -gt 0 ]; do
   case $1 in
-    --jobs) jobs=$2; shift 2 ;;
+    --jobs) [ $# -ge 2 ] || { echo "train_regions.sh: --jobs needs a number" >&2; exit 2; }; jobs=$2; shift 2 ;;
     *) echo "train_regions.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
+[[ $jobs =~ ^[1-9][0-9]*$ ]] || { echo "train_regions.sh: --jobs must be a positive whole number, got '$jobs'" >&2; exit 2; }
 mkdir -p "$out"
 condition=(--segmenter learned --anonymize-names --base-color-only --assets "$sh3d" --truth "$labels")
 
 # The training models, in J shards of every J-th key (sorted), each its own process.
-mapfile -t keys < <(/usr/bin/python3 -c "
+keys_text=$(/usr/bin/python3 -c "
 import json, sys
 d = json.load(open(sys.argv[1]))
 print('\n'.join(sorted(k for k, v in d['models'].items() if v.get('split') == 'train')))" "$labels")
+mapfile -t keys <<< "$keys_text"
+[ -n "$keys_text" ] || { echo "train_regions.sh: $labels has no model of split \"train\"" >&2; exit 1; }
+[ "$jobs" -le "${#keys[@]}" ] || jobs=${#keys[@]}
 echo "train_regions.sh: ${#keys[@]} training models in $jobs shards" >&2
 pids=()
 for ((s = 0; s < jobs; s++)); do
@@ -47,11 +52,16 @@ for ((s = 0; s < jobs; s++)); do
     --json "$out/train$s.json" > "$out/train$s.log" 2>&1 &
   pids+=($!)
 done
-for p in "${pids[@]}"; do wait "$p"; done
+failed=0
+for ((s = 0; s < jobs; s++)); do
+  wait "${pids[s]}" || { echo "train_regions.sh: shard $s failed: $out/train$s.log" >&2; failed=1; }
+done
+[ "$failed" = 0 ] || exit 1
 "$bin/g2p" eval seg "${condition[@]}" --split val --region-features "$out/val.csv" --json "$out/val.json" \
   > "$out/val.log" 2>&1
 
 train=()
 for ((s = 0; s < jobs; s++)); do train+=("$out/train$s.csv"); done
-"$bin/g2p_train_regions" "${train[@]}" -o "$out" --check "$out/val.csv"
+# Class-balanced weights: the choice made on validation (docs/accuracy.md).
+"$bin/g2p_train_regions" "${train[@]}" -o "$out" --balance --check "$out/val.csv"
 }

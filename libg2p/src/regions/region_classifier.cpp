@@ -1,6 +1,8 @@
 // The region classifier: OpenCV random trees (Breiman 2001, cv::ml::RTrees)
 // behind a model card. Probabilities are the share of trees voting for each
-// class.
+// class. RTrees seeds its own generator when it is created, so the same rows
+// give the same trees.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,8 +40,9 @@ Result<RegionClassifier> RegionClassifier::load(const std::string& card_path, co
   const nlohmann::json card = nlohmann::json::parse(text.str(), nullptr, false);
   if (card.is_discarded() || !card.is_object() || card.value("format", nlohmann::json()) != "g2p-region-classifier")
     return Status::ParseError(card_path + ": not a region classifier card (format \"g2p-region-classifier\")");
-  if (card.value("version", 0) != 1)
-    return Status::ParseError(card_path + ": unsupported version (libg2p reads version 1)");
+  const auto version = card.find("version");
+  if (version == card.end() || !version->is_number_integer() || version->get<long long>() != 1)
+    return Status::ParseError(card_path + ": \"version\" must be 1 (the version libg2p reads)");
   std::vector<std::string> classes, features;
   try {
     classes = card.at("classes").get<std::vector<std::string>>();
@@ -72,6 +75,20 @@ Result<RegionClassifier> RegionClassifier::load(const std::string& card_path, co
       out.impl_->trees->getVarCount() != static_cast<int>(features.size()))
     return Status::ParseError("region classifier trees " + trees_path.string() + ": not trained on " +
                               std::to_string(features.size()) + " features");
+  // The trees' classes must be the table's indices (trees for another table
+  // with as many features would otherwise pass).
+  try {
+    cv::Mat votes;
+    const cv::Mat probe = cv::Mat::zeros(1, static_cast<int>(features.size()), CV_32F);
+    out.impl_->trees->getVotes(probe, votes, 0);
+    for (int c = 0; c < votes.cols; ++c)
+      if (votes.type() != CV_32S || votes.at<int>(0, c) < 0 || votes.at<int>(0, c) >= table.size())
+        return Status::ParseError("region classifier trees " + trees_path.string() + ": class " +
+                                  std::to_string(votes.at<int>(0, c)) + " is not one of the card's " +
+                                  std::to_string(table.size()));
+  } catch (const cv::Exception& e) {
+    return Status::ParseError("region classifier trees " + trees_path.string() + ": " + e.what());
+  }
   out.impl_->classes = table.size();
   out.impl_->features = static_cast<int>(features.size());
   out.impl_->card = card_path;
@@ -80,9 +97,10 @@ Result<RegionClassifier> RegionClassifier::load(const std::string& card_path, co
 
 Result<std::vector<float>> RegionClassifier::predict(const std::vector<float>& features, int rows) const {
   if (impl_->trees.empty()) return Status::Unavailable("region classifier: not loaded");
+  const std::string who = "region classifier " + impl_->card + ": ";
   if (rows < 0 || features.size() != static_cast<std::size_t>(rows) * static_cast<std::size_t>(impl_->features))
-    return Status::InvalidArgument("region classifier: " + std::to_string(features.size()) + " values for " +
-                                   std::to_string(rows) + " rows of " + std::to_string(impl_->features) + " features");
+    return Status::InvalidArgument(who + std::to_string(features.size()) + " values for " + std::to_string(rows) +
+                                   " rows of " + std::to_string(impl_->features) + " features");
   std::vector<float> out(static_cast<std::size_t>(rows) * static_cast<std::size_t>(impl_->classes), 0.f);
   if (rows == 0) return out;
   const cv::Mat samples(rows, impl_->features, CV_32F, const_cast<float*>(features.data()));
@@ -90,11 +108,10 @@ Result<std::vector<float>> RegionClassifier::predict(const std::vector<float>& f
   try {
     impl_->trees->getVotes(samples, votes, 0);
   } catch (const cv::Exception& e) {
-    return Status::Internal(std::string("region classifier: ") + e.what());
+    return Status::Internal(who + e.what());
   }
   // Row 0 holds the class of each column, rows 1..rows the trees' votes.
-  if (votes.rows != rows + 1 || votes.type() != CV_32S)
-    return Status::Internal("region classifier: unexpected vote matrix");
+  if (votes.rows != rows + 1 || votes.type() != CV_32S) return Status::Internal(who + "unexpected vote matrix");
   for (int r = 0; r < rows; ++r) {
     double sum = 0.0;
     for (int c = 0; c < votes.cols; ++c) sum += votes.at<int>(r + 1, c);
@@ -115,6 +132,9 @@ Status train_region_classifier(const std::vector<float>& features, const std::ve
   if (num_features <= 0 || features.size() != rows * static_cast<std::size_t>(num_features) || weights.size() != rows ||
       rows == 0)
     return Status::InvalidArgument("train_region_classifier: features, labels and weights disagree or are empty");
+  for (const float w : weights)
+    if (!(w >= 0.f) || !std::isfinite(w))
+      return Status::InvalidArgument("train_region_classifier: a weight is negative or not finite");
   for (const int l : labels)
     if (l < 0 || l >= num_classes) return Status::InvalidArgument("train_region_classifier: label out of range");
   if (options.trees < 1 || options.max_depth < 1 || options.min_samples < 1 || options.features_per_split < 0)
@@ -136,7 +156,6 @@ Status train_region_classifier(const std::vector<float>& features, const std::ve
     trees->setUseSurrogates(false);
     trees->setMaxCategories(std::max(num_classes, 2));
     trees->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, options.trees, 0.0));
-    cv::theRNG().state = 1;  // the same trees from the same data
     if (!trees->train(data)) return Status::Internal("train_region_classifier: OpenCV did not train");
     trees->save(trees_path);
   } catch (const cv::Exception& e) {

@@ -52,8 +52,19 @@ Result<std::vector<float>> region_features(const Mesh& mesh, const Regions& regi
                                            const FaceColours& colours, const MaterialTable& table) {
   const int nf = mesh.num_faces(), k = table.size();
   if (static_cast<int>(regions.face_region.size()) != nf || static_cast<int>(votes.total.size()) != nf ||
-      static_cast<int>(colours.rgb.size()) != nf || votes.num_classes != k)
+      static_cast<int>(votes.row.size()) != nf || static_cast<int>(colours.rgb.size()) != nf ||
+      static_cast<int>(colours.pixels.size()) != nf || votes.num_classes != k)
     return Status::InvalidArgument("region_features: regions, votes or colours are not of this mesh and table");
+  for (int f = 0; f < nf; ++f) {
+    const int row = votes.row[static_cast<std::size_t>(f)];
+    if (row >= 0 && (static_cast<std::size_t>(row) + 1) * static_cast<std::size_t>(k) > votes.histogram.size())
+      return Status::InvalidArgument("region_features: face " + std::to_string(f) + "'s votes are out of range");
+  }
+  for (const Region& region : regions.regions)
+    for (const int f : region.faces)
+      if (f < 0 || f >= nf)
+        return Status::InvalidArgument("region_features: a region names face " + std::to_string(f) + " of " +
+                                       std::to_string(nf));
   const int width = 2 * k + kTailCount;
   const std::size_t nr = regions.regions.size();
   std::vector<float> out(nr * static_cast<std::size_t>(width), 0.f);

@@ -38,8 +38,9 @@ FaceColours face_colours(const Mesh& mesh, const std::vector<View>& views) {
   std::vector<Eigen::Vector3d> sum(nf, Eigen::Vector3d::Zero());
   for (const View& v : views) {
     const bool base = !v.base_color.empty() && v.base_color.width() == v.face_id.width() &&
-                      v.base_color.height() == v.face_id.height();
-    const bool shaded = !v.rgb.empty() && v.rgb.width() == v.face_id.width() && v.rgb.height() == v.face_id.height();
+                      v.base_color.height() == v.face_id.height() && v.base_color.channels() >= 3;
+    const bool shaded = !v.rgb.empty() && v.rgb.width() == v.face_id.width() && v.rgb.height() == v.face_id.height() &&
+                        v.rgb.channels() >= 3;
     if (!base && !shaded) continue;
     for (int y = 0; y < v.face_id.height(); ++y)
       for (int x = 0; x < v.face_id.width(); ++x) {
@@ -64,7 +65,8 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
                              const RegionOptions& options) {
   const int nf = mesh.num_faces();
   if (graph.num_faces() != nf || static_cast<int>(colours.rgb.size()) != nf ||
-      static_cast<int>(colours.pixels.size()) != nf)
+      static_cast<int>(colours.pixels.size()) != nf || graph.neighbors.size() != graph.shared_edge_m.size() ||
+      std::any_of(graph.neighbors.begin(), graph.neighbors.end(), [nf](int g) { return g < 0 || g >= nf; }))
     return Status::InvalidArgument("find_regions: the face graph or the colours are not of this mesh (" +
                                    std::to_string(nf) + " faces)");
   if (!(options.crease_deg >= 0.0 && options.crease_deg <= 180.0) || !(options.colour_step >= 0.0) ||
@@ -79,7 +81,10 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
     normal[static_cast<std::size_t>(f)] = face_normal(mesh, f).cast<float>();
     total_area += area[static_cast<std::size_t>(f)] = face_area(mesh, f);
   }
-  const float min_cos = static_cast<float>(std::cos(options.crease_deg * M_PI / 180.0));
+  // At 180 degrees nothing is a crease (rounding can put the dot product of
+  // opposite normals below -1).
+  const float min_cos =
+      options.crease_deg >= 180.0 ? -2.f : static_cast<float>(std::cos(options.crease_deg * M_PI / 180.0));
   const float step2 = static_cast<float>(options.colour_step * options.colour_step);
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
@@ -148,9 +153,10 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
       merged[static_cast<std::size_t>(r)] = best;
       region_area[static_cast<std::size_t>(best)] += region_area[static_cast<std::size_t>(r)];
       std::vector<int>& into = faces_of[static_cast<std::size_t>(best)];
-      into.insert(into.end(), faces_of[static_cast<std::size_t>(r)].begin(),
-                  faces_of[static_cast<std::size_t>(r)].end());
-      faces_of[static_cast<std::size_t>(r)].clear();
+      std::vector<int>& from = faces_of[static_cast<std::size_t>(r)];
+      if (into.size() < from.size()) into.swap(from);  // append the shorter list: no quadratic growth
+      into.insert(into.end(), from.begin(), from.end());
+      from.clear();
     }
   }
   Regions out;

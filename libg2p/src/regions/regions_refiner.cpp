@@ -2,14 +2,18 @@
 // (regions.h). Every face of a region takes the class the classifier gives
 // the region, unless the classifier is less sure than `min_probability`, in
 // which case the region keeps the labels the project stage gave it. When the
-// classifier cannot run (no card, no views to take colours from) it falls
-// back to `smooth` and says why.
+// classifier cannot run (no card installed, a card that cannot be read, no
+// views with base colour) it falls back to `smooth` and says why in its last
+// note. A `card` setting that names no file is refused when configured.
 //
 // Settings: card (a classifier card; default the shipped g2p-regions.json),
 // crease (degrees, default 40), colour (linear RGB step, default 0.1),
 // min_area (area share, default 0.002), min_probability (default 0).
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <mutex>
 
 #include "core/settings.h"
 #include "g2p/regions.h"
@@ -23,7 +27,9 @@ class RegionsRefiner final : public Refiner {
   Status configure(const BackendSettings& settings) override {
     for (const auto& [key, value] : settings) {
       if (key == "card") {
-        if (value.empty()) return Status::InvalidArgument("regions: card needs a path");
+        std::error_code ec;
+        if (value.empty() || !std::filesystem::is_regular_file(value, ec))
+          return Status::InvalidArgument("regions: card=" + value + " is not a file (a g2p-regions.json)");
         card_ = value;
         continue;
       }
@@ -49,31 +55,39 @@ class RegionsRefiner final : public Refiner {
   Result<RefineResult> refine(const RefineInput& in) const override {
     if (in.mesh == nullptr || in.graph == nullptr || in.votes == nullptr || in.labels == nullptr || in.table == nullptr)
       return Status::InvalidArgument("regions: needs the mesh, face graph, votes, labels and material table");
+    if (static_cast<int>(in.labels->label.size()) != in.mesh->num_faces())
+      return Status::InvalidArgument("regions: mesh and labels disagree on the number of faces");
     std::string why;
     const std::string card = card_.empty() ? shipped_region_card() : card_;
-    Result<RegionClassifier> classifier = Status::NotFound("");
+    Result<std::shared_ptr<const RegionClassifier>> classifier = Status::NotFound("");
+    const bool base_colour = in.views != nullptr && std::any_of(in.views->begin(), in.views->end(),
+                                                                [](const View& v) { return !v.base_color.empty(); });
     if (card.empty())
       why = "the region classifier g2p-regions.json is not installed";
     else if (in.views == nullptr || in.views->empty())
       why = "no rendered views to read the regions' colours from";
-    else if (classifier = RegionClassifier::load(card, *in.table); !classifier.ok())
+    else if (!base_colour)
+      // The classifier learnt base colours; shaded images (all that g2p
+      // refine DIR keeps) would give it colours it never saw.
+      why = "the views have no base-colour buffer, the colours the classifier was trained on";
+    else if (classifier = load(card, *in.table); !classifier.ok())
       why = classifier.status().message();
     if (!why.empty()) return fall_back(in, why);
 
     const FaceColours colours = face_colours(*in.mesh, *in.views);
     if (std::all_of(colours.pixels.begin(), colours.pixels.end(), [](float p) { return p == 0.f; }))
-      return fall_back(in, "the views show no colour of any face (no colour or base-colour buffer)");
+      return fall_back(in, "no view shows any face");
     Result<Regions> regions = find_regions(*in.mesh, *in.graph, colours, options_);
     if (!regions.ok()) return regions.status();
     Result<std::vector<float>> features = region_features(*in.mesh, *regions, *in.votes, colours, *in.table);
     if (!features.ok()) return features.status();
     const int rows = static_cast<int>(regions->regions.size());
-    Result<std::vector<float>> probabilities = classifier->predict(*features, rows);
+    Result<std::vector<float>> probabilities = (*classifier)->predict(*features, rows);
     if (!probabilities.ok()) return fall_back(in, probabilities.status().message());
 
     RefineResult result;
     result.labels = in.labels->label;
-    const int k = classifier->num_classes();
+    const int k = (*classifier)->num_classes();
     int decided = 0, kept = 0;
     for (int r = 0; r < rows; ++r) {
       const float* p = probabilities->data() + static_cast<std::size_t>(r) * k;
@@ -103,6 +117,19 @@ class RegionsRefiner final : public Refiner {
   }
 
  private:
+  // The classifier, read once per card and table (the trees file is 5 MB).
+  Result<std::shared_ptr<const RegionClassifier>> load(const std::string& card, const MaterialTable& table) const {
+    std::string key = card;
+    for (const MaterialClass& c : table.classes()) key += "\n" + c.name;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (cached_ != nullptr && key == cached_key_) return cached_;
+    Result<RegionClassifier> loaded = RegionClassifier::load(card, table);
+    if (!loaded.ok()) return loaded.status();
+    cached_ = std::make_shared<const RegionClassifier>(std::move(*loaded));
+    cached_key_ = key;
+    return cached_;
+  }
+
   // `smooth` in its place, with the reason as the last note; the stage is
   // marked degraded.
   Result<RefineResult> fall_back(const RefineInput& in, const std::string& why) const {
@@ -115,6 +142,9 @@ class RegionsRefiner final : public Refiner {
 
   std::string card_;
   RegionOptions options_;
+  mutable std::mutex mutex_;
+  mutable std::shared_ptr<const RegionClassifier> cached_;
+  mutable std::string cached_key_;
   double min_probability_ = 0.0;
 };
 

@@ -229,6 +229,7 @@ void bind_core(py::module_& m) {
              return model.material_name(face);
            })
       .def("anonymize_names", [](Model& model) { anonymize_names(model); })
+      .def("reduce_to_base_color", [](Model& model) { reduce_to_base_color(model); })
       .def("__repr__", [](const Model& model) {
         return "<g2p.Model '" + model.info.path + "' " + std::to_string(model.mesh.num_faces()) + " faces, " +
                std::to_string(model.materials.size()) + " materials>";

@@ -274,6 +274,7 @@ void bind_pipeline(py::module_& m) {
       .def(py::init([](const py::kwargs& kw) { return from_kwargs<PipelineOptions>(kw); }))
       .def_readwrite("import_options", &PipelineOptions::import, "g2p.ImportOptions for run_file")
       .def_readwrite("anonymize_names", &PipelineOptions::anonymize_names)
+      .def_readwrite("base_color_only", &PipelineOptions::base_color_only)
       .def_readwrite("renderer", &PipelineOptions::renderer)
       .def_readwrite("views", &PipelineOptions::views)
       .def_readwrite("render", &PipelineOptions::render)

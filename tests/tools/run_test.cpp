@@ -359,6 +359,28 @@ TEST(ToolRun, HybridDecomposesAGeneratedLookingMesh) {
   EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
 }
 
+// `--base-color-only` runs a curated asset as a generator would emit it: the
+// candle holder's glass is glass by its authored transmission; without it,
+// metallic at glTF's default of 1 reads as metal everywhere (`pbr`).
+TEST(ToolRun, BaseColorOnlyDropsTheAuthoredPbrAsAGeneratorWould) {
+  const std::string dir = test::scratch_dir("ToolRunBaseColorOnly");
+  const std::string glb = test::quote(test::asset_path("GlassHurricaneCandleHolder"));
+  std::set<std::string> classes[2];
+  for (int reduced = 0; reduced < 2; ++reduced) {
+    const std::string out = dir + "/out" + std::to_string(reduced);
+    test::ToolRun r = test::run_tool("run " + glb + " -o " + test::quote(out) + kQuick +
+                                     " --anonymize-names --segmenter pbr --format mjcf --json" +
+                                     (reduced ? " --base-color-only" : ""));
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    for (const auto& part : j["parts"]) classes[reduced].insert(part["material"].get<std::string>());
+    const nlohmann::json project = nlohmann::json::parse(test::read_file(out + "/project.json"));
+    EXPECT_EQ(project["base_color_only"], reduced == 1);
+  }
+  EXPECT_EQ(classes[0].count("Glass"), 1u) << "PBR kept";
+  EXPECT_EQ(classes[1], std::set<std::string>{"Metal"}) << "base colour only";
+}
+
 TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {
   test::ToolRun r = test::run_tool("run --help");
   EXPECT_EQ(r.exit_code, 0);

@@ -77,17 +77,6 @@ Status write_region_rows(std::ostream& out, const std::string& key, const Model&
   return out ? Status::Ok() : Status::IoError("writing the region features failed");
 }
 
-// What image-to-3D generators emit: base colour only. Metallic and roughness
-// go to glTF's defaults (1, 1), their texture and transmission are dropped.
-void reduce_to_base_color(Model& model) {
-  for (SourceMaterial& m : model.materials) {
-    m.metallic = 1.f;
-    m.roughness = 1.f;
-    m.transmission = 0.f;
-    m.metallic_roughness_texture = Texture{};
-  }
-}
-
 int run_eval_seg(const EvalArgs& args) {
   namespace fs = std::filesystem;
   const std::string labels_path = args.truth.empty() ? (fs::path(args.assets) / "labels.json").string() : args.truth;

@@ -60,6 +60,7 @@ int run_refine(const RefineCommandArgs& args) {
   Result<Model> model = load_with_flags("refine", manifest.value("model", ""), import, exit_code);
   if (!model.ok()) return exit_code;
   if (manifest.value("anonymize_names", false)) anonymize_names(*model);
+  if (manifest.value("base_color_only", false)) reduce_to_base_color(*model);
   Result<MaterialTable> table = load_table_flag("refine", manifest.value("materials", ""), exit_code);
   if (!table.ok()) return exit_code;
 

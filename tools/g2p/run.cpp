@@ -33,7 +33,8 @@ struct RunArgs {
   std::string vlm_url, vlm_model;
   std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
   bool soft = false;  // soft votes in the project stage
-  bool fixed = false, anonymize = false, overwrite = false, intermediates = false, json = false, quiet = false;
+  bool fixed = false, anonymize = false, base_color_only = false, overwrite = false, intermediates = false,
+       json = false, quiet = false;
   double memory_limit_gib = 0.0;
 };
 
@@ -95,6 +96,7 @@ int run_pipeline(const RunArgs& args) {
   if (!import.ok()) return usage(import.status().message());
   o.import = *import;
   o.anonymize_names = args.anonymize;
+  o.base_color_only = args.base_color_only;
   if (args.soft) o.project.vote.mode = VoteMode::kSoft;
   Result<ViewOptions> views = view_options(args.views);
   if (!views.ok()) return usage(views.status().message());
@@ -226,6 +228,9 @@ void add_run_command(CLI::App& app, Command& run) {
       ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
   cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
   cmd->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one first");
+  cmd->add_flag("--base-color-only", args->base_color_only,
+                "Keep only base colour: metallic and roughness at glTF's default of 1, no metallic-roughness texture "
+                "or transmission (what image-to-3D generators emit; for measuring)");
   cmd->add_flag("--soft", args->soft,
                 "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
                 "the learned and onnx segmenters)");

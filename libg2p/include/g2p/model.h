@@ -113,4 +113,10 @@ G2P_API ObjectSize object_size(const Model& model);
 // (the oracle's default key) are unchanged.
 G2P_API void anonymize_names(Model& model);
 
+// Reduces every material to what image-to-3D generators emit: base colour
+// (factor and texture) only. Metallic and roughness go to glTF's defaults
+// (1, 1); the metallic-roughness texture and transmission are dropped. For
+// measuring the pipeline on curated assets as if they were generated.
+G2P_API void reduce_to_base_color(Model& model);
+
 }  // namespace g2p

@@ -85,6 +85,7 @@ struct BackendChoice {
 struct PipelineOptions {
   ImportOptions import;          // run_file only
   bool anonymize_names = false;  // drop mesh/material/texture names first (as generated meshes have none)
+  bool base_color_only = false;  // keep only base colour, metallic/roughness at glTF's 1 (as generators emit)
 
   // 1. render: 11 views at 512 x 512 (the paper's set-up), full buffers.
   BackendChoice renderer{"embree", {}};

@@ -24,4 +24,13 @@ void anonymize_names(Model& model) {
   }
 }
 
+void reduce_to_base_color(Model& model) {
+  for (SourceMaterial& m : model.materials) {
+    m.metallic = 1.f;
+    m.roughness = 1.f;
+    m.transmission = 0.f;
+    m.metallic_roughness_texture = Texture{};
+  }
+}
+
 }  // namespace g2p

@@ -48,6 +48,7 @@ Status write_manifests(const std::string& tmp, const fs::path& final_dir, const 
       {"import", {{"unit", unit}, {"up", up}, {"keep_axes", !rotated && up != "z"}, {"no_textures", false}}},
       {"materials", materials},
       {"anonymize_names", o.anonymize_names},
+      {"base_color_only", o.base_color_only},
       {"views", r.views.size()},
       {"vote", o.project.vote.mode == VoteMode::kSoft ? "soft" : "hard"},
       {"weight_angle", o.project.vote.weight_by_angle},

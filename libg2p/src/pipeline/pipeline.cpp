@@ -444,6 +444,7 @@ Result<PipelineResult> Pipeline::run_unguarded(Model model, RunContext* context)
   PipelineResult r;
   r.model = std::move(model);
   if (impl_->options.anonymize_names) anonymize_names(r.model);
+  if (impl_->options.base_color_only) reduce_to_base_color(r.model);
   r.table = impl_->table;
   Status s = impl_->run_stages(r, ctx);
   if (!s.ok()) {

@@ -39,6 +39,9 @@ TEST(MaterialTable, DefaultValuesArePhysicallyOrdered) {
   EXPECT_GT(density(PaperClass::kWood), density(PaperClass::kFabric));
   EXPECT_EQ(t[static_cast<int>(PaperClass::kMetal)].structure, Structure::kSolid);
   EXPECT_EQ(t[static_cast<int>(PaperClass::kGlass)].structure, Structure::kHollow);
+  // No class limits its solid thickness by default (accuracy.md: the candidate limits did not
+  // pass their shipping rule).
+  for (const MaterialClass& c : t.classes()) EXPECT_EQ(c.max_solid_thickness_m, 0.0) << c.name;
   for (const MaterialClass& c : t.classes()) {
     EXPECT_LE(c.density_min_kg_m3, c.density_kg_m3) << c.name;
     EXPECT_GE(c.density_max_kg_m3, c.density_kg_m3) << c.name;
@@ -64,6 +67,7 @@ TEST(MaterialTable, JsonRoundTripKeepsEveryField) {
     EXPECT_DOUBLE_EQ(a.restitution, b.restitution);
     EXPECT_EQ(a.structure, b.structure);
     EXPECT_DOUBLE_EQ(a.wall_thickness_m, b.wall_thickness_m);
+    EXPECT_DOUBLE_EQ(a.max_solid_thickness_m, b.max_solid_thickness_m);
     EXPECT_EQ(a.source, b.source);
   }
 }
@@ -127,7 +131,10 @@ INSTANTIATE_TEST_SUITE_P(
                              "'version' must be an integer"},
                     BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "restitutoin": 0.2}]})",
                              StatusCode::kParseError, "classes[0]: unknown key 'restitutoin'"},
-                    BadTable{R"({"clases": []})", StatusCode::kParseError, "unknown key 'clases'"}),
+                    BadTable{R"({"clases": []})", StatusCode::kParseError, "unknown key 'clases'"},
+                    BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "wall_thickness_m": 0.02,
+                                  "max_solid_thickness_m": 0.03}]})",
+                             StatusCode::kInvalidArgument, "class 'A': max_solid_thickness_m must be 0 (no limit) or"}),
     [](const testing::TestParamInfo<BadTable>& info) { return "case" + std::to_string(info.index); });
 
 TEST(MaterialTable, LoadAndSaveFiles) {

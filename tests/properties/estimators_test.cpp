@@ -123,6 +123,82 @@ TEST(TableEstimator, ThinPartsOfHollowClassesAreSolid) {
   EXPECT_NEAR(r.object.mass_kg / (1150 * 0.2 * 0.1 * 0.004), 1.0, 0.05);
 }
 
+// The default table with the thickest solid pieces of docs/materials.md
+// (off by default): Wood 0.10 m, Metal 0.06 m.
+const MaterialTable& table_with_solid_limits() {
+  static const MaterialTable t = [] {
+    std::vector<MaterialClass> classes = table().classes();
+    classes[static_cast<std::size_t>(kWood)].max_solid_thickness_m = 0.10;
+    classes[static_cast<std::size_t>(kMetal)].max_solid_thickness_m = 0.06;
+    return *MaterialTable::from_classes(classes, "limits");
+  }();
+  return t;
+}
+
+PropertiesReport report_with_solid_limits(const Stage& s) {
+  auto e = std::move(*make_estimator("table"));
+  Result<PropertiesReport> r = estimate_properties(s.mesh, s.parts, s.completion, table_with_solid_limits(), *e);
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  return r.ok() ? *r : PropertiesReport{};
+}
+
+// The thickest solid piece of a class (max_solid_thickness_m): a wardrobe
+// modelled as a closed box is panels around air; the same box with no limit
+// (the default table) stays solid wood; a wooden plank stays solid.
+TEST(TableEstimator, PartsThickerThanTheirClassesThickestSolidPieceAreShells) {
+  const Mesh wardrobe = test::box_mesh({0, 0, 0}, {0.6f, 0.5f, 1.8f});
+  const Stage s = complete_object(wardrobe, test::single_part(wardrobe, kWood));
+  PropertiesReport r = report_with_solid_limits(s);
+  ASSERT_EQ(r.parts.size(), 1u);
+  const PartProperties& p = r.parts[0].properties;
+  EXPECT_EQ(p.structure, Structure::kHollow);
+  EXPECT_FALSE(p.double_walled);
+  EXPECT_EQ(p.structure_source, ValueSource::kGeometry);
+  EXPECT_DOUBLE_EQ(p.wall_thickness_m, 0.02);
+  EXPECT_NE(p.notes.back().find("more than the thickest solid Wood"), std::string::npos) << p.notes.back();
+  const double area = surface_area(wardrobe);
+  EXPECT_NEAR(r.object.mass_kg / (700 * area * 0.02), 1.0, 1e-6);
+
+  const PropertiesReport solid = report_of(s);
+  ASSERT_EQ(solid.parts.size(), 1u);
+  EXPECT_EQ(solid.parts[0].properties.structure, Structure::kSolid);
+  EXPECT_NEAR(solid.object.mass_kg / (700 * 0.6 * 0.5 * 1.8), 1.0, 0.01);
+
+  const Mesh plank = test::box_mesh({0, 0, 0}, {0.8f, 0.2f, 0.04f});
+  r = report_with_solid_limits(complete_object(plank, test::single_part(plank, kWood)));
+  ASSERT_EQ(r.parts.size(), 1u);
+  EXPECT_EQ(r.parts[0].properties.structure, Structure::kSolid);
+  EXPECT_NEAR(r.object.mass_kg / (700 * 0.8 * 0.2 * 0.04), 1.0, 0.01);
+}
+
+// An inner surface farther in than the class's thickest solid piece is
+// another part, not the far side of this part's wall: a steel box around a
+// box 10 cm inside it is not 10 cm of steel but a sheet-metal shell.
+TEST(TableEstimator, AnInnerSurfaceFartherThanAWallCanBeIsNotTheWall) {
+  Mesh box = test::box_mesh({-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f});
+  Mesh inner = test::box_mesh({-0.15f, -0.15f, -0.15f}, {0.15f, 0.15f, 0.15f});
+  for (auto& t : inner.triangles) std::swap(t[1], t[2]);
+  test::append_mesh(box, inner);
+  const Stage s = complete_object(box, test::single_part(box, kMetal));
+  const PropertiesReport r = report_with_solid_limits(s);
+  ASSERT_EQ(r.parts.size(), 1u);
+  const PartProperties& p = r.parts[0].properties;
+  EXPECT_GT(p.walls.inner_fraction(), 0.5);  // the rays do meet the inner box...
+  EXPECT_NEAR(p.walls.inner_wall_m, 0.1, 0.01);
+  EXPECT_EQ(p.structure, Structure::kHollow);  // ...but the part is a shell of the class's 0.5 mm
+  EXPECT_FALSE(p.double_walled);
+  EXPECT_DOUBLE_EQ(p.wall_thickness_m, 0.0005);
+  bool said = false;
+  for (const std::string& n : p.notes) said = said || n.find("another part, not this part's wall") != std::string::npos;
+  EXPECT_TRUE(said) << ::testing::PrintToString(p.notes);
+  // 10 cm of steel between the boxes would weigh about 760 kg: the default
+  // table, with no limit, takes the gap for the wall (and the guard then
+  // fills it).
+  EXPECT_LT(r.object.mass_kg, 20.0);
+  const PropertiesReport unlimited = report_of(s);
+  EXPECT_GT(unlimited.object.mass_kg, 300.0);
+}
+
 // A scripted vision-language model.
 class ScriptedVlm final : public VlmClient {
  public:

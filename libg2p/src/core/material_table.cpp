@@ -51,15 +51,19 @@ Status check_class(const MaterialClass& c) {
   if (c.restitution < 0.0 || c.restitution > 1.0)
     return bad("restitution must lie in [0, 1], got " + fmt(c.restitution));
   if (c.wall_thickness_m <= 0.0) return bad("wall_thickness_m must be > 0, got " + fmt(c.wall_thickness_m));
+  if (c.max_solid_thickness_m < 0.0 ||
+      (c.max_solid_thickness_m > 0.0 && c.max_solid_thickness_m < 2 * c.wall_thickness_m))
+    return bad("max_solid_thickness_m must be 0 (no limit) or at least two walls (" + fmt(2 * c.wall_thickness_m) +
+               "), got " + fmt(c.max_solid_thickness_m));
   return Status::Ok();
 }
 
 // Reads one class object; `where` is "origin: classes[i]".
 // Keys a class object may have; anything else is a typo that would silently
 // leave a default in place, so it is an error.
-constexpr const char* kClassKeys[] = {"name",     "color",       "density_kg_m3", "density_range_kg_m3",
-                                      "friction", "restitution", "structure",     "wall_thickness_m",
-                                      "source"};
+constexpr const char* kClassKeys[] = {
+    "name",        "color",     "density_kg_m3",    "density_range_kg_m3",   "friction",
+    "restitution", "structure", "wall_thickness_m", "max_solid_thickness_m", "source"};
 
 Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   if (!j.is_object()) return Status::ParseError(where + ": expected an object");
@@ -116,6 +120,7 @@ Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   }
   G2P_RETURN_IF_ERROR(number(j, "restitution", c.restitution, false));
   G2P_RETURN_IF_ERROR(number(j, "wall_thickness_m", c.wall_thickness_m, false));
+  G2P_RETURN_IF_ERROR(number(j, "max_solid_thickness_m", c.max_solid_thickness_m, false));
   if (auto s = j.find("structure"); s != j.end()) {
     const std::string v = s->is_string() ? s->get<std::string>() : "";
     if (iequals(v, "solid"))
@@ -215,6 +220,7 @@ std::string MaterialTable::to_json() const {
                        {"restitution", c.restitution},
                        {"structure", g2p::to_string(c.structure)},
                        {"wall_thickness_m", c.wall_thickness_m},
+                       {"max_solid_thickness_m", c.max_solid_thickness_m},
                        {"source", c.source}});
   }
   json doc = {{"format", kFormat}, {"version", kFormatVersion}, {"name", name_}, {"classes", classes}};

@@ -11,7 +11,14 @@
 //    they enclose more than half a litre of the object (source: geometry): a
 //    solid steel water bottle would weigh 14 kg; things that big are shells.
 //    (A hammer's steel head, 0.17 litres, stays solid.)
-// 3. Guards (source: geometry): a hollow part thinner than two walls (median
+//    Rule 1 only counts an inner surface no farther in than the class's
+//    thickest solid piece (max_solid_thickness_m, 0 = no limit): a steel
+//    "wall" 10 cm thick is the gap to another part of the object, not a wall.
+// 3. A part of a class solid by default that is thicker (median local
+//    thickness) than the class's thickest solid piece is a single-walled shell
+//    of the class's wall thickness (source: geometry): a wardrobe modelled as
+//    a closed box is panels around air, a tyre is rubber around air.
+// 4. Guards (source: geometry): a hollow part thinner than two walls (median
 //    local thickness <= 2 t), or whose shell A t would exceed its volume, is
 //    solid: its walls fill it.
 #include <cmath>
@@ -121,7 +128,13 @@ Result<PartProperties> table_properties(const PropertyInput& in, const TableRule
     if (!w.ok()) return w.status();
     p.walls = *w;
   }
-  if (p.walls.rays > 0 && p.walls.inner_fraction() >= 0.5 && p.walls.inner_wall_m > 0) {
+  const double max_solid = c.max_solid_thickness_m;  // 0 = no limit
+  const bool measured_inside = p.walls.rays > 0 && p.walls.inner_fraction() >= 0.5 && p.walls.inner_wall_m > 0;
+  const bool wall_too_thick = measured_inside && max_solid > 0 && p.walls.inner_wall_m > max_solid;
+  if (wall_too_thick)
+    p.notes.push_back("an inner surface " + mm(p.walls.inner_wall_m) + " in is farther than the thickest solid " +
+                      c.name + " (" + mm(max_solid) + "): another part, not this part's wall");
+  if (measured_inside && !wall_too_thick) {
     p.structure = Structure::kHollow;
     p.wall_thickness_m = p.walls.inner_wall_m;
     p.double_walled = true;
@@ -139,6 +152,12 @@ Result<PartProperties> table_properties(const PropertyInput& in, const TableRule
          << " litres, which would weigh " << class_volume * c.density_kg_m3
          << " kg solid; dense parts this large are shells (" << mm(p.wall_thickness_m) << " walls, the class's)";
     p.notes.push_back(note.str());
+  } else if (c.structure == Structure::kSolid && max_solid > 0 && p.walls.rays > 0 && p.walls.thickness_m > max_solid) {
+    p.structure = Structure::kHollow;
+    p.structure_source = ValueSource::kGeometry;
+    p.notes.push_back("hollow: the part is " + mm(p.walls.thickness_m) + " thick, more than the thickest solid " +
+                      c.name + " (" + mm(max_solid) + "): a shell of " + mm(p.wall_thickness_m) +
+                      " walls (the class's)");
   } else {
     p.notes.push_back(std::string(to_string(c.structure)) + ": the class's default (no modelled inner walls)");
   }

@@ -25,6 +25,7 @@ import json
 import math
 import os
 import random
+import shutil
 import subprocess
 import sys
 import time
@@ -47,17 +48,20 @@ def run_model(g2p, key, entry, out, extra):
     # One format and one hull per part: collision geometry does not change the mass.
     cmd = [g2p, "run", model, "-o", out, "--overwrite", "--quiet", "--format", "mjcf", "--decomposer", "hull",
            "--longest-side", str(entry["longest_side_m"])] + extra
+    # A failed run leaves an earlier run's folder in place (--overwrite replaces it only on
+    # success): remove it first, so that no old report is scored.
+    shutil.rmtree(out, ignore_errors=True)
     start = time.time()
     done = subprocess.run(cmd, capture_output=True, text=True)
     return cmd, done, time.time() - start
 
 
-def score_model(key, entry, out):
+def score_model(key, entry, out, failed=False):
     lo, hi = entry["mass_kg"]
     centre = math.sqrt(lo * hi)
     r = {"key": key, "name": entry["name"], "mass_range_kg": [lo, hi], "centre_kg": centre}
     report_path = os.path.join(out, "report.json")
-    if not os.path.isfile(report_path):
+    if failed or not os.path.isfile(report_path):
         r.update({"failed": True, "mass_kg": None, "mass_in_range": False, "ratio": None, "mnre": 0.0})
         return r
     report = json.load(open(report_path))
@@ -132,7 +136,9 @@ def main():
             ap.error(f"--only: not a scored model of {args.set}.json: {', '.join(unknown)}")
         models = {k: models[k] for k in args.only}
     keys = list(models)
-    outs = {k: os.path.join(args.out, f"{i:03d}_" + os.path.basename(os.path.dirname(k))) for i, k in enumerate(keys)}
+    # Folders numbered by place in the whole scored set, so that --reuse --only finds them.
+    place = {k: i for i, k in enumerate(load_set(args.set))}
+    outs = {k: os.path.join(args.out, f"{place[k]:03d}_" + os.path.basename(os.path.dirname(k))) for k in keys}
     commands, seconds, errors = {}, {}, {}
     if not args.reuse:
         os.makedirs(args.out, exist_ok=True)
@@ -149,7 +155,7 @@ def main():
     print("| model | mass kg | range kg | in range | p / c | s |")
     print("|---|---:|---|---|---:|---:|")
     for k in keys:
-        r = score_model(k, models[k], outs[k])
+        r = score_model(k, models[k], outs[k], failed=k in errors)
         r["seconds"] = seconds.get(k, 0.0)
         if k in errors:
             r["error"] = errors[k]
@@ -159,8 +165,9 @@ def main():
         print(f"| {r['name']} (`{os.path.basename(k)}`) | {mass} | {r['mass_range_kg'][0]:g}-{r['mass_range_kg'][1]:g} "
               f"| {'yes' if r['mass_in_range'] else 'no'} | {ratio} | {r['seconds']:.0f} |")
     s = summarise(results)
+    median = "none" if s["median_ratio"] is None else f"{s['median_ratio']:.2f}"
     print(f"\n{s['models']} models: mass in range {s['mass_in_range']} ({100 * s['share_in_range']:.1f} %), "
-          f"mean MnRE {s['mean_mnre']:.3f}, median p/c {s['median_ratio']:.2f}, too heavy {s['too_heavy']}, "
+          f"mean MnRE {s['mean_mnre']:.3f}, median p/c {median}, too heavy {s['too_heavy']}, "
           f"too light {s['too_light']}, failed {len(s['failed'])}")
     if args.json:
         with open(args.json, "w") as f:

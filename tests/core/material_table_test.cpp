@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "support/test_data.h"
@@ -70,6 +72,21 @@ TEST(MaterialTable, JsonRoundTripKeepsEveryField) {
     EXPECT_DOUBLE_EQ(a.max_solid_thickness_m, b.max_solid_thickness_m);
     EXPECT_EQ(a.source, b.source);
   }
+}
+
+TEST(MaterialTable, TheThickestSolidPieceIsReadAndWrittenAndChecked) {
+  Result<MaterialTable> t = MaterialTable::from_json(
+      R"({"classes": [{"name": "Oak", "density_kg_m3": 700, "wall_thickness_m": 0.02, "max_solid_thickness_m": 0.1},
+                      {"name": "Foam", "density_kg_m3": 30}]})");
+  ASSERT_TRUE(t.ok()) << t.status().to_string();
+  EXPECT_DOUBLE_EQ((*t)[0].max_solid_thickness_m, 0.1);
+  EXPECT_DOUBLE_EQ((*t)[1].max_solid_thickness_m, 0.0);  // no limit unless given
+  Result<MaterialTable> back = MaterialTable::from_json(t->to_json());
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  EXPECT_DOUBLE_EQ((*back)[0].max_solid_thickness_m, 0.1);
+  std::vector<MaterialClass> classes = t->classes();
+  classes[0].max_solid_thickness_m = std::nan("");
+  EXPECT_FALSE(MaterialTable::from_classes(classes).ok());
 }
 
 TEST(MaterialTable, CustomVocabularyWithDefaults) {

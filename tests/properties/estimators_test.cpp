@@ -171,6 +171,29 @@ TEST(TableEstimator, PartsThickerThanTheirClassesThickestSolidPieceAreShells) {
   EXPECT_NEAR(r.object.mass_kg / (700 * 0.8 * 0.2 * 0.04), 1.0, 0.01);
 }
 
+// Modelled walls that the guards would fill (a 15 cm wooden slab with a
+// metal plate in its middle: the plate is 7.4 cm in, and a 7.4 cm shell
+// would exceed the slab's volume) still leave a part thicker than the
+// thickest solid wood a shell of the class's wall.
+TEST(TableEstimator, GuardsDoNotFillAPartThickerThanItsClassesThickestSolidPiece) {
+  Mesh object = test::box_mesh({0, 0, 0}, {0.5f, 0.5f, 0.15f});
+  const int slab_faces = object.num_faces();
+  test::append_mesh(object, test::box_mesh({0.02f, 0.02f, 0.074f}, {0.48f, 0.48f, 0.076f}));
+  std::vector<Part> parts(2);
+  parts[0].label = kWood;
+  parts[1].label = kMetal;
+  for (int f = 0; f < object.num_faces(); ++f) parts[f < slab_faces ? 0 : 1].faces.push_back(f);
+  const Stage s = complete_object(object, parts);
+  const PropertiesReport r = report_with_solid_limits(s);
+  ASSERT_EQ(r.parts.size(), 2u);
+  const PartProperties& slab = r.parts[0].properties;
+  EXPECT_GT(slab.walls.thickness_m, 0.10);
+  EXPECT_EQ(slab.structure, Structure::kHollow) << ::testing::PrintToString(slab.notes);
+  EXPECT_FALSE(slab.double_walled);
+  EXPECT_DOUBLE_EQ(slab.wall_thickness_m, 0.02);
+  EXPECT_LT(r.parts[0].mass.mass_kg, 0.6 * 700 * 0.5 * 0.5 * 0.15);
+}
+
 // An inner surface farther in than the class's thickest solid piece is
 // another part, not the far side of this part's wall: a steel box around a
 // box 10 cm inside it is not 10 cm of steel but a sheet-metal shell.

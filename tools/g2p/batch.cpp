@@ -45,6 +45,8 @@ const PassThrough kPassThrough[] = {
     {"--keep-axes", "Keep the file's axes", false, false},
     {"--no-textures", "Ignore textures", false, false},
     {"--lenient", "Keep the good triangles of a damaged file", false, false},
+    {"--anonymize-names", "Replace every name by a meaningless one first", false, false},
+    {"--base-color-only", "Keep only base colour, as image-to-3D generators emit it", false, false},
 };
 
 struct BatchArgs {

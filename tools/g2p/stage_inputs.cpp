@@ -88,6 +88,9 @@ Result<LabelledObject> load_labels(const std::string& command, const LabelledSou
     import.no_textures = !args.textures;  // most later stages need geometry only
     Result<Model> model = load_with_flags(command, manifest.value("model", ""), import, exit_code);
     if (!model.ok()) return model.status();
+    // The model as the run saw it (g2p run --anonymize-names, --base-color-only).
+    if (manifest.value("anonymize_names", false)) anonymize_names(*model);
+    if (manifest.value("base_color_only", false)) reduce_to_base_color(*model);
     out.model = std::move(*model);
     const std::string table_path = args.materials.empty() ? manifest.value("materials", "") : args.materials;
     Result<MaterialTable> table = load_table_flag(command, table_path, exit_code);

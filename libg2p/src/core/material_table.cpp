@@ -40,7 +40,7 @@ Status check_class(const MaterialClass& c) {
   auto bad = [&](const std::string& what) { return Status::InvalidArgument("class '" + c.name + "': " + what); };
   if (c.name.empty()) return Status::InvalidArgument("a class has an empty name");
   const double values[] = {c.density_kg_m3,    c.density_min_kg_m3, c.density_max_kg_m3, c.friction_static,
-                           c.friction_dynamic, c.restitution,       c.wall_thickness_m};
+                           c.friction_dynamic, c.restitution,       c.wall_thickness_m,  c.max_solid_thickness_m};
   for (double v : values)
     if (!std::isfinite(v)) return bad("a value is not a finite number");
   if (c.density_kg_m3 <= 0.0) return bad("density_kg_m3 must be > 0, got " + fmt(c.density_kg_m3));

@@ -159,9 +159,23 @@ Result<PartProperties> table_properties(const PropertyInput& in, const TableRule
                       c.name + " (" + mm(max_solid) + "): a shell of " + mm(p.wall_thickness_m) +
                       " walls (the class's)");
   } else {
-    p.notes.push_back(std::string(to_string(c.structure)) + ": the class's default (no modelled inner walls)");
+    p.notes.push_back(std::string(to_string(c.structure)) + ": the class's default" +
+                      (wall_too_thick ? "" : " (no modelled inner walls)"));
   }
   apply_geometry_guards(p, *in.completed);
+  // Modelled walls that the guards filled (the part no thicker than two of
+  // them) give a solid part; one thicker than its class's thickest solid
+  // piece is still a shell of the class's wall (rule 3).
+  if (p.structure == Structure::kSolid && p.structure_source == ValueSource::kGeometry &&
+      c.structure == Structure::kSolid && max_solid > 0 && p.walls.rays > 0 && p.walls.thickness_m > max_solid) {
+    p.structure = Structure::kHollow;
+    p.wall_thickness_m = c.wall_thickness_m;
+    p.thickness_source = ValueSource::kTable;
+    p.notes.push_back("hollow: the part is " + mm(p.walls.thickness_m) + " thick, more than the thickest solid " +
+                      c.name + " (" + mm(max_solid) + "): a shell of " + mm(p.wall_thickness_m) +
+                      " walls (the class's)");
+    apply_geometry_guards(p, *in.completed);
+  }
   return p;
 }
 

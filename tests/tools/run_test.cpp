@@ -369,7 +369,7 @@ TEST(ToolRun, BaseColorOnlyDropsTheAuthoredPbrAsAGeneratorWould) {
   for (int reduced = 0; reduced < 2; ++reduced) {
     const std::string out = dir + "/out" + std::to_string(reduced);
     test::ToolRun r = test::run_tool("run " + glb + " -o " + test::quote(out) + kQuick +
-                                     " --anonymize-names --segmenter pbr --format mjcf --json" +
+                                     " --anonymize-names --segmenter pbr --format mjcf --decomposer hull --json" +
                                      (reduced ? " --base-color-only" : ""));
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);

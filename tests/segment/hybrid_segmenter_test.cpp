@@ -287,6 +287,51 @@ TEST(HybridSegmenter, UnnamedSaysWhetherAModelNothingNamesGoesToTheNetwork) {
   EXPECT_EQ(share_labelled_as_pbr(boxes, {{"unnamed", "pbr"}}), 1.0);
   EXPECT_LT(share_labelled_as_pbr(boxes, {{"unnamed", "network"}}), 1.0);
   EXPECT_EQ(make_segmenter("hybrid", {{"unnamed", "yes"}}).status().code(), StatusCode::kInvalidArgument);
+
+  // unnamed=nameless: only a model whose every name is a placeholder.
+  EXPECT_LT(share_labelled_as_pbr(boxes, {{"unnamed", "nameless"}}), 1.0);  // material_0, mesh_0, node
+  Model exported = boxes;                                                   // as Blender and Maya leave them
+  const char* placeholders[] = {"Material.001", "01 - Default", "lambert2"};
+  for (std::size_t m = 0; m < exported.materials.size(); ++m) exported.materials[m].name = placeholders[m];
+  for (SourcePrimitive& p : exported.primitives) p.mesh_name = "pCubeShape1", p.node_name = "Cube.003";
+  EXPECT_LT(share_labelled_as_pbr(exported, {{"unnamed", "nameless"}}), 1.0);
+  // A curated asset's own words that name no material ("black", a cube's
+  // colours) say that someone made its materials per part: `pbr` reads them.
+  Model curated = boxes;
+  const char* colours[] = {"red", "blue", "yellow"};
+  for (std::size_t m = 0; m < curated.materials.size(); ++m) curated.materials[m].name = colours[m];
+  EXPECT_EQ(share_labelled_as_pbr(curated, {{"unnamed", "nameless"}}), 1.0);
+  EXPECT_LT(share_labelled_as_pbr(curated, {{"unnamed", "network"}}), 1.0);
+  // So does one own word anywhere: an object name, or a texture file's name.
+  Model object_named = exported;
+  object_named.primitives.front().node_name = "potty_Cylinder";
+  EXPECT_EQ(share_labelled_as_pbr(object_named, {{"unnamed", "nameless"}}), 1.0);
+  Model mesh_named = exported;
+  mesh_named.primitives.front().mesh_name = "potty";
+  EXPECT_EQ(share_labelled_as_pbr(mesh_named, {{"unnamed", "nameless"}}), 1.0);
+  Model texture_named = exported;
+  texture_named.materials.front().base_color_texture.uri = "rubik_faces.png";
+  EXPECT_EQ(share_labelled_as_pbr(texture_named, {{"unnamed", "nameless"}}), 1.0);
+  // A texture's own words say nothing in a texture file's name, but "Base"
+  // names a part.
+  Model texture_placeholder = exported;
+  texture_placeholder.materials.front().base_color_texture.uri = "textures/material_0_baseColor.png";
+  EXPECT_LT(share_labelled_as_pbr(texture_placeholder, {{"unnamed", "nameless"}}), 1.0);
+  Model base_named = exported;
+  base_named.materials.front().name = "Base";
+  EXPECT_EQ(share_labelled_as_pbr(base_named, {{"unnamed", "nameless"}}), 1.0);
+  // Maya's shading groups, 3ds Max's wireframe colours, assimp's unnamed glTF
+  // nodes: placeholders.
+  Model maya = exported;
+  const char* shading_groups[] = {"lambert2SG", "wire_028089177", "blinn1SG"};
+  for (std::size_t m = 0; m < maya.materials.size(); ++m) maya.materials[m].name = shading_groups[m];
+  for (SourcePrimitive& p : maya.primitives) p.node_name = "nodes[0]";
+  EXPECT_LT(share_labelled_as_pbr(maya, {{"unnamed", "nameless"}}), 1.0);
+  // Names in a script the word splitter does not read are somebody's words.
+  Model chinese = exported;
+  const char* hanzi[] = {"\u6728\u5934", "\u91d1\u5c5e", "\u6905\u5b50"};  // wood, metal, chair
+  for (std::size_t m = 0; m < chinese.materials.size(); ++m) chinese.materials[m].name = hanzi[m];
+  EXPECT_EQ(share_labelled_as_pbr(chinese, {{"unnamed", "nameless"}}), 1.0);
 }
 
 }  // namespace

@@ -108,7 +108,8 @@ void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args) {
   cmd->add_option(
       "--set", args.settings,
       "Segmenter setting KEY=VALUE, repeatable (onnx: model_card=FILE, flip=on|off; learned, auto: the same and "
-      "names=T|off, pbr=on|off; hybrid: model_card, flip, names, share=S, prior=W, scope=model|material; oracle: "
+      "names=T|off, pbr=on|off; hybrid: model_card, flip, names, share=S, prior=W, scope=model|material, "
+      "colour=on|off, atlas_charts=N, unnamed=nameless|network|pbr; oracle: "
       "labels=FILE, key=NAME; "
       "pbr: names=on|off, temperature=T)");
 }

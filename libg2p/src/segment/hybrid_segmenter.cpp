@@ -19,7 +19,11 @@
 //  3. its material's PBR values were authored, or some face of the model is
 //     named: `pbr` (per-part materials);
 //  4. otherwise (nothing named or authored anywhere): the network with
-//     unnamed=network, `pbr` with unnamed=pbr (the default).
+//     unnamed=network; with unnamed=nameless only when every name the model
+//     carries (materials, meshes, nodes, texture files) is a placeholder
+//     ("Material.001", "Cube", "material_0"), as an exporter or a generator
+//     leaves them, while a curated asset's own unrated words ("potty",
+//     "black") keep it per material (the default); `pbr` with unnamed=pbr.
 // A model whose every face falls under 1 or 3 is labelled by `pbr` alone and
 // the network is neither loaded nor run.
 //
@@ -28,15 +32,17 @@
 // says why in warnings() (the pipeline reports it in PipelineResult::warnings).
 //
 // Settings: model_card = FILE, flip = on|off (as `learned`); the rest in
-// HybridOptions. The defaults are the fifth candidate of docs/accuracy.md;
-// share=0.5 colour=off unnamed=network is the first.
+// HybridOptions. The defaults are the sixth candidate of docs/accuracy.md
+// (unnamed=pbr is the fifth; share=0.5 colour=off unnamed=network the first).
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numeric>
 
 #include "core/settings.h"
 #include "g2p/project.h"
 #include "segment/backends.h"
+#include "segment/material_lexicon.h"
 
 namespace g2p {
 namespace {
@@ -73,10 +79,12 @@ struct HybridOptions {
   // has a few charts (a towel 2, a skirt 9); an atlas baked by an image-to-3D
   // pipeline hundreds. 0 = any texture counts.
   int atlas_charts = 16;
-  // unnamed=network|pbr: rule 4, whether a model that nothing names or
-  // authors goes to the network as a whole (`network`) or is read per
-  // material by `pbr`.
-  bool unnamed_network = false;
+  // unnamed=network|nameless|pbr: rule 4, whether a model that nothing names
+  // or authors goes to the network as a whole (`network`), only when its
+  // every name is a placeholder (`nameless`), or is read per material by
+  // `pbr`.
+  enum class Unnamed { kPbr, kNameless, kNetwork };
+  Unnamed unnamed = Unnamed::kNameless;
 };
 
 class HybridSegmenter final : public Segmenter {
@@ -101,13 +109,15 @@ class HybridSegmenter final : public Segmenter {
         o.colour = value == "on";
       } else if (key == "atlas_charts" && number && v >= 0 && v <= 1e6 && v == std::floor(v)) {
         o.atlas_charts = static_cast<int>(v);
-      } else if (key == "unnamed" && (value == "network" || value == "pbr")) {
-        o.unnamed_network = value == "network";
+      } else if (key == "unnamed" && (value == "network" || value == "nameless" || value == "pbr")) {
+        o.unnamed = value == "network"    ? HybridOptions::Unnamed::kNetwork
+                    : value == "nameless" ? HybridOptions::Unnamed::kNameless
+                                          : HybridOptions::Unnamed::kPbr;
       } else {
         return Status::InvalidArgument(
             "hybrid: bad setting " + key + "=" + value +
             " (known: model_card=FILE, flip=on|off, share=(0,1], prior=[0,1], "
-            "names=(0,1]|off, scope=model|material, colour=on|off, atlas_charts=N, unnamed=network|pbr)");
+            "names=(0,1]|off, scope=model|material, colour=on|off, atlas_charts=N, unnamed=network|nameless|pbr)");
       }
     }
     options_ = o;
@@ -239,6 +249,8 @@ class HybridSegmenter final : public Segmenter {
       }
     }
     for (std::size_t k = 0; k <= n; ++k) shows_regions[k] = shows_regions[k] || coloured[k];
+    const bool rule4 = options_.unnamed == HybridOptions::Unnamed::kNetwork ||
+                       (options_.unnamed == HybridOptions::Unnamed::kNameless && nameless(model));
     for (std::size_t f = 0; f < named.size(); ++f) {
       if (named[f]) continue;  // 1: names decide
       const int m = mesh.face_source[f].material;
@@ -248,10 +260,26 @@ class HybridSegmenter final : public Segmenter {
           total > 0 && area[slot(m)] >= options_.share * total && (!options_.colour || shows_regions[slot(m)] != 0);
       if (several_parts)
         by_network_[f] = authored && options_.prior > 0 ? 2 : 1;  // 2: several parts
-      else if (options_.unnamed_network && !authored && !any_named)
+      else if (rule4 && !authored && !any_named)
         by_network_[f] = 1;  // 4: nothing speaks anywhere
       // else 3: a per-part material: `pbr`
     }
+  }
+
+  // Every name the model carries is a placeholder: its materials', meshes',
+  // nodes' and texture files' (the names `pbr` reads).
+  static bool nameless(const Model& model) {
+    for (const SourceMaterial& m : model.materials) {
+      if (!detail::is_placeholder_name(m.name)) return false;
+      for (const Texture* t : {&m.base_color_texture, &m.metallic_roughness_texture})
+        if (!t->uri.empty() && t->uri[0] != '*' &&
+            !detail::is_placeholder_name(std::filesystem::path(t->uri).stem().string(),
+                                         detail::PlaceholderKind::kTextureFile))
+          return false;
+    }
+    for (const SourcePrimitive& p : model.primitives)
+      if (!detail::is_placeholder_name(p.mesh_name) || !detail::is_placeholder_name(p.node_name)) return false;
+    return true;
   }
 
   // colour=on: a base-colour texture shows regions; so does no colour at all

@@ -172,6 +172,42 @@ std::vector<float> name_evidence(std::string_view text, const MaterialTable& tab
   return evidence;
 }
 
+bool is_placeholder_name(std::string_view text, PlaceholderKind kind) {
+  // Default words of Blender (Cube, Material.001, Collection, Grid), Maya
+  // (pCubeShape1, polySurface1, lambert2SG, initialShadingGroup,
+  // aiStandardSurface), 3ds Max (Box001, "01 - Default"), SketchUp
+  // (Color_A01, ID123), assimp (DefaultMaterial, defaultobject, $RootNode,
+  // nodes[0], meshes[0]), trimesh and the generators' files (geometry_0,
+  // material_0, world, tmpoxykr9_1.ply) and libg2p's own --anonymize-names
+  // (material_0, mesh_0, node, texture_0).
+  static constexpr std::string_view kWords =
+      " ai armature blinn box circle collection color colour cone cube cylinder dae data default defaultmaterial"
+      " defaultobject empty export exported fbx geom geometry glb gltf grid group ico icosphere id initial instance"
+      " lambert mat material materials mesh meshes model mtl new node nodes none noname null obj object phong plane"
+      " ply poly prim primitive root scene sg shading shape sketchup sphere standard stl submesh surface torus"
+      " transform untitled unnamed uv world ";
+  // Words that say nothing only in a texture file's name (baseColor.png,
+  // texture_0_diffuse.jpg); as a part's name, "Base" or "Map" is a word.
+  static constexpr std::string_view kTextureWords = " albedo base diffuse image img map tex texture ";
+  const std::string folded = fold(text);
+  // A script tokenize does not read (Cyrillic, Greek, CJK) is somebody's word.
+  if (std::any_of(folded.begin(), folded.end(), [](char c) { return static_cast<unsigned char>(c) >= 0x80; }))
+    return false;
+  // 3ds Max names an object after its wireframe colour: wire_ and nine digits.
+  if (folded.size() == 14 && tokenize(folded.substr(0, 5)) == std::vector<std::string>{"wire"} && folded[4] == '_' &&
+      std::all_of(folded.begin() + 5, folded.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+    return true;
+  for (const std::string& token : tokenize(text)) {
+    if (token.size() <= 1) continue;
+    if (token.compare(0, 3, "tmp") == 0) continue;  // a temporary file's name (Python's tempfile)
+    const std::string word = " " + token + " ";
+    const bool known = kWords.find(word) != std::string_view::npos ||
+                       (kind == PlaceholderKind::kTextureFile && kTextureWords.find(word) != std::string_view::npos);
+    if (!known) return false;
+  }
+  return true;
+}
+
 }  // namespace g2p::detail
 
 namespace g2p {

@@ -18,4 +18,15 @@ std::vector<std::string> tokenize(std::string_view text);
 // (the paper's vocabulary); a custom class is also matched by its own name.
 std::vector<float> name_evidence(std::string_view text, const MaterialTable& table);
 
+// Whether `text` is a placeholder: every word of it (tokenize) is one that
+// exporters, modelling tools and image-to-3D pipelines give when nobody named
+// anything ("Material.001", "material_0", "Cube", "pCubeShape1", "mesh_3",
+// "nodes[0]", "01 - Default", "geometry_0", "wire_028089177"), or a single
+// letter; an empty or all-digit text is one too. A curated asset's own words
+// ("potty", "black", "Wood_bareoak"), and any text in a script other than
+// Latin, are not. A texture file's name may also use the words of a texture
+// ("texture_0", "baseColor", "diffuse"), which name a part elsewhere ("Base").
+enum class PlaceholderKind { kName, kTextureFile };
+bool is_placeholder_name(std::string_view text, PlaceholderKind kind = PlaceholderKind::kName);
+
 }  // namespace g2p::detail

@@ -41,9 +41,16 @@ TEST(MaterialTable, DefaultValuesArePhysicallyOrdered) {
   EXPECT_GT(density(PaperClass::kWood), density(PaperClass::kFabric));
   EXPECT_EQ(t[static_cast<int>(PaperClass::kMetal)].structure, Structure::kSolid);
   EXPECT_EQ(t[static_cast<int>(PaperClass::kGlass)].structure, Structure::kHollow);
-  // No class limits its solid thickness by default (accuracy.md: the candidate limits did not
-  // pass their shipping rule).
-  for (const MaterialClass& c : t.classes()) EXPECT_EQ(c.max_solid_thickness_m, 0.0) << c.name;
+  // The thickest solid piece (accuracy.md, the second structure candidate): none for the classes
+  // whose bulk is solid at any size or that the network confuses with bodies (Rubber); otherwise at
+  // least two walls, and a wooden leg or beam (0.10 m) thicker than a metal bar (0.06 m).
+  for (const PaperClass c :
+       {PaperClass::kRubber, PaperClass::kFabric, PaperClass::kOrganic, PaperClass::kStone, PaperClass::kOther})
+    EXPECT_EQ(t[static_cast<int>(c)].max_solid_thickness_m, 0.0) << t[static_cast<int>(c)].name;
+  EXPECT_DOUBLE_EQ(t[static_cast<int>(PaperClass::kWood)].max_solid_thickness_m, 0.10);
+  EXPECT_DOUBLE_EQ(t[static_cast<int>(PaperClass::kMetal)].max_solid_thickness_m, 0.06);
+  for (const MaterialClass& c : t.classes())
+    if (c.max_solid_thickness_m > 0) EXPECT_GE(c.max_solid_thickness_m, 2 * c.wall_thickness_m) << c.name;
   for (const MaterialClass& c : t.classes()) {
     EXPECT_LE(c.density_min_kg_m3, c.density_kg_m3) << c.name;
     EXPECT_GE(c.density_max_kg_m3, c.density_kg_m3) << c.name;

@@ -123,28 +123,39 @@ TEST(TableEstimator, ThinPartsOfHollowClassesAreSolid) {
   EXPECT_NEAR(r.object.mass_kg / (1150 * 0.2 * 0.1 * 0.004), 1.0, 0.05);
 }
 
-// The default table with the thickest solid pieces of docs/materials.md
-// (off by default): Wood 0.10 m, Metal 0.06 m.
+// The default table with no class's solid thickness limited, or only Wood's
+// (0.10 m) and Metal's (0.06 m), the default table's values
+// (docs/materials.md), so that these tests do not move with the others.
+MaterialTable table_with_limits(double wood_m, double metal_m) {
+  std::vector<MaterialClass> classes = table().classes();
+  for (MaterialClass& c : classes) c.max_solid_thickness_m = 0;
+  classes[static_cast<std::size_t>(kWood)].max_solid_thickness_m = wood_m;
+  classes[static_cast<std::size_t>(kMetal)].max_solid_thickness_m = metal_m;
+  return *MaterialTable::from_classes(classes, "limits");
+}
 const MaterialTable& table_with_solid_limits() {
-  static const MaterialTable t = [] {
-    std::vector<MaterialClass> classes = table().classes();
-    classes[static_cast<std::size_t>(kWood)].max_solid_thickness_m = 0.10;
-    classes[static_cast<std::size_t>(kMetal)].max_solid_thickness_m = 0.06;
-    return *MaterialTable::from_classes(classes, "limits");
-  }();
+  static const MaterialTable t = table_with_limits(0.10, 0.06);
+  return t;
+}
+const MaterialTable& table_without_solid_limits() {
+  static const MaterialTable t = table_with_limits(0, 0);
   return t;
 }
 
-PropertiesReport report_with_solid_limits(const Stage& s) {
+PropertiesReport report_with_table(const Stage& s, const MaterialTable& t) {
   auto e = std::move(*make_estimator("table"));
-  Result<PropertiesReport> r = estimate_properties(s.mesh, s.parts, s.completion, table_with_solid_limits(), *e);
+  Result<PropertiesReport> r = estimate_properties(s.mesh, s.parts, s.completion, t, *e);
   EXPECT_TRUE(r.ok()) << r.status().to_string();
   return r.ok() ? *r : PropertiesReport{};
+}
+PropertiesReport report_with_solid_limits(const Stage& s) { return report_with_table(s, table_with_solid_limits()); }
+PropertiesReport report_without_solid_limits(const Stage& s) {
+  return report_with_table(s, table_without_solid_limits());
 }
 
 // The thickest solid piece of a class (max_solid_thickness_m): a wardrobe
 // modelled as a closed box is panels around air; the same box with no limit
-// (the default table) stays solid wood; a wooden plank stays solid.
+// stays solid wood; a wooden plank stays solid.
 TEST(TableEstimator, PartsThickerThanTheirClassesThickestSolidPieceAreShells) {
   const Mesh wardrobe = test::box_mesh({0, 0, 0}, {0.6f, 0.5f, 1.8f});
   const Stage s = complete_object(wardrobe, test::single_part(wardrobe, kWood));
@@ -159,7 +170,7 @@ TEST(TableEstimator, PartsThickerThanTheirClassesThickestSolidPieceAreShells) {
   const double area = surface_area(wardrobe);
   EXPECT_NEAR(r.object.mass_kg / (700 * area * 0.02), 1.0, 1e-6);
 
-  const PropertiesReport solid = report_of(s);
+  const PropertiesReport solid = report_without_solid_limits(s);
   ASSERT_EQ(solid.parts.size(), 1u);
   EXPECT_EQ(solid.parts[0].properties.structure, Structure::kSolid);
   EXPECT_NEAR(solid.object.mass_kg / (700 * 0.6 * 0.5 * 1.8), 1.0, 0.01);
@@ -218,7 +229,7 @@ TEST(TableEstimator, AnInnerSurfaceFartherThanAWallCanBeIsNotTheWall) {
   // table, with no limit, takes the gap for the wall (and the guard then
   // fills it).
   EXPECT_LT(r.object.mass_kg, 20.0);
-  const PropertiesReport unlimited = report_of(s);
+  const PropertiesReport unlimited = report_without_solid_limits(s);
   EXPECT_GT(unlimited.object.mass_kg, 300.0);
 }
 

@@ -340,6 +340,85 @@ TEST(RegionsRefiner, DecidesOncePerRegion) {
   EXPECT_GT(changed, 0);
 }
 
+// scope=image: only the regions the image decided are the classifier's; the
+// rest take smooth's labels (rest=smooth) or keep their votes (rest=keep).
+TEST(RegionsRefiner, DecidesOnlyTheRegionsTheImageDecided) {
+  const std::string dir = test::scratch_dir("regions_refiner_scope");
+  const std::string card = train_synthetic(dir);
+  const Scene s = generated("SheenChair");
+  const Projection p = pbr_projection(s);
+  const std::size_t faces = s.model.mesh.triangles.size();
+  Result<RefineResult> smooth = (*make_refiner("smooth"))->refine(input_of(s, p));
+  ASSERT_TRUE(smooth.ok());
+
+  // No face is the image's: smooth's labels, and the classifier is not even
+  // read (a card that cannot be read goes unnoticed, nothing degrades).
+  std::ofstream(dir + "/broken.json") << "not json";
+  const std::vector<std::uint8_t> none(faces, 0);
+  RefineInput in = input_of(s, p);
+  in.image_decided = &none;
+  Result<RefineResult> r = (*make_refiner("regions", {{"card", dir + "/broken.json"}}))->refine(in);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_FALSE(r->fell_back);
+  EXPECT_EQ(r->labels, smooth->labels);
+  EXPECT_NE(r->notes.back().find("no face was labelled from the image alone"), std::string::npos) << r->notes.back();
+  r = (*make_refiner("regions", {{"card", card}, {"rest", "keep"}}))->refine(in);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->labels, p.labels.label);
+  EXPECT_TRUE(r->changes.empty());
+
+  // The image decided the faces of the chair's low half: the regions mostly
+  // there are the classifier's (one class each, Metal or Fabric); the others
+  // keep smooth's labels.
+  Eigen::Vector3d lo = s.model.mesh.positions.front().cast<double>(), hi = lo;
+  for (const auto& v : s.model.mesh.positions) lo = lo.cwiseMin(v.cast<double>()), hi = hi.cwiseMax(v.cast<double>());
+  std::vector<std::uint8_t> low(faces, 0);
+  for (std::size_t f = 0; f < faces; ++f) {
+    const Eigen::Vector3i& t = s.model.mesh.triangles[f];
+    const double z =
+        (s.model.mesh.positions[t[0]].z() + s.model.mesh.positions[t[1]].z() + s.model.mesh.positions[t[2]].z()) / 3.0;
+    low[f] = z < 0.5 * (lo.z() + hi.z()) ? 1 : 0;  // +Z is up
+  }
+  in.image_decided = &low;
+  r = (*make_refiner("regions", {{"card", card}}))->refine(in);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_FALSE(r->fell_back);
+  const Regions regions = *find_regions(s.model.mesh, p.graph, face_colours(s.model.mesh, s.views));
+  int decided = 0, kept = 0;
+  for (const Region& region : regions.regions) {
+    double image = 0, all = 0;
+    for (const int f : region.faces) all += face_area(s.model.mesh, f), image += low[f] * face_area(s.model.mesh, f);
+    if (image > 0.5 * all) {
+      ++decided;
+      const int l = r->labels[region.faces.front()];
+      EXPECT_TRUE(l == table().find("Metal") || l == table().find("Fabric")) << l;
+      for (const int f : region.faces) EXPECT_EQ(r->labels[f], l);
+    } else {
+      ++kept;
+      for (const int f : region.faces) EXPECT_EQ(r->labels[f], smooth->labels[f]) << f;
+    }
+  }
+  EXPECT_GT(decided, 0);
+  EXPECT_GT(kept, 0);
+  for (const LabelChange& c : r->changes) {
+    EXPECT_EQ(p.labels.label[c.face], c.from);
+    EXPECT_EQ(r->labels[c.face], c.to);
+  }
+  // Without the segmenter's word (no image_decided), every region is the
+  // classifier's; scope=all ignores it.
+  in.image_decided = nullptr;
+  Result<RefineResult> every = (*make_refiner("regions", {{"card", card}}))->refine(in);
+  in.image_decided = &none;
+  Result<RefineResult> all = (*make_refiner("regions", {{"card", card}, {"scope", "all"}}))->refine(in);
+  ASSERT_TRUE(every.ok() && all.ok());
+  EXPECT_EQ(every->labels, all->labels);
+  for (const Region& region : regions.regions)
+    for (const int f : region.faces) EXPECT_EQ(all->labels[f], all->labels[region.faces.front()]);
+
+  EXPECT_FALSE(make_refiner("regions", {{"scope", "network"}}).ok());
+  EXPECT_FALSE(make_refiner("regions", {{"rest", "vlm"}}).ok());
+}
+
 TEST(RegionsRefiner, FallsBackToSmoothAndSaysWhy) {
   const Scene s = generated("WaterBottle");
   const Projection p = pbr_projection(s);

@@ -121,6 +121,28 @@ TEST(HybridSegmenter, NamedPerPartAssetsKeepPbrsLabels) {
   }
 }
 
+// What the `regions` refiner reads: the faces the network labelled.
+TEST(HybridSegmenter, SaysWhichFacesTheImageDecided) {
+  const Chair& chair = sheen_chair();
+  const MaterialTable& table = MaterialTable::paper_default();
+  const std::size_t faces = chair.merged.mesh.triangles.size();
+  auto hybrid = std::move(*make_segmenter("hybrid", {{"atlas_charts", "0"}}));
+  EXPECT_TRUE(hybrid->image_decided_faces().empty()) << "before set_model";
+  ASSERT_TRUE(hybrid->set_model(chair.merged, table).ok());
+  EXPECT_EQ(hybrid->image_decided_faces(), std::vector<std::uint8_t>(faces, 1)) << "one atlas material: the network";
+  ASSERT_TRUE(hybrid->set_model(chair.original, table).ok());
+  EXPECT_EQ(hybrid->image_decided_faces(), std::vector<std::uint8_t>(chair.original.mesh.triangles.size(), 0))
+      << "named per part: pbr";
+  // Without its network, `pbr` labels everything: nothing is the image's.
+  auto blind =
+      std::move(*make_segmenter("hybrid", {{"model_card", "/nonexistent/g2p-materials.json"}, {"atlas_charts", "0"}}));
+  ASSERT_TRUE(blind->set_model(chair.merged, table).ok());
+  EXPECT_EQ(blind->image_decided_faces(), std::vector<std::uint8_t>(faces, 0));
+  auto pbr = std::move(*make_segmenter("pbr"));
+  ASSERT_TRUE(pbr->set_model(chair.merged, table).ok());
+  EXPECT_EQ(pbr->image_decided_faces(), std::vector<std::uint8_t>(faces, 0));
+}
+
 TEST(HybridSegmenter, WithoutItsNetworkFallsBackToPbrAndSaysWhy) {
   const Chair& chair = sheen_chair();
   ASSERT_FALSE(chair.truth.empty());

@@ -55,6 +55,9 @@ Status write_region_rows(std::ostream& out, const std::string& key, const Model&
   double total = 0.0;
   for (const Region& r : regions->regions) total += r.area_m2;
   std::vector<double> by_class(static_cast<std::size_t>(table.size()));
+  std::string quoted_key = "\"";  // RFC 4180: always quoted, quotes doubled
+  for (const char c : key) quoted_key += c == '"' ? std::string("\"\"") : std::string(1, c);
+  quoted_key += '"';
   for (std::size_t r = 0; r < regions->regions.size(); ++r) {
     const Region& region = regions->regions[r];
     std::fill(by_class.begin(), by_class.end(), 0.0);
@@ -68,7 +71,7 @@ Status write_region_rows(std::ostream& out, const std::string& key, const Model&
     }
     const auto best = std::max_element(by_class.begin(), by_class.end());
     const bool known = labelled > 0.0 && *best > 0.0;
-    out << '"' << key << "\"," << r << ',' << region.faces.size() << ',' << (total > 0 ? region.area_m2 / total : 0.0)
+    out << quoted_key << ',' << r << ',' << region.faces.size() << ',' << (total > 0 ? region.area_m2 / total : 0.0)
         << ',' << (known ? table[static_cast<int>(best - by_class.begin())].name : std::string()) << ','
         << (known ? *best / labelled : 0.0) << ',' << (region.area_m2 > 0 ? labelled / region.area_m2 : 0.0);
     for (std::size_t i = 0; i < width; ++i) out << ',' << (*features)[r * width + i];
@@ -203,8 +206,10 @@ int run_eval_seg(const EvalArgs& args) {
         return kExitFailure;
       }
     nlohmann::json refine_report;  // kept in the JSON, not printed: the table stays one line per model
-    if (const int code = apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
-                                       project_options.partition, *projection, refine_report, /*print_notes=*/false);
+    const std::vector<std::uint8_t> image_decided = (*predictor)->image_decided_faces();
+    if (const int code =
+            apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
+                          project_options.partition, *projection, refine_report, /*print_notes=*/false, &image_decided);
         code != kExitOk)
       return code;
     ConfusionMatrix matrix_3d(table->size());

@@ -59,8 +59,9 @@ int run_project(const ProjectArgs& args) {
 
   // Stage 4 (optional): refine the labels, then re-partition with the refined labels.
   nlohmann::json refine_report;
+  const std::vector<std::uint8_t> image_decided = (*segmenter)->image_decided_faces();
   if (int code = refine_projection("project", args.refine, *model, *views, *table, options.partition, *projection,
-                                   refine_report);
+                                   refine_report, &image_decided);
       code != kExitOk)
     return code;
 

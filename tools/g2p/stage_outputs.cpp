@@ -47,10 +47,11 @@ Result<std::unique_ptr<Refiner>> make_refiner_flag(const std::string& command, c
 
 int apply_refiner(const std::string& command, const std::string& name, const Refiner* refiner, const Model& model,
                   const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition_options,
-                  Projection& projection, nlohmann::json& report, bool print_notes) {
+                  Projection& projection, nlohmann::json& report, bool print_notes,
+                  const std::vector<std::uint8_t>* image_decided) {
   report = {{"refiner", name}};
   if (refiner == nullptr) return kExitOk;
-  RefineInput in{&model.mesh, &projection.graph, &projection.votes, &projection.labels, &views, &table};
+  RefineInput in{&model.mesh, &projection.graph, &projection.votes, &projection.labels, &views, &table, image_decided};
   Result<RefineResult> refined = refiner->refine(in);
   if (!refined.ok() &&
       (refined.status().code() == StatusCode::kInvalidArgument || refined.status().code() == StatusCode::kNotFound)) {
@@ -84,12 +85,13 @@ int apply_refiner(const std::string& command, const std::string& name, const Ref
 
 int refine_projection(const std::string& command, const RefineArgs& args, const Model& model,
                       const std::vector<View>& views, const MaterialTable& table,
-                      const PartitionOptions& partition_options, Projection& projection, nlohmann::json& report) {
+                      const PartitionOptions& partition_options, Projection& projection, nlohmann::json& report,
+                      const std::vector<std::uint8_t>* image_decided) {
   int exit_code = kExitOk;
   Result<std::unique_ptr<Refiner>> refiner = make_refiner_flag(command, args, exit_code);
   if (!refiner.ok()) return exit_code;
   return apply_refiner(command, args.name, refiner->get(), model, views, table, partition_options, projection, report,
-                       /*print_notes=*/true);
+                       /*print_notes=*/true, image_decided);
 }
 
 Status write_projection(const std::string& out, const Model& model, const std::vector<View>& views,

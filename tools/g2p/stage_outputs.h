@@ -27,17 +27,20 @@ Result<std::unique_ptr<Refiner>> make_refiner_flag(const std::string& command, c
 // Runs `refiner` (null: nothing) on the projection and re-partitions with its
 // labels; `report` gets what refine_projection writes to refine.json. A
 // refiner failure keeps the projected labels (a warning; the report says
-// why). With print_notes, its notes go to stdout.
+// why). With print_notes, its notes go to stdout. `image_decided` is the
+// segmenter's Segmenter::image_decided_faces() (null: not known).
 int apply_refiner(const std::string& command, const std::string& name, const Refiner* refiner, const Model& model,
                   const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition,
-                  Projection& projection, nlohmann::json& report, bool print_notes);
+                  Projection& projection, nlohmann::json& report, bool print_notes,
+                  const std::vector<std::uint8_t>* image_decided = nullptr);
 
 // Runs the refiner on the projection and re-partitions with its labels. A
 // refiner failure keeps the projected labels (a warning; the report says
 // why). Returns an exit code: kExitOk, or kExitUsage for bad flags.
 int refine_projection(const std::string& command, const RefineArgs& args, const Model& model,
                       const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition,
-                      Projection& projection, nlohmann::json& report);
+                      Projection& projection, nlohmann::json& report,
+                      const std::vector<std::uint8_t>* image_decided = nullptr);
 
 // faces.csv, labelled.ply, parts.json, refine.json and projected/ label maps.
 Status write_projection(const std::string& out, const Model& model, const std::vector<View>& views,

@@ -34,18 +34,26 @@ struct Rows {
   std::set<std::string> models;
 };
 
-std::vector<std::string> split_csv(const std::string& line) {
+// One CSV record (RFC 4180 quoting: "a ""b""" is a "b"); a CR before the line
+// end (a file saved on Windows) is dropped.
+std::vector<std::string> split_csv(std::string line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
   std::vector<std::string> out;
   std::string cell;
   bool quoted = false;
-  for (const char c : line) {
-    if (c == '"')
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
+      cell += '"';
+      ++i;
+    } else if (c == '"') {
       quoted = !quoted;
-    else if (c == ',' && !quoted) {
+    } else if (c == ',' && !quoted) {
       out.push_back(cell);
       cell.clear();
-    } else
+    } else {
       cell += c;
+    }
   }
   out.push_back(cell);
   return out;

@@ -4,6 +4,7 @@
 // the welded face graph. Backends are swappable through refiner_registry().
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct RefineInput {
   const FaceLabels* labels = nullptr;
   const std::vector<View>* views = nullptr;  // may be null for backends that do not need them
   const MaterialTable* table = nullptr;
+  // Per face, 1 where the segmenter's labels came from the image alone
+  // (Segmenter::image_decided_faces); null or empty: the refiner may not tell
+  // image evidence from names, and treats every face alike.
+  const std::vector<std::uint8_t>* image_decided = nullptr;
 };
 
 // One face whose label the refiner changed, and why.

@@ -171,6 +171,10 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     r.peak_rss_bytes = std::max(r.peak_rss_bytes, r.stages.back().peak_rss_bytes);
   };
 
+  // Per face, whether the segmenter's labels came from the image alone (the
+  // `regions` refiner decides only those).
+  std::vector<std::uint8_t> image_decided;
+
   // 1. render: the views, each with its face-ID and material buffers.
   {
     detail::StageClock clock(Stage::kRender, renderer.backend(o.renderer), reset);
@@ -198,6 +202,7 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     G2P_RETURN_IF_ERROR(segmenter.get()->set_model(r.model, r.table).with_context("segment"));
     // A backend that degraded (`hybrid` falls back to `pbr` without its network) says why.
     for (const std::string& w : segmenter.get()->warnings()) r.warnings.push_back("segment: " + w);
+    image_decided = segmenter.get()->image_decided_faces();
     const std::size_t n = r.views.size();
     r.label_maps.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -232,7 +237,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   // 4. refine (optional): a failure keeps the projected labels.
   if (refiner.custom || o.refiner.name != "none") {
     detail::StageClock clock(Stage::kRefine, refiner.backend(o.refiner), reset);
-    RefineInput in{&mesh, &r.projection.graph, &r.projection.votes, &r.projection.labels, &r.views, &r.table};
+    RefineInput in{&mesh,    &r.projection.graph, &r.projection.votes, &r.projection.labels, &r.views,
+                   &r.table, &image_decided};
     Result<RefineResult> refined = refiner.get()->refine(in);
     const StatusCode code = refined.ok() ? StatusCode::kOk : refined.status().code();
     if (code == StatusCode::kInvalidArgument || code == StatusCode::kNotFound)

@@ -1,12 +1,19 @@
 // The `regions` refiner: one decision per region by the region classifier
-// (regions.h). Every face of a region takes the class the classifier gives
-// the region, unless the classifier is less sure than `min_probability`, in
-// which case the region keeps the labels the project stage gave it. When the
-// classifier cannot run (no card installed, a card that cannot be read, no
-// views with base colour) it falls back to `smooth` and says why in its last
-// note. A `card` setting that names no file is refused when configured.
+// (regions.h). With scope=image (the default) it decides only the regions
+// whose faces the segmenter labelled from the image alone
+// (RefineInput::image_decided: the network's faces); names and authored
+// values are right where they speak, and the classifier, trained on the
+// network's votes, would overrule them. Every other face takes the `smooth`
+// refiner's label (rest=smooth, the default) or keeps its voted label
+// (rest=keep). A decided region's faces take the classifier's class unless it
+// is less sure than `min_probability`, in which case the region keeps its
+// `rest` labels. When the classifier cannot run (no card installed, a card
+// that cannot be read, no views with base colour) the result is `smooth`'s,
+// and the last note says why; a model with no image-decided face never needs
+// it. A `card` setting that names no file is refused when configured.
 //
 // Settings: card (a classifier card; default the shipped g2p-regions.json),
+// scope (image | all, default image), rest (smooth | keep, default smooth),
 // crease (degrees, default 40), colour (linear RGB step, default 0.1),
 // min_area (area share, default 0.002), min_probability (default 0).
 #include <algorithm>
@@ -33,6 +40,17 @@ class RegionsRefiner final : public Refiner {
         card_ = value;
         continue;
       }
+      if (key == "scope" || key == "rest") {
+        if (key == "scope" && (value == "image" || value == "all")) {
+          image_only_ = value == "image";
+        } else if (key == "rest" && (value == "smooth" || value == "keep")) {
+          smooth_rest_ = value == "smooth";
+        } else {
+          return Status::InvalidArgument("regions: bad setting " + key + "=" + value +
+                                         (key == "scope" ? " (scope is image or all)" : " (rest is smooth or keep)"));
+        }
+        continue;
+      }
       double v = 0;
       if (!detail::parse_double(value, v))
         return Status::InvalidArgument("regions: " + key + " needs a number, got '" + value + "'");
@@ -46,8 +64,8 @@ class RegionsRefiner final : public Refiner {
         min_probability_ = v;
       else
         return Status::InvalidArgument("regions: bad setting " + key + "=" + value +
-                                       " (known: card, crease in [0, 180], colour >= 0, min_area in [0, 1), "
-                                       "min_probability in [0, 1])");
+                                       " (known: card, scope=image|all, rest=smooth|keep, crease in [0, 180], "
+                                       "colour >= 0, min_area in [0, 1), min_probability in [0, 1])");
     }
     return Status::Ok();
   }
@@ -55,8 +73,33 @@ class RegionsRefiner final : public Refiner {
   Result<RefineResult> refine(const RefineInput& in) const override {
     if (in.mesh == nullptr || in.graph == nullptr || in.votes == nullptr || in.labels == nullptr || in.table == nullptr)
       return Status::InvalidArgument("regions: needs the mesh, face graph, votes, labels and material table");
-    if (static_cast<int>(in.labels->label.size()) != in.mesh->num_faces())
+    const std::size_t faces = static_cast<std::size_t>(in.mesh->num_faces());
+    if (in.labels->label.size() != faces)
       return Status::InvalidArgument("regions: mesh and labels disagree on the number of faces");
+
+    // The labels of the faces the classifier does not decide.
+    RefineResult rest;
+    if (smooth_rest_) {
+      Result<RefineResult> smoothed = make_smooth_refiner()->refine(in);
+      if (!smoothed.ok()) return smoothed.status();
+      rest = std::move(*smoothed);
+    } else {
+      rest.labels = in.labels->label;
+    }
+
+    // Which faces the classifier may decide.
+    const bool known = in.image_decided != nullptr && in.image_decided->size() == faces;
+    std::vector<std::uint8_t> eligible(faces, 1);
+    if (image_only_ && known) eligible = *in.image_decided;
+    if (image_only_ && in.image_decided != nullptr && !in.image_decided->empty() && !known)
+      rest.notes.push_back("regions: the segmenter's image-decided faces do not match the mesh; every face counts");
+    if (std::none_of(eligible.begin(), eligible.end(), [](std::uint8_t e) { return e != 0; })) {
+      rest.notes.push_back(std::string("regions: no face was labelled from the image alone (names or authored "
+                                       "values decided every one); ") +
+                           (smooth_rest_ ? "the smooth refiner's labels stand" : "the voted labels stand"));
+      return rest;
+    }
+
     std::string why;
     const std::string card = card_.empty() ? shipped_region_card() : card_;
     Result<std::shared_ptr<const RegionClassifier>> classifier = Status::NotFound("");
@@ -72,47 +115,77 @@ class RegionsRefiner final : public Refiner {
       why = "the views have no base-colour buffer, the colours the classifier was trained on";
     else if (classifier = load(card, *in.table); !classifier.ok())
       why = classifier.status().message();
-    if (!why.empty()) return fall_back(in, why);
+    if (!why.empty()) return fall_back(in, std::move(rest), why);
 
     const FaceColours colours = face_colours(*in.mesh, *in.views);
     if (std::all_of(colours.pixels.begin(), colours.pixels.end(), [](float p) { return p == 0.f; }))
-      return fall_back(in, "no view shows any face");
+      return fall_back(in, std::move(rest), "no view shows any face");
     Result<Regions> regions = find_regions(*in.mesh, *in.graph, colours, options_);
     if (!regions.ok()) return regions.status();
     Result<std::vector<float>> features = region_features(*in.mesh, *regions, *in.votes, colours, *in.table);
     if (!features.ok()) return features.status();
     const int rows = static_cast<int>(regions->regions.size());
     Result<std::vector<float>> probabilities = (*classifier)->predict(*features, rows);
-    if (!probabilities.ok()) return fall_back(in, probabilities.status().message());
+    if (!probabilities.ok()) return fall_back(in, std::move(rest), probabilities.status().message());
 
-    RefineResult result;
-    result.labels = in.labels->label;
+    // The reason for each face the classifier changes; the others keep
+    // `rest`'s label and reason.
+    std::vector<std::string> reasons;
+    std::vector<int> reason_of(faces, -1);
+    std::vector<int> labels = rest.labels;
     const int k = (*classifier)->num_classes();
-    int decided = 0, kept = 0;
+    int decided = 0, unsure = 0, outside = 0;
     for (int r = 0; r < rows; ++r) {
+      const Region& region = regions->regions[static_cast<std::size_t>(r)];
+      double image_area = 0, area = 0;
+      for (const int f : region.faces) {
+        const double a = face_area(*in.mesh, f);
+        area += a;
+        if (eligible[static_cast<std::size_t>(f)] != 0) image_area += a;
+      }
+      if (!(image_area > 0.5 * area)) {
+        ++outside;
+        continue;
+      }
       const float* p = probabilities->data() + static_cast<std::size_t>(r) * k;
       int best = 0;
       for (int c = 1; c < k; ++c)
         if (p[c] > p[best]) best = c;
       if (p[best] <= 0.f || p[best] < min_probability_) {
-        ++kept;
+        ++unsure;
         continue;
       }
       ++decided;
       char reason[160];
       std::snprintf(reason, sizeof(reason), "region %d (%zu faces): the region classifier says %s (%.0f %%)", r,
-                    regions->regions[static_cast<std::size_t>(r)].faces.size(), (*in.table)[best].name.c_str(),
-                    100.0 * p[best]);
-      for (const int f : regions->regions[static_cast<std::size_t>(r)].faces) {
-        int& label = result.labels[static_cast<std::size_t>(f)];
-        if (label == best) continue;
-        result.changes.push_back({f, label, best, reason});
-        label = best;
+                    region.faces.size(), (*in.table)[best].name.c_str(), 100.0 * p[best]);
+      reasons.emplace_back(reason);
+      for (const int f : region.faces) {
+        labels[static_cast<std::size_t>(f)] = best;
+        reason_of[static_cast<std::size_t>(f)] = static_cast<int>(reasons.size()) - 1;
       }
     }
+
+    RefineResult result;
+    result.labels = std::move(labels);
+    std::vector<const LabelChange*> rest_change(faces, nullptr);
+    for (const LabelChange& c : rest.changes)
+      if (c.face >= 0 && static_cast<std::size_t>(c.face) < faces) rest_change[static_cast<std::size_t>(c.face)] = &c;
+    for (std::size_t f = 0; f < faces; ++f) {
+      const int from = in.labels->label[f], to = result.labels[f];
+      if (from == to) continue;
+      const int why_index = reason_of[f];
+      result.changes.push_back({static_cast<int>(f), from, to,
+                                why_index >= 0              ? reasons[static_cast<std::size_t>(why_index)]
+                                : rest_change[f] != nullptr ? rest_change[f]->reason
+                                                            : std::string("smooth")});
+    }
+    result.notes = std::move(rest.notes);
     result.notes.push_back("regions: " + std::to_string(rows) + " regions, " + std::to_string(decided) +
-                           " decided by the classifier (" + card + "), " + std::to_string(kept) +
-                           " kept their voted labels; " + std::to_string(result.changes.size()) + " faces changed");
+                           " decided by the classifier (" + card + "), " + std::to_string(unsure) + " too unsure and " +
+                           std::to_string(outside) + " labelled by names or authored values kept " +
+                           (smooth_rest_ ? "the smooth refiner's labels" : "their voted labels") + "; " +
+                           std::to_string(result.changes.size()) + " faces changed");
     return result;
   }
 
@@ -130,14 +203,17 @@ class RegionsRefiner final : public Refiner {
     return cached_;
   }
 
-  // `smooth` in its place, with the reason as the last note; the stage is
-  // marked degraded.
-  Result<RefineResult> fall_back(const RefineInput& in, const std::string& why) const {
-    Result<RefineResult> r = make_smooth_refiner()->refine(in);
-    if (!r.ok()) return r;
-    r->notes.push_back("regions: " + why + "; the smooth refiner ran instead");  // last: the pipeline reports it
-    r->fell_back = true;
-    return r;
+  // `smooth` in its place (its labels already in `rest` with rest=smooth),
+  // with the reason as the last note; the stage is marked degraded.
+  Result<RefineResult> fall_back(const RefineInput& in, RefineResult rest, const std::string& why) const {
+    if (!smooth_rest_) {
+      Result<RefineResult> smoothed = make_smooth_refiner()->refine(in);
+      if (!smoothed.ok()) return smoothed;
+      rest = std::move(*smoothed);
+    }
+    rest.notes.push_back("regions: " + why + "; the smooth refiner ran instead");  // last: the pipeline reports it
+    rest.fell_back = true;
+    return rest;
   }
 
   std::string card_;
@@ -146,6 +222,8 @@ class RegionsRefiner final : public Refiner {
   mutable std::shared_ptr<const RegionClassifier> cached_;
   mutable std::string cached_key_;
   double min_probability_ = 0.0;
+  bool image_only_ = true;   // scope=image
+  bool smooth_rest_ = true;  // rest=smooth
 };
 
 }  // namespace

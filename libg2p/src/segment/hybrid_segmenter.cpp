@@ -209,6 +209,15 @@ class HybridSegmenter final : public Segmenter {
 
   std::vector<std::string> warnings() const override { return warnings_; }
 
+  // The network's faces (alone or with `pbr` as a prior), when it runs.
+  std::vector<std::uint8_t> image_decided_faces() const override {
+    if (model_ == nullptr) return {};
+    std::vector<std::uint8_t> image(by_network_.size(), 0);
+    if (use_network_)
+      for (std::size_t f = 0; f < image.size(); ++f) image[f] = by_network_[f] != 0 ? 1 : 0;
+    return image;
+  }
+
  private:
   // by_network_ per face: 0 = `pbr`, 1 = the network, 2 = the network with
   // `pbr` as a prior.

@@ -168,6 +168,15 @@ class LearnedSegmenter final : public Segmenter {
     return Status::Ok();
   }
 
+  // The network decides the faces names and authored PBR leave open.
+  std::vector<std::uint8_t> image_decided_faces() const override {
+    if (model_ == nullptr) return {};
+    std::vector<std::uint8_t> image(model_->mesh.triangles.size(), all_named_ ? 0 : 1);
+    if (!all_named_)
+      for (std::size_t f = 0; f < image.size() && f < named_.size(); ++f) image[f] = named_[f] ? 0 : 1;
+    return image;
+  }
+
   Status segment_into(const View& view, LabelMap& out) const override {
     if (model_ == nullptr) return Status::InvalidArgument(name_ + ": set_model first");
     if (all_named_) return names_->segment_into(view, out);  // the network would be overwritten everywhere

@@ -84,6 +84,11 @@ class OracleSegmenter final : public Segmenter {
     return Status::Ok();
   }
 
+  // The ground truth decides, never the image.
+  std::vector<std::uint8_t> image_decided_faces() const override {
+    return std::vector<std::uint8_t>(model_ == nullptr ? 0 : model_->mesh.triangles.size(), 0);
+  }
+
   Status segment_into(const View& view, LabelMap& out) const override {
     if (model_ == nullptr) return Status::InvalidArgument("oracle: set_model() first");
     const Mesh& mesh = model_->mesh;

@@ -210,6 +210,11 @@ class PbrSegmenter final : public Segmenter {
     return Status::Ok();
   }
 
+  // Names, textures and authored values decide, never the image alone.
+  std::vector<std::uint8_t> image_decided_faces() const override {
+    return std::vector<std::uint8_t>(model_ == nullptr ? 0 : model_->mesh.triangles.size(), 0);
+  }
+
   Status segment_into(const View& view, LabelMap& out) const override {
     if (table_ == nullptr) return Status::InvalidArgument("pbr: set_model() first");
     const int w = view.face_id.width(), h = view.face_id.height();

@@ -12,6 +12,7 @@ Status Segmenter::configure(const BackendSettings& settings) {
 }
 
 std::vector<std::string> Segmenter::warnings() const { return {}; }
+std::vector<std::uint8_t> Segmenter::image_decided_faces() const { return {}; }
 
 Result<LabelMap> Segmenter::segment(const View& view) const {
   LabelMap out;

@@ -27,6 +27,9 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kQuick = " --views 6 --resolution 160";
+// ...and a coarse closed volume and one hull per part, for the tests about
+// labels: completion and decomposition are most of a run under ASan.
+const std::string kLabelsOnly = kQuick + " --complete-set resolution=48 --decomposer hull";
 
 std::string hammer() { return test::quote(test::source_path("examples/data/hammer.obj")); }
 
@@ -310,7 +313,7 @@ TEST(ToolRun, TheDefaultDecomposesARealGeneratorMesh) {
 TEST(ToolRun, TheRegionsRefinerDecidesPerRegionOnAGeneratorMesh) {
   const std::string dir = test::scratch_dir("ToolRunRegions");
   const std::string glb = test::quote(test::source_path("data/generated/models/trellis_shell_chair.glb"));
-  test::ToolRun r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/out") + kQuick +
+  test::ToolRun r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/out") + kLabelsOnly +
                                    " --refiner regions --json");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   nlohmann::json j = nlohmann::json::parse(r.out);
@@ -324,7 +327,7 @@ TEST(ToolRun, TheRegionsRefinerDecidesPerRegionOnAGeneratorMesh) {
 
   // A card that cannot be read: the run goes on with smooth and says why.
   test::write_file(dir + "/broken-card.json", "{\"format\": \"something else\"}");
-  r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/broken") + kQuick +
+  r = test::run_tool("run " + glb + " --height 0.82 -o " + test::quote(dir + "/broken") + kLabelsOnly +
                      " --refiner regions --refine-set card=" + test::quote(dir + "/broken-card.json") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   j = nlohmann::json::parse(r.out);
@@ -350,7 +353,7 @@ TEST(ToolRun, HybridDecomposesAGeneratedLookingMesh) {
   // The fixture's atlas is one tile per source material, a few UV charts,
   // not a baked atlas's hundreds: atlas_charts=0 counts any texture.
   test::ToolRun r = test::run_tool("run " + test::quote(obj) + " --up z --segmenter hybrid --set atlas_charts=0 -o " +
-                                   test::quote(dir + "/out") + kQuick + " --json");
+                                   test::quote(dir + "/out") + kLabelsOnly + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   std::set<std::string> materials;
@@ -368,8 +371,8 @@ TEST(ToolRun, BaseColorOnlyDropsTheAuthoredPbrAsAGeneratorWould) {
   std::set<std::string> classes[2];
   for (int reduced = 0; reduced < 2; ++reduced) {
     const std::string out = dir + "/out" + std::to_string(reduced);
-    test::ToolRun r = test::run_tool("run " + glb + " -o " + test::quote(out) + kQuick +
-                                     " --anonymize-names --segmenter pbr --format mjcf --decomposer hull --json" +
+    test::ToolRun r = test::run_tool("run " + glb + " -o " + test::quote(out) + kLabelsOnly +
+                                     " --anonymize-names --segmenter pbr --format mjcf --json" +
                                      (reduced ? " --base-color-only" : ""));
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);

@@ -194,10 +194,14 @@ bool is_placeholder_name(std::string_view text, PlaceholderKind kind) {
   if (std::any_of(folded.begin(), folded.end(), [](char c) { return static_cast<unsigned char>(c) >= 0x80; }))
     return false;
   // 3ds Max names an object after its wireframe colour: wire_ and nine digits.
-  if (folded.size() == 14 && tokenize(folded.substr(0, 5)) == std::vector<std::string>{"wire"} && folded[4] == '_' &&
-      std::all_of(folded.begin() + 5, folded.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+  constexpr std::string_view kWire = "wire_";
+  const auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
+  if (folded.size() == kWire.size() + 9 &&
+      std::equal(kWire.begin(), kWire.end(), folded.begin(),
+                 [](char w, char c) { return w == std::tolower(static_cast<unsigned char>(c)); }) &&
+      std::all_of(folded.begin() + kWire.size(), folded.end(), digit))
     return true;
-  for (const std::string& token : tokenize(text)) {
+  for (const std::string& token : tokenize(folded)) {  // folded is ASCII here: folding again changes nothing
     if (token.size() <= 1) continue;
     if (token.compare(0, 3, "tmp") == 0) continue;  // a temporary file's name (Python's tempfile)
     const std::string word = " " + token + " ";

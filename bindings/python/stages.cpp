@@ -183,6 +183,23 @@ class PySegmenter : public Segmenter {
       return {python_class_name(this) + ".warnings() did not return a list of str: " + e.what()};
     }
   }
+  std::vector<std::uint8_t> image_decided_faces() const override {
+    py::gil_scoped_acquire gil;
+    py::function f = py::get_override(static_cast<const Segmenter*>(this), "image_decided_faces");
+    if (!f) return Segmenter::image_decided_faces();
+    // Not said (None), or per face 0/1; anything else is not said either:
+    // the `regions` refiner then treats every face alike.
+    py::object returned = f();
+    if (returned.is_none()) return {};
+    try {
+      const std::vector<int> faces = int_vector_from_numpy(returned, python_class_name(this) + ".image_decided_faces");
+      std::vector<std::uint8_t> out(faces.size());
+      for (std::size_t i = 0; i < faces.size(); ++i) out[i] = faces[i] != 0 ? 1 : 0;
+      return out;
+    } catch (const std::exception&) {
+      return {};
+    }
+  }
 
  private:
   int num_classes_ = 0;  // of the table given to set_model; 0 = not checked
@@ -390,7 +407,15 @@ void bind_stages(py::module_& m) {
           "votes", [](const RefineInputView& v) { return dense_votes(*v.get().votes); },
           "(M, C) float32 vote histograms")
       .def_property_readonly("views", [](const RefineInputView& v) { return copy_views(v.get().views); })
-      .def_property_readonly("table", [](const RefineInputView& v) { return *v.get().table; });
+      .def_property_readonly("table", [](const RefineInputView& v) { return *v.get().table; })
+      .def_property_readonly(
+          "image_decided",
+          [](const RefineInputView& v) -> py::object {
+            const std::vector<std::uint8_t>* d = v.get().image_decided;
+            if (d == nullptr || d->empty()) return py::none();
+            return vector_to_numpy(*d);
+          },
+          "(M,) uint8, 1 where the segmenter labelled the face from the image alone; None when not known");
   py::class_<CompletionInputView>(m, "CompletionInput", "The object and its parts; valid only during complete().")
       .def_property_readonly("mesh", [](const CompletionInputView& v) { return *v.get().mesh; })
       .def_property_readonly("parts", [](const CompletionInputView& v) { return *v.get().parts; })
@@ -491,7 +516,17 @@ void bind_stages(py::module_& m) {
           py::arg("view"), "A LabelMap for the view (call set_model first).")
       .def(
           "warnings", [](const Segmenter& s) { return s.warnings(); },
-          "What degraded since configure and set_model (hybrid without its network says why here).");
+          "What degraded since configure and set_model (hybrid without its network says why here).")
+      .def(
+          "image_decided_faces",
+          [](const Segmenter& s) -> py::object {
+            const std::vector<std::uint8_t> d = s.image_decided_faces();
+            if (d.empty()) return py::none();
+            return vector_to_numpy(d);
+          },
+          "After set_model: (M,) uint8, 1 where the image alone labels the face (a network), 0 where names or "
+          "other evidence do; None when the backend does not say. The regions refiner decides only the image's "
+          "regions.");
 
   py::class_<Refiner, PyRefiner, std::shared_ptr<Refiner>>(
       m, "Refiner",
@@ -596,14 +631,29 @@ void bind_stages(py::module_& m) {
   m.def(
       "refine",
       [](const Refiner& refiner, const Mesh& mesh, const Projection& projection, const std::vector<View>& views,
-         const MaterialTable* table) {
-        RefineInput in{&mesh,  &projection.graph,       &projection.votes, &projection.labels,
-                       &views, &table_or_default(table)};
+         const MaterialTable* table, const py::object& image_decided) {
+        std::vector<std::uint8_t> decided;
+        if (!image_decided.is_none()) {
+          const std::vector<int> faces = int_vector_from_numpy(image_decided, "image_decided");
+          if (static_cast<int>(faces.size()) != mesh.num_faces())
+            throw py::value_error("image_decided: " + std::to_string(faces.size()) + " values for " +
+                                  std::to_string(mesh.num_faces()) + " faces");
+          for (const int f : faces) decided.push_back(f != 0 ? 1 : 0);
+        }
+        RefineInput in{&mesh,
+                       &projection.graph,
+                       &projection.votes,
+                       &projection.labels,
+                       &views,
+                       &table_or_default(table),
+                       image_decided.is_none() ? nullptr : &decided};
         py::gil_scoped_release release;
         return unwrap(refiner.refine(in));
       },
       py::arg("refiner"), py::arg("mesh"), py::arg("projection"), py::arg("views") = std::vector<View>{},
-      py::arg("table") = no_table);
+      py::arg("table") = no_table, py::arg("image_decided") = py::none(),
+      "Runs a refiner on a projection. image_decided: per face, 1 where the segmenter labelled it from the image "
+      "alone (Segmenter.image_decided_faces()); None: not known.");
   m.def(
       "apply_refinement",
       [](const Mesh& mesh, const py::object& labels, Projection& projection, const PartitionOptions& options) {

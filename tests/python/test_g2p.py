@@ -223,6 +223,38 @@ class PythonBackendsTest(unittest.TestCase):
         self.assertEqual(hybrid.warnings(), [])
         self.assertEqual(g2p.make_segmenter("pbr").warnings(), [])
 
+    def test_the_image_decided_faces_reach_the_refiner(self):
+        # hybrid gives a real TRELLIS mesh (one atlas material, no names) to its
+        # network, and the named hammer to pbr.
+        hybrid = g2p.make_segmenter("hybrid")
+        trellis = g2p.load_model(str(ROOT / "data" / "generated" / "models" / "trellis_shell_chair.glb"))
+        hybrid.set_model(trellis)
+        decided = hybrid.image_decided_faces()
+        self.assertEqual(decided.dtype, np.uint8)
+        self.assertEqual(decided.shape, (trellis.mesh.num_faces,))
+        self.assertTrue((decided == 1).all())
+        hybrid.set_model(g2p.load_model(HAMMER))
+        self.assertTrue((hybrid.image_decided_faces() == 0).all())
+        self.assertIsNone(AllPlastic().image_decided_faces(), "a Python segmenter that does not say")
+
+        # A Python segmenter that says the image decided the first half of
+        # the faces: a Python refiner sees it.
+        class HalfByImage(AllPlastic):
+            def image_decided_faces(self):
+                return np.array([1] * 52 + [0] * 52, dtype=np.uint8)
+
+        class Looks(g2p.Refiner):
+            def refine(self, input):
+                self.decided = input.image_decided
+                return input.labels
+
+        pipeline = g2p.Pipeline(quick_options())
+        looks = Looks()
+        pipeline.set_segmenter(HalfByImage())
+        pipeline.set_refiner(looks)
+        pipeline.run_file(HAMMER)
+        np.testing.assert_array_equal(looks.decided, [1] * 52 + [0] * 52)
+
     def test_segmenter_output_is_checked(self):
         pipeline = g2p.Pipeline(quick_options())
         pipeline.set_segmenter(WrongShape())

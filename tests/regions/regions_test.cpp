@@ -361,7 +361,8 @@ TEST(RegionsRefiner, DecidesOnlyTheRegionsTheImageDecided) {
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   EXPECT_FALSE(r->fell_back);
   EXPECT_EQ(r->labels, smooth->labels);
-  EXPECT_NE(r->notes.back().find("no face was labelled from the image alone"), std::string::npos) << r->notes.back();
+  EXPECT_NE(r->notes.back().find("the segmenter labelled no face from the image alone"), std::string::npos)
+      << r->notes.back();
   r = (*make_refiner("regions", {{"card", card}, {"rest", "keep"}}))->refine(in);
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->labels, p.labels.label);
@@ -400,6 +401,9 @@ TEST(RegionsRefiner, DecidesOnlyTheRegionsTheImageDecided) {
   }
   EXPECT_GT(decided, 0);
   EXPECT_GT(kept, 0);
+  std::size_t differ = 0;
+  for (std::size_t f = 0; f < faces; ++f) differ += r->labels[f] != p.labels.label[f];
+  EXPECT_EQ(r->changes.size(), differ) << "every changed face is listed once";
   for (const LabelChange& c : r->changes) {
     EXPECT_EQ(p.labels.label[c.face], c.from);
     EXPECT_EQ(r->labels[c.face], c.to);

@@ -302,6 +302,8 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
     Result<std::unique_ptr<Segmenter>> pbr = make_segmenter("pbr");
     ASSERT_TRUE(learned.ok() && pbr.ok());
     ASSERT_TRUE((*learned)->set_model(model, table).ok() && (*pbr)->set_model(model, table).ok());
+    EXPECT_EQ((*learned)->image_decided_faces(), std::vector<std::uint8_t>(model.mesh.triangles.size(), 0))
+        << "every face follows pbr: none is the image's";
     Result<LabelMap> a = (*learned)->segment(no_rgb), b = (*pbr)->segment(no_rgb);
     ASSERT_TRUE(a.ok()) << a.status().to_string();
     ASSERT_TRUE(b.ok()) << b.status().to_string();
@@ -325,6 +327,11 @@ TEST(LearnedSegmenter, NamesWhereTheyNameAMaterialTheNetworkElsewhere) {
     const std::vector<View> crate_views = test::render(crate, 2, 96);
     Result<std::unique_ptr<Segmenter>> s = make_segmenter("learned", {{"model_card", card}});
     ASSERT_TRUE(s.ok() && (*s)->set_model(crate, table).ok());
+    // What the `regions` refiner reads: the two boxes the network labels.
+    const std::vector<std::uint8_t> image = (*s)->image_decided_faces();
+    ASSERT_EQ(image.size(), crate.mesh.triangles.size());
+    for (std::size_t f = 0; f < image.size(); ++f)
+      EXPECT_EQ(image[f], crate.mesh.face_source[f].material == 2 ? 0 : 1) << f;
     std::vector<LabelMap> maps(crate_views.size());
     for (std::size_t i = 0; i < crate_views.size(); ++i) ASSERT_TRUE((*s)->segment_into(crate_views[i], maps[i]).ok());
     EXPECT_EQ((std::vector<int>{test::majority_label(crate, crate_views, maps, 0),

@@ -42,12 +42,29 @@ TEST(TrainRegions, TrainsOnTheRowsEvalSegWrites) {
   EXPECT_EQ(lines[0].rfind("model,region,faces,area_share,truth,truth_share,labelled_share,", 0), 0u) << lines[0];
   for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(lines[i].front(), '"') << "keys are quoted: " << lines[i];
 
-  // The same rows with Windows line ends, and one model renamed to a key
-  // holding a comma and quotes (written as "odd, ""name""").
+  // The same rows with Windows line ends, and two models renamed to keys that
+  // differ only by a quote: a"b (written "a""b") and ab. A reader that drops
+  // the doubled quote would count them as one model.
   std::string windows;
+  std::string renamed[2];
+  for (std::size_t i = 1; i < lines.size() && renamed[1].empty(); ++i) {
+    // A model with a row that trains: a true class, 60 % of the region, half of it labelled.
+    std::vector<std::string> cells;
+    std::istringstream row(lines[i]);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    if (cells.size() < 7 || cells[4].empty() || std::stod(cells[5]) < 0.6 || std::stod(cells[6]) < 0.5) continue;
+    const std::string& key = cells[0];
+    if (renamed[0].empty())
+      renamed[0] = key;
+    else if (key != renamed[0])
+      renamed[1] = key;
+  }
+  ASSERT_FALSE(renamed[1].empty()) << "two models with regions";
   for (std::size_t i = 0; i < lines.size(); ++i) {
     std::string line = lines[i];
-    if (i > 0 && line.rfind("\"SheenChair\",", 0) == 0) line = "\"odd, \"\"name\"\"\"" + line.substr(12);
+    const std::string key = line.substr(0, line.find(','));
+    if (i > 0 && key == renamed[0]) line = "\"odd, a\"\"b\"" + line.substr(key.size());
+    if (i > 0 && key == renamed[1]) line = "\"odd, ab\"" + line.substr(key.size());
     windows += line + "\r\n";
   }
   test::write_file(dir + "/windows.csv", windows);
@@ -65,7 +82,7 @@ TEST(TrainRegions, TrainsOnTheRowsEvalSegWrites) {
   const nlohmann::json odd = nlohmann::json::parse(test::read_file(dir + "/windows/g2p-regions.json"));
   EXPECT_GT(plain["training"]["regions"].get<int>(), 5);
   EXPECT_EQ(odd["training"]["regions"], plain["training"]["regions"]);
-  EXPECT_EQ(odd["training"]["models"], plain["training"]["models"]);
+  EXPECT_EQ(odd["training"]["models"], plain["training"]["models"]) << "the two renamed keys are two models";
 
   // A row cut short: refused, naming the file and the line.
   std::string cut = lines[0] + "\n" + lines[1] + "\n" + lines[2].substr(0, lines[2].rfind(',')) + "\n";

@@ -50,9 +50,10 @@ class G2P_API Segmenter {
   // The pipeline adds them to PipelineResult::warnings. Default: none.
   virtual std::vector<std::string> warnings() const;
   // Per face of the last set_model's mesh: 1 where the labels come from the
-  // image alone (a network reading pixels), 0 where names or authored values
-  // decided them. Empty when the backend does not say (the default). The
-  // `regions` refiner decides only the regions the image decided (refine.h).
+  // image (a network reading pixels, with at most a prior from authored PBR),
+  // 0 where other evidence decided them (names, authored or default values).
+  // Empty when the backend does not say (the default). The `regions` refiner
+  // decides only the regions the image decided (refine.h).
   virtual std::vector<std::uint8_t> image_decided_faces() const;
 
   // Convenience: a new LabelMap.

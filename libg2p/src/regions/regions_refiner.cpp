@@ -89,13 +89,13 @@ class RegionsRefiner final : public Refiner {
 
     // Which faces the classifier may decide.
     const bool known = in.image_decided != nullptr && in.image_decided->size() == faces;
+    const bool everywhere = !image_only_ || !known;  // every region is the classifier's
     std::vector<std::uint8_t> eligible(faces, 1);
-    if (image_only_ && known) eligible = *in.image_decided;
+    if (!everywhere) eligible = *in.image_decided;
     if (image_only_ && in.image_decided != nullptr && !in.image_decided->empty() && !known)
       rest.notes.push_back("regions: the segmenter's image-decided faces do not match the mesh; every face counts");
     if (std::none_of(eligible.begin(), eligible.end(), [](std::uint8_t e) { return e != 0; })) {
-      rest.notes.push_back(std::string("regions: no face was labelled from the image alone (names or authored "
-                                       "values decided every one); ") +
+      rest.notes.push_back(std::string("regions: the segmenter labelled no face from the image alone; ") +
                            (smooth_rest_ ? "the smooth refiner's labels stand" : "the voted labels stand"));
       return rest;
     }
@@ -137,15 +137,20 @@ class RegionsRefiner final : public Refiner {
     int decided = 0, unsure = 0, outside = 0;
     for (int r = 0; r < rows; ++r) {
       const Region& region = regions->regions[static_cast<std::size_t>(r)];
-      double image_area = 0, area = 0;
-      for (const int f : region.faces) {
-        const double a = face_area(*in.mesh, f);
-        area += a;
-        if (eligible[static_cast<std::size_t>(f)] != 0) image_area += a;
-      }
-      if (!(image_area > 0.5 * area)) {
-        ++outside;
-        continue;
+      if (!everywhere) {  // most of the region's area (of its faces, if it has none) is the image's
+        double image_area = 0, area = 0;
+        std::size_t image_faces = 0;
+        for (const int f : region.faces) {
+          const double a = face_area(*in.mesh, f);
+          area += a;
+          if (eligible[static_cast<std::size_t>(f)] == 0) continue;
+          image_area += a;
+          ++image_faces;
+        }
+        if (area > 0 ? !(image_area > 0.5 * area) : 2 * image_faces <= region.faces.size()) {
+          ++outside;
+          continue;
+        }
       }
       const float* p = probabilities->data() + static_cast<std::size_t>(r) * k;
       int best = 0;
@@ -183,7 +188,7 @@ class RegionsRefiner final : public Refiner {
     result.notes = std::move(rest.notes);
     result.notes.push_back("regions: " + std::to_string(rows) + " regions, " + std::to_string(decided) +
                            " decided by the classifier (" + card + "), " + std::to_string(unsure) + " too unsure and " +
-                           std::to_string(outside) + " labelled by names or authored values kept " +
+                           std::to_string(outside) + " not labelled from the image kept " +
                            (smooth_rest_ ? "the smooth refiner's labels" : "their voted labels") + "; " +
                            std::to_string(result.changes.size()) + " faces changed");
     return result;
@@ -209,6 +214,7 @@ class RegionsRefiner final : public Refiner {
     if (!smooth_rest_) {
       Result<RefineResult> smoothed = make_smooth_refiner()->refine(in);
       if (!smoothed.ok()) return smoothed;
+      smoothed->notes.insert(smoothed->notes.begin(), rest.notes.begin(), rest.notes.end());
       rest = std::move(*smoothed);
     }
     rest.notes.push_back("regions: " + why + "; the smooth refiner ran instead");  // last: the pipeline reports it

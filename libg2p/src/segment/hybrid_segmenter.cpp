@@ -209,7 +209,9 @@ class HybridSegmenter final : public Segmenter {
 
   std::vector<std::string> warnings() const override { return warnings_; }
 
-  // The network's faces (alone or with `pbr` as a prior), when it runs.
+  // The network's faces, when it runs: alone, or with `pbr`'s probabilities
+  // as a prior (authored PBR on a material that covers several parts, where
+  // the issue asks the image to decide and the values to be at most a prior).
   std::vector<std::uint8_t> image_decided_faces() const override {
     if (model_ == nullptr) return {};
     std::vector<std::uint8_t> image(by_network_.size(), 0);

@@ -249,6 +249,7 @@ void bind_core(py::module_& m) {
       .def_readwrite("structure", &MaterialClass::structure)
       .def_readwrite("wall_thickness_m", &MaterialClass::wall_thickness_m)
       .def_readwrite("max_solid_thickness_m", &MaterialClass::max_solid_thickness_m)
+      .def_readwrite("max_wall_thickness_m", &MaterialClass::max_wall_thickness_m)
       .def_readwrite("source", &MaterialClass::source)
       .def("__repr__", [](const MaterialClass& c) { return "<g2p.MaterialClass '" + c.name + "'>"; });
   py::class_<MaterialTable>(m, "MaterialTable", "The material vocabulary (default: the paper's 12 classes).")

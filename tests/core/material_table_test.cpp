@@ -77,6 +77,7 @@ TEST(MaterialTable, JsonRoundTripKeepsEveryField) {
     EXPECT_EQ(a.structure, b.structure);
     EXPECT_DOUBLE_EQ(a.wall_thickness_m, b.wall_thickness_m);
     EXPECT_DOUBLE_EQ(a.max_solid_thickness_m, b.max_solid_thickness_m);
+    EXPECT_DOUBLE_EQ(a.max_wall_thickness_m, b.max_wall_thickness_m);
     EXPECT_EQ(a.source, b.source);
   }
 }
@@ -93,6 +94,23 @@ TEST(MaterialTable, TheThickestSolidPieceIsReadAndWrittenAndChecked) {
   EXPECT_DOUBLE_EQ((*back)[0].max_solid_thickness_m, 0.1);
   std::vector<MaterialClass> classes = t->classes();
   classes[0].max_solid_thickness_m = std::nan("");
+  EXPECT_FALSE(MaterialTable::from_classes(classes).ok());
+}
+
+TEST(MaterialTable, TheThickestWallIsReadAndWrittenAndChecked) {
+  Result<MaterialTable> t = MaterialTable::from_json(
+      R"({"classes": [{"name": "Steel", "density_kg_m3": 7800, "wall_thickness_m": 0.001, "max_wall_thickness_m": 0.006},
+                      {"name": "Foam", "density_kg_m3": 30}]})");
+  ASSERT_TRUE(t.ok()) << t.status().to_string();
+  EXPECT_DOUBLE_EQ((*t)[0].max_wall_thickness_m, 0.006);
+  EXPECT_DOUBLE_EQ((*t)[1].max_wall_thickness_m, 0.0);  // no limit unless given
+  Result<MaterialTable> back = MaterialTable::from_json(t->to_json());
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  EXPECT_DOUBLE_EQ((*back)[0].max_wall_thickness_m, 0.006);
+  std::vector<MaterialClass> classes = t->classes();
+  classes[0].max_wall_thickness_m = std::nan("");
+  EXPECT_FALSE(MaterialTable::from_classes(classes).ok());
+  classes[0].max_wall_thickness_m = -0.001;
   EXPECT_FALSE(MaterialTable::from_classes(classes).ok());
 }
 
@@ -158,7 +176,11 @@ INSTANTIATE_TEST_SUITE_P(
                     BadTable{R"({"clases": []})", StatusCode::kParseError, "unknown key 'clases'"},
                     BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "wall_thickness_m": 0.02,
                                   "max_solid_thickness_m": 0.03}]})",
-                             StatusCode::kInvalidArgument, "class 'A': max_solid_thickness_m must be 0 (no limit) or"}),
+                             StatusCode::kInvalidArgument, "class 'A': max_solid_thickness_m must be 0 (no limit) or"},
+                    BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "wall_thickness_m": 0.02,
+                                  "max_wall_thickness_m": 0.01}]})",
+                             StatusCode::kInvalidArgument,
+                             "class 'A': max_wall_thickness_m must be 0 (no limit) or at least wall_thickness_m"}),
     [](const testing::TestParamInfo<BadTable>& info) { return "case" + std::to_string(info.index); });
 
 TEST(MaterialTable, LoadAndSaveFiles) {

@@ -125,10 +125,11 @@ TEST(TableEstimator, ThinPartsOfHollowClassesAreSolid) {
 
 // The default table with no class's solid thickness limited, or only Wood's
 // (0.10 m) and Metal's (0.06 m), the default table's values
-// (docs/materials.md), so that these tests do not move with the others.
+// (docs/materials.md), so that these tests do not move with the others; no
+// class's wall is limited.
 MaterialTable table_with_limits(double wood_m, double metal_m) {
   std::vector<MaterialClass> classes = table().classes();
-  for (MaterialClass& c : classes) c.max_solid_thickness_m = 0;
+  for (MaterialClass& c : classes) c.max_solid_thickness_m = c.max_wall_thickness_m = 0;
   classes[static_cast<std::size_t>(kWood)].max_solid_thickness_m = wood_m;
   classes[static_cast<std::size_t>(kMetal)].max_solid_thickness_m = metal_m;
   return *MaterialTable::from_classes(classes, "limits");
@@ -153,6 +154,16 @@ PropertiesReport report_without_solid_limits(const Stage& s) {
   return report_with_table(s, table_without_solid_limits());
 }
 
+// A part weighed as a single-walled shell of `wall_m`, as the geometry
+// decided, whose last note says `why`.
+void expect_geometry_shell(const PartProperties& p, double wall_m, const std::string& why) {
+  EXPECT_EQ(p.structure, Structure::kHollow);
+  EXPECT_FALSE(p.double_walled);
+  EXPECT_EQ(p.structure_source, ValueSource::kGeometry);
+  EXPECT_DOUBLE_EQ(p.wall_thickness_m, wall_m);
+  EXPECT_NE(p.notes.back().find(why), std::string::npos) << p.notes.back();
+}
+
 // The thickest solid piece of a class (max_solid_thickness_m): a wardrobe
 // modelled as a closed box is panels around air; the same box with no limit
 // stays solid wood; a wooden plank stays solid.
@@ -161,12 +172,7 @@ TEST(TableEstimator, PartsThickerThanTheirClassesThickestSolidPieceAreShells) {
   const Stage s = complete_object(wardrobe, test::single_part(wardrobe, kWood));
   PropertiesReport r = report_with_solid_limits(s);
   ASSERT_EQ(r.parts.size(), 1u);
-  const PartProperties& p = r.parts[0].properties;
-  EXPECT_EQ(p.structure, Structure::kHollow);
-  EXPECT_FALSE(p.double_walled);
-  EXPECT_EQ(p.structure_source, ValueSource::kGeometry);
-  EXPECT_DOUBLE_EQ(p.wall_thickness_m, 0.02);
-  EXPECT_NE(p.notes.back().find("more than the thickest solid Wood"), std::string::npos) << p.notes.back();
+  expect_geometry_shell(r.parts[0].properties, 0.02, "more than the thickest solid Wood");
   const double area = surface_area(wardrobe);
   EXPECT_NEAR(r.object.mass_kg / (700 * area * 0.02), 1.0, 1e-6);
 
@@ -231,6 +237,48 @@ TEST(TableEstimator, AnInnerSurfaceFartherThanAWallCanBeIsNotTheWall) {
   EXPECT_LT(r.object.mass_kg, 20.0);
   const PropertiesReport unlimited = report_without_solid_limits(s);
   EXPECT_GT(unlimited.object.mass_kg, 300.0);
+}
+
+// A modelled wall thicker than the class's thickest single wall
+// (max_wall_thickness_m) is a closed section: a steel box with a box 25 mm
+// inside it (both faces of its 25 mm panels modelled) is sheet around air,
+// every face a wall of the class's 0.5 mm; 25 mm of plate would weigh 265 kg.
+// A 4 mm modelled wall is under the limit and stays as measured.
+TEST(TableEstimator, ModelledWallsThickerThanTheClassesThickestWallAreClosedSections) {
+  auto steel_box = [](float wall_m) {
+    Mesh box = test::box_mesh({-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f});
+    const float in = 0.25f - wall_m;
+    Mesh inner = test::box_mesh({-in, -in, -in}, {in, in, in});
+    for (auto& t : inner.triangles) std::swap(t[1], t[2]);
+    test::append_mesh(box, inner);
+    return box;
+  };
+  std::vector<MaterialClass> classes = table_with_solid_limits().classes();
+  classes[static_cast<std::size_t>(kMetal)].max_wall_thickness_m = 0.006;
+  const MaterialTable wall_limit = *MaterialTable::from_classes(classes, "wall limit");
+
+  const Mesh thick = steel_box(0.025f);
+  const Stage s = complete_object(thick, test::single_part(thick, kMetal));
+  const PropertiesReport plate = report_with_solid_limits(s);
+  ASSERT_EQ(plate.parts.size(), 1u);
+  EXPECT_NEAR(plate.parts[0].properties.walls.inner_wall_m, 0.025, 0.003);
+  EXPECT_TRUE(plate.parts[0].properties.double_walled);
+  const double steel_m3 = 0.5 * 0.5 * 0.5 - 0.45 * 0.45 * 0.45;
+  EXPECT_NEAR(plate.object.mass_kg / (7800 * steel_m3), 1.0, 0.1);
+
+  const PropertiesReport section = report_with_table(s, wall_limit);
+  ASSERT_EQ(section.parts.size(), 1u);
+  expect_geometry_shell(section.parts[0].properties, 0.0005,
+                        "more than the thickest Metal wall (6 mm): a closed section");
+  EXPECT_NEAR(section.object.mass_kg / (7800 * surface_area(thick) * 0.0005), 1.0, 1e-6);
+
+  const Mesh thin = steel_box(0.004f);
+  const Stage t = complete_object(thin, test::single_part(thin, kMetal));
+  const PropertiesReport sheet = report_with_table(t, wall_limit);
+  ASSERT_EQ(sheet.parts.size(), 1u);
+  EXPECT_TRUE(sheet.parts[0].properties.double_walled) << ::testing::PrintToString(sheet.parts[0].properties.notes);
+  EXPECT_NEAR(sheet.parts[0].properties.wall_thickness_m, 0.004, 0.001);
+  EXPECT_NEAR(sheet.object.mass_kg, report_with_solid_limits(t).object.mass_kg, 1e-9);
 }
 
 // A scripted vision-language model.

@@ -49,6 +49,7 @@ struct MaterialClass {
   Structure structure = Structure::kSolid;  // default internal structure
   double wall_thickness_m = 0.002;          // used when the part is hollow
   double max_solid_thickness_m = 0.0;       // thickest plausible solid piece; 0 = no limit (docs/properties.md)
+  double max_wall_thickness_m = 0.0;        // thickest plausible single wall; 0 = no limit (docs/properties.md)
   std::string source;                       // where the values come from
 };
 

@@ -39,8 +39,9 @@ std::string fmt(double x) {
 Status check_class(const MaterialClass& c) {
   auto bad = [&](const std::string& what) { return Status::InvalidArgument("class '" + c.name + "': " + what); };
   if (c.name.empty()) return Status::InvalidArgument("a class has an empty name");
-  const double values[] = {c.density_kg_m3,    c.density_min_kg_m3, c.density_max_kg_m3, c.friction_static,
-                           c.friction_dynamic, c.restitution,       c.wall_thickness_m,  c.max_solid_thickness_m};
+  const double values[] = {c.density_kg_m3,    c.density_min_kg_m3,     c.density_max_kg_m3,
+                           c.friction_static,  c.friction_dynamic,      c.restitution,
+                           c.wall_thickness_m, c.max_solid_thickness_m, c.max_wall_thickness_m};
   for (double v : values)
     if (!std::isfinite(v)) return bad("a value is not a finite number");
   if (c.density_kg_m3 <= 0.0) return bad("density_kg_m3 must be > 0, got " + fmt(c.density_kg_m3));
@@ -55,6 +56,9 @@ Status check_class(const MaterialClass& c) {
       (c.max_solid_thickness_m > 0.0 && c.max_solid_thickness_m < 2 * c.wall_thickness_m))
     return bad("max_solid_thickness_m must be 0 (no limit) or at least two walls (" + fmt(2 * c.wall_thickness_m) +
                "), got " + fmt(c.max_solid_thickness_m));
+  if (c.max_wall_thickness_m < 0.0 || (c.max_wall_thickness_m > 0.0 && c.max_wall_thickness_m < c.wall_thickness_m))
+    return bad("max_wall_thickness_m must be 0 (no limit) or at least wall_thickness_m (" + fmt(c.wall_thickness_m) +
+               "), got " + fmt(c.max_wall_thickness_m));
   return Status::Ok();
 }
 
@@ -63,7 +67,8 @@ Status check_class(const MaterialClass& c) {
 // leave a default in place, so it is an error.
 constexpr const char* kClassKeys[] = {
     "name",        "color",     "density_kg_m3",    "density_range_kg_m3",   "friction",
-    "restitution", "structure", "wall_thickness_m", "max_solid_thickness_m", "source"};
+    "restitution", "structure", "wall_thickness_m", "max_solid_thickness_m", "max_wall_thickness_m",
+    "source"};
 
 Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   if (!j.is_object()) return Status::ParseError(where + ": expected an object");
@@ -121,6 +126,7 @@ Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   G2P_RETURN_IF_ERROR(number(j, "restitution", c.restitution, false));
   G2P_RETURN_IF_ERROR(number(j, "wall_thickness_m", c.wall_thickness_m, false));
   G2P_RETURN_IF_ERROR(number(j, "max_solid_thickness_m", c.max_solid_thickness_m, false));
+  G2P_RETURN_IF_ERROR(number(j, "max_wall_thickness_m", c.max_wall_thickness_m, false));
   if (auto s = j.find("structure"); s != j.end()) {
     const std::string v = s->is_string() ? s->get<std::string>() : "";
     if (iequals(v, "solid"))
@@ -221,6 +227,7 @@ std::string MaterialTable::to_json() const {
                        {"structure", g2p::to_string(c.structure)},
                        {"wall_thickness_m", c.wall_thickness_m},
                        {"max_solid_thickness_m", c.max_solid_thickness_m},
+                       {"max_wall_thickness_m", c.max_wall_thickness_m},
                        {"source", c.source}});
   }
   json doc = {{"format", kFormat}, {"version", kFormatVersion}, {"name", name_}, {"classes", classes}};

@@ -171,8 +171,8 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
               uv.insert(uv.end(),
                         {mesh.uvs[static_cast<std::size_t>(v)].x(), mesh.uvs[static_cast<std::size_t>(v)].y()});
             if (mesh.has_colors()) {
-              const Eigen::Vector4f& c = mesh.colors[static_cast<std::size_t>(v)];
-              rgba.insert(rgba.end(), {c[0], c[1], c[2], c[3]});
+              const Eigen::Vector4f& colour = mesh.colors[static_cast<std::size_t>(v)];
+              rgba.insert(rgba.end(), {colour[0], colour[1], colour[2], colour[3]});
             }
           }
           idx.push_back(it->second);

@@ -14,6 +14,10 @@
 //    Rule 1 only counts an inner surface no farther in than the class's
 //    thickest solid piece (max_solid_thickness_m, 0 = no limit): a steel
 //    "wall" 10 cm thick is the gap to another part of the object, not a wall.
+//    A modelled wall thicker than the class's thickest single wall
+//    (max_wall_thickness_m, 0 = no limit) is a closed section: every face of
+//    the part is a wall of the class's thickness (source: geometry). Sheet
+//    metal ends at about 6 mm; a 30 mm "steel panel" is a box of sheet.
 // 3. A part of a class solid by default that is thicker (median local
 //    thickness) than the class's thickest solid piece is a single-walled shell
 //    of the class's wall thickness (source: geometry): a wardrobe modelled as
@@ -134,7 +138,18 @@ Result<PartProperties> table_properties(const PropertyInput& in, const TableRule
   if (wall_too_thick)
     p.notes.push_back("an inner surface " + mm(p.walls.inner_wall_m) + " in is farther than the thickest solid " +
                       c.name + " (" + mm(max_solid) + "): another part, not this part's wall");
-  if (measured_inside && !wall_too_thick) {
+  // A modelled wall thicker than the class's thickest single wall is a closed
+  // section (a steel panel 30 mm thick is a box of sheet, not a 30 mm plate).
+  const double max_wall = c.max_wall_thickness_m;  // 0 = no limit
+  const bool closed_section = measured_inside && !wall_too_thick && max_wall > 0 && p.walls.inner_wall_m > max_wall;
+  if (closed_section) {
+    p.structure = Structure::kHollow;
+    p.double_walled = false;
+    p.structure_source = ValueSource::kGeometry;
+    p.notes.push_back("hollow: the modelled walls are " + mm(p.walls.inner_wall_m) + " thick, more than the thickest " +
+                      c.name + " wall (" + mm(max_wall) + "): a closed section, each face a " + mm(p.wall_thickness_m) +
+                      " wall (the class's)");
+  } else if (measured_inside && !wall_too_thick) {
     p.structure = Structure::kHollow;
     p.wall_thickness_m = p.walls.inner_wall_m;
     p.double_walled = true;

@@ -42,6 +42,7 @@
 #include <sstream>
 
 #include "augment.h"
+#include "core/csv.h"
 #include "g2p/g2p.h"
 
 namespace fs = std::filesystem;
@@ -149,11 +150,6 @@ int run(const Args& a) {
   if (a.normals) fs::create_directories(a.out + "/normals");
   std::ofstream materials_csv(a.out + "/materials.csv");
   materials_csv << "library,model,split,material,name,texture,r,g,b,area_share,rule,class\n";
-  const auto csv_field = [](std::string v) {
-    for (char& c : v)
-      if (c == ',' || c == '"' || c == '\n') c = ' ';
-    return v;
-  };
   std::ofstream manifest(a.out + "/manifest.csv");
   manifest << "image,library,model,split,view,labelled_pixels";
   for (const g2p::MaterialClass& c : table.classes()) manifest << "," << c.name;
@@ -208,10 +204,11 @@ int run(const Args& a) {
           char colour[64];
           std::snprintf(colour, sizeof colour, "%.3f,%.3f,%.3f", sm.base_color.x(), sm.base_color.y(),
                         sm.base_color.z());
-          materials_csv << library << "," << csv_field(key) << "," << split << "," << m << "," << csv_field(sm.name)
-                        << "," << csv_field(fs::path(sm.base_color_texture.uri).filename().string()) << "," << colour
-                        << "," << (total > 0 ? material_area[m] / total : 0.0) << "," << material_rule[m] << ","
-                        << (table.valid_label(material_label[m]) ? table[material_label[m]].name : "") << "\n";
+          materials_csv << library << "," << g2p::detail::csv_field(key) << "," << split << "," << m << ","
+                        << g2p::detail::csv_field(sm.name) << ","
+                        << g2p::detail::csv_field(fs::path(sm.base_color_texture.uri).filename().string()) << ","
+                        << colour << "," << (total > 0 ? material_area[m] / total : 0.0) << "," << material_rule[m]
+                        << "," << (table.valid_label(material_label[m]) ? table[material_label[m]].name : "") << "\n";
         }
       }
       std::vector<int> face_label(static_cast<std::size_t>(mesh.num_faces()), g2p::kUnknownLabel);

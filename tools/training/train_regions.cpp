@@ -22,6 +22,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/csv.h"
 #include "g2p/materials.h"
 #include "g2p/regions.h"
 
@@ -34,31 +35,6 @@ struct Rows {
   std::set<std::string> models;
 };
 
-// One CSV record (RFC 4180 quoting: "a ""b""" is a "b"); a CR before the line
-// end (a file saved on Windows) is dropped.
-std::vector<std::string> split_csv(std::string line) {
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  std::vector<std::string> out;
-  std::string cell;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
-      cell += '"';
-      ++i;
-    } else if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      out.push_back(cell);
-      cell.clear();
-    } else {
-      cell += c;
-    }
-  }
-  out.push_back(cell);
-  return out;
-}
-
 // Reads the rows of `path` that train; false with a message on bad input.
 bool read_rows(const std::string& path, const g2p::MaterialTable& table, double min_purity, double min_labelled,
                Rows& rows, std::string& error) {
@@ -66,7 +42,7 @@ bool read_rows(const std::string& path, const g2p::MaterialTable& table, double 
   if (!in) return error = path + ": cannot be read", false;
   std::string line;
   if (!std::getline(in, line)) return error = path + ": empty", false;
-  const std::vector<std::string> header = split_csv(line);
+  const std::vector<std::string> header = g2p::detail::csv_fields(line);
   const std::vector<std::string> names = g2p::region_feature_names(table);
   const std::size_t first = 7;  // model,region,faces,area_share,truth,truth_share,labelled_share
   if (header.size() != first + names.size() || !std::equal(names.begin(), names.end(), header.begin() + first))
@@ -74,7 +50,7 @@ bool read_rows(const std::string& path, const g2p::MaterialTable& table, double 
   int number = 1;
   while (std::getline(in, line)) {
     ++number;
-    const std::vector<std::string> cells = split_csv(line);
+    const std::vector<std::string> cells = g2p::detail::csv_fields(line);
     if (cells.size() != header.size())
       return error = path + ":" + std::to_string(number) + ": " + std::to_string(cells.size()) + " cells, expected " +
                      std::to_string(header.size()),

@@ -101,6 +101,34 @@ TEST(ImportErrors, BadNormalsAreRepairedAndReported) {
   EXPECT_NE(model->info.warnings[0].find("normals recomputed"), std::string::npos);
 }
 
+// An OBJ whose .mtl is not beside it still loads, with its material names,
+// and says which library is missing; with the library there, no warning.
+TEST(ImportErrors, AnObjWhoseMaterialLibraryIsMissingSaysSo) {
+  const std::string dir = test::scratch_dir("ImportErrors.ObjWithoutMtl");
+  const std::string tetra =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl steel\nf 1 3 2\nf 1 2 4\nusemtl oak\nf 1 4 3\nf 2 3 4\n";
+  test::write_file(dir + "/a.obj", "# two libraries, one missing\nmtllib a.mtl gone.mtl\n" + tetra);
+  test::write_file(dir + "/a.mtl", "newmtl steel\nKd 0.2 0.3 0.9\nnewmtl oak\nKd 0.6 0.4 0.2\n");
+  Result<Model> model = load_model(dir + "/a.obj");
+  ASSERT_TRUE(model.ok()) << model.status().to_string();
+  const auto about_libraries = [](const std::vector<std::string>& warnings) {
+    std::vector<std::string> out;
+    for (const std::string& w : warnings)
+      if (w.find("mtllib") != std::string::npos) out.push_back(w);
+    return out;
+  };
+  const std::vector<std::string> missing = about_libraries(model->info.warnings);
+  ASSERT_EQ(missing.size(), 1u) << ::testing::PrintToString(model->info.warnings);
+  EXPECT_NE(missing[0].find("a.obj line 2: material library 'gone.mtl' (mtllib) not found"), std::string::npos)
+      << missing[0];
+  ASSERT_EQ(model->materials.size(), 2u);
+
+  test::write_file(dir + "/b.obj", "mtllib a.mtl\n" + tetra);
+  Result<Model> complete = load_model(dir + "/b.obj");
+  ASSERT_TRUE(complete.ok()) << complete.status().to_string();
+  EXPECT_TRUE(about_libraries(complete->info.warnings).empty()) << ::testing::PrintToString(complete->info.warnings);
+}
+
 TEST(ImportErrors, MissingEmptyAndUnknownFiles) {
   const std::string dir = test::scratch_dir("ImportErrors.Files");
   Result<Model> missing = load_model(dir + "/nothing.glb");

@@ -45,6 +45,39 @@ std::string extension_of(const std::string& path) {
   return ext.empty() ? ext : ext.substr(1);
 }
 
+// An OBJ's material libraries (mtllib lines) that are not beside it: assimp
+// then reads the usemtl names with its default colour, so the user's colours
+// and textures are lost without a word. One warning per missing library.
+void warn_missing_material_libraries(const std::string& path, const std::string& dir,
+                                     std::vector<std::string>& warnings) {
+  std::ifstream in(path);
+  std::string line;
+  std::set<std::string> seen;
+  for (long number = 1; std::getline(in, line); ++number) {
+    std::size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line.compare(start, 6, "mtllib") != 0) continue;
+    start = line.find_first_not_of(" \t", start + 6);
+    if (start == std::string::npos) continue;
+    std::string names = line.substr(start);
+    while (!names.empty() && std::isspace(static_cast<unsigned char>(names.back()))) names.pop_back();
+    // One name with spaces, or several names separated by them.
+    std::vector<std::string> libraries{names};
+    std::error_code ec;
+    if (!fs::exists(fs::path(dir) / names, ec)) {
+      libraries.clear();
+      std::istringstream words(names);
+      for (std::string w; words >> w;) libraries.push_back(w);
+    }
+    for (const std::string& library : libraries) {
+      if (fs::exists(fs::path(dir) / library, ec) || !seen.insert(library).second) continue;
+      warnings.push_back(fs::path(path).filename().string() + " line " + std::to_string(number) +
+                         ": material library '" + library +
+                         "' (mtllib) not found beside the file; its materials keep their names but "
+                         "not their colours or textures");
+    }
+  }
+}
+
 std::string vec_str(const aiVector3D& v) {
   std::ostringstream s;
   s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
@@ -582,6 +615,7 @@ Result<Model> load_model(const std::string& path, const ImportOptions& options) 
     const std::string gltf_bytes = is_gltf(ext) ? read_gltf_json_bytes(path) : std::string();
     std::string dir = fs::path(path).parent_path().string();
     if (dir.empty()) dir = ".";
+    if (ext == "obj") warn_missing_material_libraries(path, dir, info.warnings);
     return convert_scene(*scene, ext, dir, gltf_bytes, options, std::move(info));
   });
 }

@@ -51,6 +51,11 @@ TEST(MaterialTable, DefaultValuesArePhysicallyOrdered) {
   EXPECT_DOUBLE_EQ(t[static_cast<int>(PaperClass::kMetal)].max_solid_thickness_m, 0.06);
   for (const MaterialClass& c : t.classes())
     if (c.max_solid_thickness_m > 0) EXPECT_GE(c.max_solid_thickness_m, 2 * c.wall_thickness_m) << c.name;
+  // The thickest wall (accuracy.md, the third structure candidate): only Metal's, where sheet
+  // ends and plate begins.
+  for (const MaterialClass& c : t.classes())
+    if (c.name != "Metal") EXPECT_EQ(c.max_wall_thickness_m, 0.0) << c.name;
+  EXPECT_DOUBLE_EQ(t[static_cast<int>(PaperClass::kMetal)].max_wall_thickness_m, 0.006);
   for (const MaterialClass& c : t.classes()) {
     EXPECT_LE(c.density_min_kg_m3, c.density_kg_m3) << c.name;
     EXPECT_GE(c.density_max_kg_m3, c.density_kg_m3) << c.name;

@@ -112,6 +112,8 @@ TEST(MaterialTable, TheThickestWallIsReadAndWrittenAndChecked) {
   Result<MaterialTable> back = MaterialTable::from_json(t->to_json());
   ASSERT_TRUE(back.ok()) << back.status().to_string();
   EXPECT_DOUBLE_EQ((*back)[0].max_wall_thickness_m, 0.006);
+  EXPECT_EQ(t->to_json().find("max_solid_thickness_m"), std::string::npos);  // limits only when set
+  EXPECT_EQ(t->to_json().find("max_wall_thickness_m"), t->to_json().rfind("max_wall_thickness_m"));
   std::vector<MaterialClass> classes = t->classes();
   classes[0].max_wall_thickness_m = std::nan("");
   EXPECT_FALSE(MaterialTable::from_classes(classes).ok());
@@ -185,7 +187,11 @@ INSTANTIATE_TEST_SUITE_P(
                     BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "wall_thickness_m": 0.02,
                                   "max_wall_thickness_m": 0.01}]})",
                              StatusCode::kInvalidArgument,
-                             "class 'A': max_wall_thickness_m must be 0 (no limit) or at least wall_thickness_m"}),
+                             "class 'A': max_wall_thickness_m must be 0 (no limit) or at least wall_thickness_m"},
+                    BadTable{R"({"classes": [{"name": "A", "density_kg_m3": 5, "wall_thickness_m": 0.001,
+                                  "max_solid_thickness_m": 0.01, "max_wall_thickness_m": 0.01}]})",
+                             StatusCode::kInvalidArgument,
+                             "class 'A': max_wall_thickness_m (0.01) must be less than max_solid_thickness_m (0.01)"}),
     [](const testing::TestParamInfo<BadTable>& info) { return "case" + std::to_string(info.index); });
 
 TEST(MaterialTable, LoadAndSaveFiles) {

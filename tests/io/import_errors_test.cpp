@@ -101,32 +101,54 @@ TEST(ImportErrors, BadNormalsAreRepairedAndReported) {
   EXPECT_NE(model->info.warnings[0].find("normals recomputed"), std::string::npos);
 }
 
-// An OBJ whose .mtl is not beside it still loads, with its material names,
-// and says which library is missing; with the library there, no warning.
+// An OBJ whose material library is not beside it still loads, with its
+// material names, and says what was lost; the reader's fallback to the OBJ's
+// own name (a.obj reads a.mtl) is named; a library that is there is quiet.
 TEST(ImportErrors, AnObjWhoseMaterialLibraryIsMissingSaysSo) {
   const std::string dir = test::scratch_dir("ImportErrors.ObjWithoutMtl");
   const std::string tetra =
-      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl steel\nf 1 3 2\nf 1 2 4\nusemtl oak\nf 1 4 3\nf 2 3 4\n";
-  test::write_file(dir + "/a.obj", "# two libraries, one missing\nmtllib a.mtl gone.mtl\n" + tetra);
-  test::write_file(dir + "/a.mtl", "newmtl steel\nKd 0.2 0.3 0.9\nnewmtl oak\nKd 0.6 0.4 0.2\n");
-  Result<Model> model = load_model(dir + "/a.obj");
-  ASSERT_TRUE(model.ok()) << model.status().to_string();
-  const auto about_libraries = [](const std::vector<std::string>& warnings) {
-    std::vector<std::string> out;
-    for (const std::string& w : warnings)
-      if (w.find("mtllib") != std::string::npos) out.push_back(w);
-    return out;
+      "v 0 0 0\nv 0.3 0 0\nv 0 0.2 0\nv 0 0 0.25\nusemtl steel\nf 1 3 2\nf 1 2 4\n"
+      "usemtl oak\nf 1 4 3\nf 2 3 4\n";
+  const std::string library = "newmtl steel\nKd 0.2 0.3 0.9\nnewmtl oak\nKd 0.6 0.4 0.2\n";
+  test::write_file(dir + "/lib.mtl", library);
+  test::write_file(dir + "/a.mtl", library);
+  const auto load = [&](const std::string& name, const std::string& header) {
+    test::write_file(dir + "/" + name, header + tetra);
+    Result<Model> m = load_model(dir + "/" + name);
+    EXPECT_TRUE(m.ok()) << m.status().to_string();
+    std::vector<std::string> about_libraries;
+    if (m.ok())
+      for (const std::string& w : m->info.warnings)
+        if (w.find("mtllib") != std::string::npos) about_libraries.push_back(w);
+    return std::make_pair(m.ok() ? std::move(*m) : Model{}, about_libraries);
   };
-  const std::vector<std::string> missing = about_libraries(model->info.warnings);
-  ASSERT_EQ(missing.size(), 1u) << ::testing::PrintToString(model->info.warnings);
-  EXPECT_NE(missing[0].find("a.obj line 2: material library 'gone.mtl' (mtllib) not found"), std::string::npos)
-      << missing[0];
-  ASSERT_EQ(model->materials.size(), 2u);
+  const auto steel_blue = [](const Model& m) {
+    return m.materials.size() == 2 && m.materials[0].name == "steel" &&
+           std::abs(m.materials[0].base_color[2] - 0.9f) < 1e-3f;
+  };
 
-  test::write_file(dir + "/b.obj", "mtllib a.mtl\n" + tetra);
-  Result<Model> complete = load_model(dir + "/b.obj");
-  ASSERT_TRUE(complete.ok()) << complete.status().to_string();
-  EXPECT_TRUE(about_libraries(complete->info.warnings).empty()) << ::testing::PrintToString(complete->info.warnings);
+  // Two names on one line are one name to the reader: nothing is read.
+  auto [two, two_warnings] = load("two.obj", "# comment\nmtllib lib.mtl a.mtl\n");
+  ASSERT_EQ(two_warnings.size(), 1u) << ::testing::PrintToString(two.info.warnings);
+  EXPECT_NE(two_warnings[0].find("two.obj line 2: material library 'lib.mtl a.mtl' (mtllib) not found"),
+            std::string::npos)
+      << two_warnings[0];
+  EXPECT_NE(two_warnings[0].find("not their colours or textures"), std::string::npos) << two_warnings[0];
+  ASSERT_EQ(two.materials.size(), 2u);
+  EXPECT_FALSE(steel_blue(two));
+
+  // a.obj falls back to a.mtl: its colours are read, and the warning says from where.
+  auto [fallback, fallback_warnings] = load("a.obj", "mtllib gone.mtl\n");
+  ASSERT_EQ(fallback_warnings.size(), 1u) << ::testing::PrintToString(fallback.info.warnings);
+  EXPECT_NE(fallback_warnings[0].find("'gone.mtl' (mtllib) not found beside the file; a.mtl (the file's own name) "
+                                      "was read instead"),
+            std::string::npos)
+      << fallback_warnings[0];
+  EXPECT_TRUE(steel_blue(fallback));
+
+  auto [found, found_warnings] = load("b.obj", "mtllib lib.mtl\r\n");
+  EXPECT_TRUE(found_warnings.empty()) << ::testing::PrintToString(found.info.warnings);
+  EXPECT_TRUE(steel_blue(found));
 }
 
 TEST(ImportErrors, MissingEmptyAndUnknownFiles) {

@@ -149,6 +149,13 @@ int run(const Args& a) {
   fs::create_directories(a.out + "/labels");
   if (a.normals) fs::create_directories(a.out + "/normals");
   std::ofstream materials_csv(a.out + "/materials.csv");
+  // One record per line: line breaks in a name become spaces, commas and
+  // quotes are quoted (RFC 4180).
+  const auto csv_cell = [](std::string v) {
+    for (char& c : v)
+      if (c == '\n' || c == '\r') c = ' ';
+    return g2p::detail::csv_field(v);
+  };
   materials_csv << "library,model,split,material,name,texture,r,g,b,area_share,rule,class\n";
   std::ofstream manifest(a.out + "/manifest.csv");
   manifest << "image,library,model,split,view,labelled_pixels";
@@ -204,11 +211,10 @@ int run(const Args& a) {
           char colour[64];
           std::snprintf(colour, sizeof colour, "%.3f,%.3f,%.3f", sm.base_color.x(), sm.base_color.y(),
                         sm.base_color.z());
-          materials_csv << library << "," << g2p::detail::csv_field(key) << "," << split << "," << m << ","
-                        << g2p::detail::csv_field(sm.name) << ","
-                        << g2p::detail::csv_field(fs::path(sm.base_color_texture.uri).filename().string()) << ","
-                        << colour << "," << (total > 0 ? material_area[m] / total : 0.0) << "," << material_rule[m]
-                        << "," << (table.valid_label(material_label[m]) ? table[material_label[m]].name : "") << "\n";
+          materials_csv << library << "," << csv_cell(key) << "," << split << "," << m << "," << csv_cell(sm.name)
+                        << "," << csv_cell(fs::path(sm.base_color_texture.uri).filename().string()) << "," << colour
+                        << "," << (total > 0 ? material_area[m] / total : 0.0) << "," << material_rule[m] << ","
+                        << (table.valid_label(material_label[m]) ? table[material_label[m]].name : "") << "\n";
         }
       }
       std::vector<int> face_label(static_cast<std::size_t>(mesh.num_faces()), g2p::kUnknownLabel);

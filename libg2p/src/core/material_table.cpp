@@ -59,6 +59,10 @@ Status check_class(const MaterialClass& c) {
   if (c.max_wall_thickness_m < 0.0 || (c.max_wall_thickness_m > 0.0 && c.max_wall_thickness_m < c.wall_thickness_m))
     return bad("max_wall_thickness_m must be 0 (no limit) or at least wall_thickness_m (" + fmt(c.wall_thickness_m) +
                "), got " + fmt(c.max_wall_thickness_m));
+  if (c.max_wall_thickness_m > 0.0 && c.max_solid_thickness_m > 0.0 &&
+      c.max_wall_thickness_m >= c.max_solid_thickness_m)
+    return bad("max_wall_thickness_m (" + fmt(c.max_wall_thickness_m) + ") must be less than max_solid_thickness_m (" +
+               fmt(c.max_solid_thickness_m) + "): a wall is no thicker than the thickest solid piece");
   return Status::Ok();
 }
 
@@ -226,9 +230,11 @@ std::string MaterialTable::to_json() const {
                        {"restitution", c.restitution},
                        {"structure", g2p::to_string(c.structure)},
                        {"wall_thickness_m", c.wall_thickness_m},
-                       {"max_solid_thickness_m", c.max_solid_thickness_m},
-                       {"max_wall_thickness_m", c.max_wall_thickness_m},
                        {"source", c.source}});
+    // The limits only when set (0 = no limit, the default), so that tables
+    // without them stay readable by a libg2p that predates the keys.
+    if (c.max_solid_thickness_m > 0) classes.back()["max_solid_thickness_m"] = c.max_solid_thickness_m;
+    if (c.max_wall_thickness_m > 0) classes.back()["max_wall_thickness_m"] = c.max_wall_thickness_m;
   }
   json doc = {{"format", kFormat}, {"version", kFormatVersion}, {"name", name_}, {"classes", classes}};
   return doc.dump(2) + "\n";

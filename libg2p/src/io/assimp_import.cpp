@@ -45,36 +45,39 @@ std::string extension_of(const std::string& path) {
   return ext.empty() ? ext : ext.substr(1);
 }
 
-// An OBJ's material libraries (mtllib lines) that are not beside it: assimp
-// then reads the usemtl names with its default colour, so the user's colours
-// and textures are lost without a word. One warning per missing library.
+// An OBJ's material libraries (mtllib lines) that assimp cannot open. Assimp
+// (5.2) takes the rest of the line as one file name in the OBJ's folder and,
+// when that is missing, reads <the OBJ's stem>.mtl instead; with neither, the
+// usemtl names get its grey default and the user's colours and textures are
+// lost without a word. One warning per library that is not read as written.
 void warn_missing_material_libraries(const std::string& path, const std::string& dir,
                                      std::vector<std::string>& warnings) {
-  std::ifstream in(path);
-  std::string line;
+  std::ifstream in(path, std::ios::binary);
+  const std::string file = fs::path(path).filename().string();
+  const std::string stem_library = fs::path(path).stem().string() + ".mtl";
+  std::error_code ec;
+  const bool stem_library_there = fs::is_regular_file(fs::path(dir) / stem_library, ec);
   std::set<std::string> seen;
+  std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
+    if (line.empty() || (line[0] != 'm' && line[0] != ' ' && line[0] != '\t')) continue;
     std::size_t start = line.find_first_not_of(" \t");
-    if (start == std::string::npos || line.compare(start, 6, "mtllib") != 0) continue;
+    if (start == std::string::npos || line.compare(start, 6, "mtllib") != 0 || start + 6 >= line.size() ||
+        (line[start + 6] != ' ' && line[start + 6] != '\t'))
+      continue;
     start = line.find_first_not_of(" \t", start + 6);
     if (start == std::string::npos) continue;
-    std::string names = line.substr(start);
-    while (!names.empty() && std::isspace(static_cast<unsigned char>(names.back()))) names.pop_back();
-    // One name with spaces, or several names separated by them.
-    std::vector<std::string> libraries{names};
-    std::error_code ec;
-    if (!fs::exists(fs::path(dir) / names, ec)) {
-      libraries.clear();
-      std::istringstream words(names);
-      for (std::string w; words >> w;) libraries.push_back(w);
-    }
-    for (const std::string& library : libraries) {
-      if (fs::exists(fs::path(dir) / library, ec) || !seen.insert(library).second) continue;
-      warnings.push_back(fs::path(path).filename().string() + " line " + std::to_string(number) +
-                         ": material library '" + library +
-                         "' (mtllib) not found beside the file; its materials keep their names but "
-                         "not their colours or textures");
-    }
+    std::string library = line.substr(start);
+    if (!library.empty() && library.back() == '\r') library.pop_back();
+    if (fs::is_regular_file(dir + "/" + library, ec) || !seen.insert(library).second) continue;
+    const std::string where = file + " line " + std::to_string(number) + ": material library '" + library + "'";
+    if (stem_library_there)
+      warnings.push_back(where + " (mtllib) not found beside the file; " + stem_library +
+                         " (the file's own name) was read instead");
+    else
+      warnings.push_back(where +
+                         " (mtllib) not found beside the file (mtllib takes the rest of the line as one "
+                         "name); its materials keep their names but not their colours or textures");
   }
 }
 

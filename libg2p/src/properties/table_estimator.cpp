@@ -1,30 +1,34 @@
 // The PropertyEstimator base class, the registry and the `table` backend.
 //
-// The `table` rule for solid or hollow, from measure_walls and the class:
-// 1. Modelled walls: if at least half of the rays cast into the part's closed
+// The `table` rule for solid or hollow, from measure_walls and the class
+// (numbered as in docs/properties.md, "The table backend"):
+// 1. The class's values (source: table).
+// 2. Modelled walls: if at least half of the rays cast into the part's closed
 //    volume meet an inner surface of the object before leaving it (the model
-//    has an inside: a bottle's inner wall), the part is hollow and its wall
-//    thickness is the median distance to that surface (source: geometry).
-// 2. Otherwise the class's default structure and thickness (source: table),
-//    except that the parts of a dense class (>= 2000 kg/m^3: metal, glass,
-//    ceramic, stone) are hollow with the class's wall thickness when together
-//    they enclose more than half a litre of the object (source: geometry): a
-//    solid steel water bottle would weigh 14 kg; things that big are shells.
-//    (A hammer's steel head, 0.17 litres, stays solid.)
-//    Rule 1 only counts an inner surface no farther in than the class's
-//    thickest solid piece (max_solid_thickness_m, 0 = no limit): a steel
-//    "wall" 10 cm thick is the gap to another part of the object, not a wall.
-//    A modelled wall thicker than the class's thickest single wall
-//    (max_wall_thickness_m, 0 = no limit) is a closed section: every face of
-//    the part is a wall of the class's thickness (source: geometry). Sheet
+//    has an inside: a bottle's inner wall), the part is hollow, double-walled,
+//    and its wall thickness is the median distance to that surface (source:
+//    geometry). Only an inner surface no farther in than the class's thickest
+//    solid piece counts (max_solid_thickness_m, 0 = no limit): a steel "wall"
+//    10 cm thick is the gap to another part of the object. A counted wall
+//    thicker than the class's thickest single wall (max_wall_thickness_m,
+//    0 = no limit) is a closed section instead: hollow, single-walled, every
+//    face a wall of the class's thickness (structure source: geometry). Sheet
 //    metal ends at about 6 mm; a 30 mm "steel panel" is a box of sheet.
-// 3. A part of a class solid by default that is thicker (median local
+// 3. Dense bulk: the parts of a dense class (>= 2000 kg/m^3: metal, glass,
+//    ceramic, stone) solid by default are hollow with the class's wall
+//    thickness when together they enclose more than half a litre of the
+//    object (source: geometry): a solid steel water bottle would weigh 14 kg;
+//    things that big are shells. (A hammer's steel head, 0.17 litres, stays
+//    solid.)
+// 4. A part of a class solid by default that is thicker (median local
 //    thickness) than the class's thickest solid piece is a single-walled shell
 //    of the class's wall thickness (source: geometry): a wardrobe modelled as
 //    a closed box is panels around air, a tyre is rubber around air.
-// 4. Guards (source: geometry): a hollow part thinner than two walls (median
+// 5. Otherwise the class's default structure and thickness (source: table).
+// 6. Guards (source: geometry): a hollow part thinner than two walls (median
 //    local thickness <= 2 t), or whose shell A t would exceed its volume, is
-//    solid: its walls fill it.
+//    solid: its walls fill it. A part that the guards filled but that is
+//    thicker than its class's thickest solid piece is still rule 4's shell.
 #include <cmath>
 #include <sstream>
 

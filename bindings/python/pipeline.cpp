@@ -168,7 +168,8 @@ py::list properties_list(const PipelineResult& r) {
     d["restitution"] = p.restitution;
     d["mass_kg"] = pr.mass.mass_kg;
     d["mass_range_kg"] = py::make_tuple(pr.mass_min_kg, pr.mass_max_kg);
-    d["volume_m3"] = pr.mass.volume_m3;
+    d["volume_m3"] = pr.mass.volume_m3 - pr.contents.volume_m3;
+    d["contents_mass_kg"] = pr.contents.mass_kg;
     d["area_m2"] = pr.mass.area_m2;
     d["center_of_mass"] = py::cast(pr.mass.center_of_mass);
     d["inertia"] = py::cast(pr.mass.inertia);

@@ -284,6 +284,12 @@ void bind_stage_types(py::module_& m) {
   m.def("shell_mass_properties", [](const Mesh& mesh, double density_kg_m3, double thickness_m) {
     return unwrap(shell_mass_properties(mesh, density_kg_m3, thickness_m));
   });
+  m.def(
+      "fill_mass_properties",
+      [](const Mesh& closed, double density_kg_m3, double volume_m3) {
+        return unwrap(fill_mass_properties(closed, density_kg_m3, volume_m3));
+      },
+      "A fill of volume_m3 settled in the bottom of a closed mesh (gravity along -Z).");
   m.def("combine", &combine, "Several parts' mass properties as one body.");
   py::class_<WallMeasurement>(m, "WallMeasurement")
       .def_readonly("rays", &WallMeasurement::rays)
@@ -302,6 +308,8 @@ void bind_stage_types(py::module_& m) {
       .def_readwrite("structure", &PartProperties::structure)
       .def_readwrite("wall_thickness_m", &PartProperties::wall_thickness_m)
       .def_readwrite("double_walled", &PartProperties::double_walled)
+      .def_readwrite("contents_density_kg_m3", &PartProperties::contents_density_kg_m3)
+      .def_readwrite("contents_fill", &PartProperties::contents_fill, "share of a hollow part's cavity, 0 to 1")
       .def_readwrite("friction_static", &PartProperties::friction_static)
       .def_readwrite("friction_dynamic", &PartProperties::friction_dynamic)
       .def_readwrite("restitution", &PartProperties::restitution)
@@ -316,7 +324,8 @@ void bind_stage_types(py::module_& m) {
   py::class_<PartReport>(m, "PartReport")
       .def_readonly("part", &PartReport::part)
       .def_readonly("properties", &PartReport::properties)
-      .def_readonly("mass", &PartReport::mass)
+      .def_readonly("mass", &PartReport::mass, "the walls and the contents together")
+      .def_readonly("contents", &PartReport::contents, "the contents alone (zero mass when empty)")
       .def_readonly("mass_min_kg", &PartReport::mass_min_kg)
       .def_readonly("mass_max_kg", &PartReport::mass_max_kg)
       .def_readonly("completed_ok", &PartReport::completed_ok);

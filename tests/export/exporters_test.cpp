@@ -19,6 +19,7 @@
 #include "g2p/complete.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
+#include "g2p/overrides.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/segment.h"
@@ -131,6 +132,105 @@ TEST(Exporters, HingedHammerSwingsHeadDownAsPhysicsSays) {
       hinge_acceleration(hammer_asset(kWood), test::scratch_dir("ExportHingeUniform"), predicted_uniform);
   EXPECT_NEAR(uniform / predicted_uniform, 1.0, 0.01);
   EXPECT_LT(uniform, 0.8 * two_materials) << "uniform " << uniform << " vs two materials " << two_materials;
+}
+
+// A glass bottle (a closed cylinder, r 4 cm, 25 cm tall, +Z up), one part,
+// through stages 5 and 6 with `overrides` (empty: none) and out as MJCF.
+SimulationAsset bottle_asset(const std::string& overrides_json, PropertiesReport* report_out = nullptr) {
+  std::vector<Eigen::Vector3f> p;
+  std::vector<std::array<unsigned, 3>> t;
+  test::cylinder_geometry(0.04f, 0.f, 0.25f, 64, p, t);
+  for (Eigen::Vector3f& v : p) v = Eigen::Vector3f(v.x(), -v.z(), v.y());  // glTF +Y up to +Z up
+  const Mesh mesh = test::mesh_from_geometry(p, t);
+  std::vector<Part> parts(1);
+  parts[0].label = static_cast<int>(PaperClass::kGlass);
+  for (int f = 0; f < mesh.num_faces(); ++f) parts[0].faces.push_back(f);
+  const MaterialTable& table = MaterialTable::paper_default();
+  const Completion completion = *(*make_completer("partition"))->complete({&mesh, &parts, &table});
+  const std::unique_ptr<PropertyEstimator> base = *make_estimator("table");
+  Result<Overrides> o = parse_overrides(overrides_json, table);
+  EXPECT_TRUE(o.ok()) << o.status().to_string();
+  const std::vector<int> labels(static_cast<std::size_t>(mesh.num_faces()), parts[0].label);
+  const ResolvedOverrides resolved = *resolve_overrides(*o, mesh.num_faces(), parts, labels, table);
+  const std::unique_ptr<PropertyEstimator> estimator = make_overriding_estimator(*base, resolved);
+  Result<PropertiesReport> report = estimate_properties(mesh, parts, completion, table, *estimator);
+  EXPECT_TRUE(report.ok()) << report.status().to_string();
+  if (report_out != nullptr) *report_out = *report;
+  Result<SimulationAsset> asset = make_asset("bottle", mesh, parts, completion, *report, table);
+  EXPECT_TRUE(asset.ok()) << asset.status().to_string();
+  return *asset;
+}
+
+// The bottle's MJCF over a floor, released from rest tilted by `degrees` about
+// X with its lowest point on the floor; after two seconds, the cosine of its
+// tilt (1 upright, 0 on its side).
+double upright_after_release(const SimulationAsset& asset, const std::string& dir, double degrees) {
+  EXPECT_TRUE(write_asset(dir, asset, {"mjcf"}).ok());
+  std::string xml = test::read_file(dir + "/bottle.xml");
+  const std::string body = "  <worldbody>\n";
+  xml.insert(xml.find(body) + body.size(), "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\"/>\n");
+  test::write_file(dir + "/tilted.xml", xml);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML((dir + "/tilted.xml").c_str(), nullptr, error, sizeof error);
+  EXPECT_NE(m, nullptr) << error;
+  if (m == nullptr) return -1;
+  mjData* d = mj_makeData(m);
+  const double half = 0.5 * degrees * M_PI / 180.0;
+  const Eigen::Quaterniond q(std::cos(half), std::sin(half), 0, 0);
+  double lowest = 1e9;
+  for (const AssetPart& part : asset.parts)
+    for (const Eigen::Vector3f& v : part.closed.positions) lowest = std::min(lowest, (q * v.cast<double>()).z());
+  const double qpos[7] = {0, 0, -lowest, q.w(), q.x(), q.y(), q.z()};
+  std::copy(qpos, qpos + 7, d->qpos);
+  const int steps = static_cast<int>(std::ceil(2.0 / m->opt.timestep));
+  for (int i = 0; i < steps; ++i) mj_step(m, d);
+  const double up = d->xmat[9 * 1 + 8];  // body 1's z axis, world z component
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return up;
+}
+
+TEST(Exporters, WaterInABottleWeighsInMujocoAndKeepsItFromTipping) {
+  const std::string empty = R"({"format": "g2p-overrides", "version": 1, "overrides": []})";
+  const std::string half =
+      R"({"format": "g2p-overrides", "version": 1, "overrides": [{"part": 0, "contents": {"fill": 0.5}}]})";
+  PropertiesReport empty_report, half_report;
+  const SimulationAsset bottle = bottle_asset(empty, &empty_report);
+  const SimulationAsset filled = bottle_asset(half, &half_report);
+  // The water: half the cavity (the cylinder less its 4 mm glass walls) at 1000 kg/m^3,
+  // in the bottom quarter of the bottle.
+  const PartReport& part = half_report.parts[0];
+  ASSERT_EQ(part.properties.structure, Structure::kHollow);
+  const double cavity = M_PI * 0.04 * 0.04 * 0.25 - empty_report.parts[0].mass.volume_m3;
+  EXPECT_NEAR(part.contents.mass_kg, 0.5 * cavity * 1000.0, 0.01 * 0.5 * cavity * 1000.0);
+  EXPECT_NEAR(part.contents.center_of_mass.z(), 0.25 * 0.25 * (cavity / (M_PI * 0.04 * 0.04 * 0.25)), 0.002);
+  EXPECT_NEAR(part.mass.mass_kg, empty_report.parts[0].mass.mass_kg + part.contents.mass_kg, 1e-9);
+  const std::string report = report_json(half_report, MaterialTable::paper_default());
+  const nlohmann::json j = nlohmann::json::parse(report);
+  EXPECT_NEAR(j["parts"][0]["contents"]["mass_kg"].get<double>(), part.contents.mass_kg, 1e-9);
+  EXPECT_NEAR(j["parts"][0]["material_volume_m3"].get<double>(), empty_report.parts[0].mass.volume_m3, 1e-12);
+  EXPECT_TRUE(nlohmann::json::parse(report_json(empty_report, MaterialTable::paper_default()))["parts"][0]["contents"]
+                  .is_null());
+
+  // MuJoCo compiles the filled bottle with the water's mass and its low centre of mass.
+  const std::string dir = test::scratch_dir("ExportBottle");
+  ASSERT_TRUE(write_asset(dir, filled, {"mjcf"}).ok());
+  Result<EngineCheck> c = check_in_mujoco(dir + "/bottle.xml");
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  expect_mujoco_agrees(*c, filled);
+  EXPECT_LT(c->center_of_mass.z(), bottle.total.center_of_mass.z() - 0.02);
+
+  // Tipping: a body tips over once its centre of mass passes over the base's
+  // edge, at atan(r / z_com): about 18 degrees empty (centre of mass at mid
+  // height) and 23 half full. Released at 20.5 degrees, the empty bottle falls
+  // over and the half-full one rights itself; at 10 both stand.
+  const double empty_critical = std::atan(0.04 / bottle.total.center_of_mass.z()) * 180.0 / M_PI;
+  const double filled_critical = std::atan(0.04 / filled.total.center_of_mass.z()) * 180.0 / M_PI;
+  ASSERT_LT(empty_critical, 19.5);
+  ASSERT_GT(filled_critical, 21.5);
+  EXPECT_LT(upright_after_release(bottle, test::scratch_dir("TipEmpty"), 20.5), 0.5);
+  EXPECT_GT(upright_after_release(filled, test::scratch_dir("TipFilled"), 20.5), 0.99);
+  EXPECT_GT(upright_after_release(bottle, test::scratch_dir("StandEmpty"), 10.0), 0.99);
 }
 
 TEST(Exporters, UrdfdomAndCheckUrdfReadTheUrdf) {

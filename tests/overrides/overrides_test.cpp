@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <set>
 
 #include "g2p/io.h"
@@ -65,6 +67,12 @@ TEST(Overrides, ABadEntryIsRejectedNamingTheEntryAndTheKey) {
       {R"({"part": 0, "note": "nothing"})", "changes nothing"},
       {R"({"faces": [5], "was": {"class": "Metal"}, "class": "Wood"})", "'was' checks a 'part'"},
       {R"({"part": 0, "was": {"faces": 4294967388}, "class": "Wood"})", "'was' holds 'faces'"},
+      {R"({"part": 0, "contents": 0.5})", "'contents' must be an object like {\"fill\""},
+      {R"({"part": 0, "contents": {"density_kg_m3": 1000}})", "'contents' must be an object"},
+      {R"({"part": 0, "contents": {"fill": 1.5}})", "fill must be a share of the cavity from 0 to 1, not 1.5"},
+      {R"({"part": 0, "contents": {"fill": 0.5, "density_kg_m3": 0}})", "'contents' density_kg_m3 must be"},
+      {R"({"part": 0, "contents": {"fill": 0.5, "liquid": "water"}})", "'contents' holds 'liquid'"},
+      {R"({"part": 0, "structure": "solid", "contents": {"fill": 0.5}})", "fills a solid part"},
   };
   for (const auto& c : cases) {
     const std::string e = error_of(file(c.entries));
@@ -82,10 +90,11 @@ TEST(Overrides, ABadEntryIsRejectedNamingTheEntryAndTheKey) {
 TEST(Overrides, WrittenAndReadBackTheSame) {
   const std::string text = file(
       R"({"part": 1, "was": {"class": "metal", "faces": 12}, "class": "stone", "note": "granite head"},
-         {"faces": [3, [10, 20]], "structure": "hollow", "wall_thickness_m": 0.004, "density_kg_m3": 950})");
+         {"faces": [3, [10, 20]], "structure": "hollow", "wall_thickness_m": 0.004, "density_kg_m3": 950},
+         {"part": 0, "contents": {"fill": 0.75, "density_kg_m3": 790}, "note": "ethanol"})");
   Result<Overrides> a = parse_overrides(text, table());
   ASSERT_TRUE(a.ok()) << a.status().to_string();
-  ASSERT_EQ(a->entries.size(), 2u);
+  ASSERT_EQ(a->entries.size(), 3u);
   EXPECT_EQ(a->entries[0].label, table().find("Stone"));  // names are case-insensitive
   EXPECT_EQ(a->entries[1].faces, (std::vector<std::array<int, 2>>{{3, 3}, {10, 20}}));
   EXPECT_TRUE(a->changes_labels());
@@ -96,6 +105,14 @@ TEST(Overrides, WrittenAndReadBackTheSame) {
   EXPECT_EQ(b->entries[0].note, "granite head");
   EXPECT_EQ(b->entries[0].was_faces, 12);
   EXPECT_DOUBLE_EQ(b->entries[1].density_kg_m3, 950.0);
+  EXPECT_TRUE(b->entries[2].set_contents);
+  EXPECT_DOUBLE_EQ(b->entries[2].contents_fill, 0.75);
+  EXPECT_DOUBLE_EQ(b->entries[2].contents_density_kg_m3, 790.0);
+  EXPECT_FALSE(b->entries[1].set_contents);
+  // Contents without a density are water.
+  Result<Overrides> w = parse_overrides(file(R"({"part": 0, "contents": {"fill": 1}})"), table());
+  ASSERT_TRUE(w.ok()) << w.status().to_string();
+  EXPECT_DOUBLE_EQ(w->entries[0].contents_density_kg_m3, 1000.0);
   // Overlapping ranges come back merged: each face once.
   Result<Overrides> c =
       parse_overrides(file(R"({"faces": [[10, 20], 3, [0, 2], [15, 30], 12], "class": "Wood"})"), table());
@@ -258,6 +275,38 @@ TEST(Overrides, EntriesThatSetDifferentValuesOfOnePartAddUp) {
   EXPECT_EQ(q->structure, p->structure);
   EXPECT_DOUBLE_EQ(q->wall_thickness_m, p->wall_thickness_m);
   EXPECT_DOUBLE_EQ(q->density_kg_m3, p->density_kg_m3);
+}
+
+TEST(Overrides, ContentsFillTheSelectedPartAndALaterEntryEmptiesIt) {
+  const Labelled h = hammer();
+  Result<Overrides> o = parse_overrides(file(R"({"part": 0, "structure": "hollow", "contents": {"fill": 0.4}},
+                                              {"part": 1, "structure": "hollow", "contents": {"fill": 0.9, "density_kg_m3": 1400}},
+                                              {"faces": [0], "contents": {"fill": 0}})"),
+                                        table());
+  ASSERT_TRUE(o.ok()) << o.status().to_string();
+  Result<ResolvedOverrides> r = resolve_overrides(*o, h.model.mesh.num_faces(), h.parts, h.labels, table());
+  ASSERT_TRUE(r.ok());
+  FixedEstimator base;
+  PropertyInput in0{&h.model.mesh, &h.parts[0], nullptr, &table()};
+  PropertyInput in1{&h.model.mesh, &h.parts[1], nullptr, &table()};
+  const std::unique_ptr<PropertyEstimator> e = make_overriding_estimator(base, *r);
+  Result<PartProperties> p0 = e->estimate(in0), p1 = e->estimate(in1);
+  ASSERT_TRUE(p0.ok() && p1.ok());
+  // Part 0 holds face 0, which the third entry empties; entries apply in file order.
+  ASSERT_TRUE(std::find(h.parts[0].faces.begin(), h.parts[0].faces.end(), 0) != h.parts[0].faces.end());
+  EXPECT_DOUBLE_EQ(p0->contents_fill, 0.0);
+  EXPECT_NE(p0->notes.back().find("empty"), std::string::npos) << p0->notes.back();
+  EXPECT_DOUBLE_EQ(p1->contents_fill, 0.9);
+  EXPECT_DOUBLE_EQ(p1->contents_density_kg_m3, 1400.0);
+  EXPECT_NE(p1->notes.back().find("contents 90 % full at 1400 kg/m^3"), std::string::npos) << p1->notes.back();
+  // As face selections, the same.
+  Result<ResolvedOverrides> r2 =
+      resolve_overrides(as_face_selections(*r), h.model.mesh.num_faces(), h.parts, h.labels, table());
+  ASSERT_TRUE(r2.ok());
+  Result<PartProperties> q1 = make_overriding_estimator(base, *r2)->estimate(in1);
+  ASSERT_TRUE(q1.ok());
+  EXPECT_DOUBLE_EQ(q1->contents_fill, 0.9);
+  EXPECT_DOUBLE_EQ(q1->contents_density_kg_m3, 1400.0);
 }
 
 }  // namespace

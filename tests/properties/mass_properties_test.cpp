@@ -89,6 +89,53 @@ TEST(MassProperties, TwoMaterialHammerBalancesInItsHead) {
   EXPECT_GT(hammer.inertia(0, 0), head.inertia(0, 0) + handle.inertia(0, 0));
 }
 
+TEST(MassProperties, AFillSettlesAtTheBottomOfItsVolume) {
+  // A 1 x 1 x 2 m tank half full of water holds a 1 m cube of water at the bottom.
+  const Mesh tank = test::box_mesh({-0.5f, -0.5f, 0.f}, {0.5f, 0.5f, 2.f});
+  Result<MassProperties> half = fill_mass_properties(tank, 1000.0, 1.0);
+  ASSERT_TRUE(half.ok()) << half.status().to_string();
+  EXPECT_NEAR(half->mass_kg, 1000.0, 1e-6);
+  EXPECT_NEAR(half->volume_m3, 1.0, 1e-8);
+  EXPECT_TRUE(half->center_of_mass.isApprox(Eigen::Vector3d(0, 0, 0.5), 1e-8)) << half->center_of_mass.transpose();
+  EXPECT_TRUE(half->inertia.isApprox(Eigen::Matrix3d::Identity() * 1000.0 / 6.0, 1e-6)) << half->inertia;
+  // Full: the solid itself.
+  Result<MassProperties> full = fill_mass_properties(tank, 1000.0, 2.0);
+  ASSERT_TRUE(full.ok());
+  EXPECT_NEAR(full->center_of_mass.z(), 1.0, 1e-9);
+
+  // A sphere half full: a hemisphere, centre of mass 3 r / 8 below the centre; a quarter
+  // full: the cap of height h with pi h^2 (3 r - h) / 3 = pi r^3 / 3, centroid
+  // 3 (2 r - h)^2 / (4 (3 r - h)) below the centre.
+  const double r = 0.5;
+  const Mesh ball = test::sphere_mesh(r, 128);
+  const double volume = 4.0 / 3.0 * M_PI * r * r * r;
+  Result<MassProperties> hemisphere = fill_mass_properties(ball, 1000.0, 0.5 * volume);
+  ASSERT_TRUE(hemisphere.ok());
+  EXPECT_NEAR(hemisphere->center_of_mass.z(), -3.0 * r / 8.0, 1e-3 * r);
+  EXPECT_NEAR(hemisphere->center_of_mass.head<2>().norm(), 0.0, 1e-6);
+  double lo = 0, hi = 2 * r;  // the cap's height, by bisection on its closed form
+  for (int i = 0; i < 100; ++i) {
+    const double h = 0.5 * (lo + hi);
+    (M_PI * h * h * (3 * r - h) / 3 < 0.25 * volume ? lo : hi) = h;
+  }
+  const double h = lo;
+  Result<MassProperties> cap = fill_mass_properties(ball, 1000.0, 0.25 * volume);
+  ASSERT_TRUE(cap.ok());
+  expect_relative(cap->mass_kg, 250.0 * volume, 1e-6, "cap mass");
+  EXPECT_NEAR(cap->center_of_mass.z(), -3 * (2 * r - h) * (2 * r - h) / (4 * (3 * r - h)), 2e-3 * r);
+
+  // Bad fills: none, more than the volume, a mesh wound inward.
+  EXPECT_EQ(fill_mass_properties(tank, 1000.0, 0.0).status().code(), StatusCode::kInvalidArgument);
+  Result<MassProperties> over = fill_mass_properties(tank, 1000.0, 2.5);
+  EXPECT_EQ(over.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(over.status().message().find("at most all of it"), std::string::npos) << over.status().message();
+  Mesh inward = tank;
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  Result<MassProperties> inside_out = fill_mass_properties(inward, 1000.0, 0.5);
+  EXPECT_EQ(inside_out.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(inside_out.status().message().find("fill: "), std::string::npos) << inside_out.status().message();
+}
+
 TEST(MassProperties, Errors) {
   EXPECT_EQ(solid_mass_properties(Mesh{}, 1000).status().code(), StatusCode::kInvalidArgument);
   Mesh inward = test::box_mesh({0, 0, 0}, {1, 1, 1});

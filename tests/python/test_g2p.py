@@ -122,6 +122,19 @@ class HammerPipelineTest(unittest.TestCase):
             self.assertGreater(part.volume_m3, 0.0)
             self.assertEqual(part.mesh.positions.shape[1], 3)
             self.assertTrue(part.checks.closed)
+        self.assertEqual(props["Metal"]["contents_mass_kg"], 0.0)
+
+    def test_a_fill_settles_in_the_bottom_of_a_closed_part(self):
+        closed = self.result.completion.parts[0].mesh
+        whole = g2p.solid_mass_properties(closed, 1000.0)
+        half = g2p.fill_mass_properties(closed, 1000.0, 0.5 * whole.volume_m3)
+        self.assertAlmostEqual(half.volume_m3, 0.5 * whole.volume_m3, places=9)
+        self.assertAlmostEqual(half.mass_kg, 500.0 * whole.volume_m3, places=6)
+        self.assertLess(half.center_of_mass[2], whole.center_of_mass[2])
+        with self.assertRaises(ValueError):
+            g2p.fill_mass_properties(closed, 1000.0, 2.0 * whole.volume_m3)
+        p = g2p.PartProperties(contents_fill=0.5, contents_density_kg_m3=790.0)
+        self.assertEqual((p.contents_fill, p.contents_density_kg_m3), (0.5, 790.0))
 
     def test_arrays_have_the_documented_shapes(self):
         r = self.result

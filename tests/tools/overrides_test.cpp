@@ -102,6 +102,49 @@ TEST(ToolOverrides, ADensityChangeReusesTheClosedParts) {
   EXPECT_NEAR(report["parts"][1]["mass_kg"].get<double>(), 2.0 * before, 1e-6 * before) << report.dump();
 }
 
+TEST(ToolOverrides, ContentsWeighInTheRunAndEveryFolderThatFollows) {
+  // A dead-blow hammer: the steel head a hollow casting half full of steel shot (bulk 4700 kg/m^3).
+  const std::string dir = test::scratch_dir("ToolOverridesContents");
+  test::write_file(dir + "/shot.json", R"({"format": "g2p-overrides", "version": 1, "overrides": [
+    {"part": 1, "structure": "hollow", "wall_thickness_m": 0.003, "contents": {"fill": 0.5, "density_kg_m3": 4700}}]})");
+  test::write_file(dir + "/shell.json", R"({"format": "g2p-overrides", "version": 1, "overrides": [
+    {"part": 1, "structure": "hollow", "wall_thickness_m": 0.003}]})");
+  test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/shell") + " -q --overrides " +
+                                   test::quote(dir + "/shell.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/shot") + " -q --overrides " +
+                     test::quote(dir + "/shot.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("correction: part 1: hollow, 3 mm walls, contents 50 % full at 4700 kg/m^3"), std::string::npos)
+      << r.err;
+  const nlohmann::json shell = json_of(dir + "/shell/report.json")["parts"][1];
+  const nlohmann::json shot = json_of(dir + "/shot/report.json")["parts"][1];
+  ASSERT_TRUE(shot["contents"].is_object()) << shot.dump();
+  const double fill = shot["contents"]["mass_kg"].get<double>();
+  EXPECT_GT(fill, 0.0);
+  EXPECT_NEAR(shot["mass_kg"].get<double>(), shell["mass_kg"].get<double>() + fill, 1e-9);
+  EXPECT_NEAR(shot["material_volume_m3"].get<double>(), shell["material_volume_m3"].get<double>(), 1e-12);
+  // The shot lies in the bottom of the head: below the shell's centre of mass.
+  EXPECT_LT(shot["contents"]["center_of_mass_m"][2].get<double>(), shell["center_of_mass_m"][2].get<double>());
+  EXPECT_NE(test::read_file(dir + "/shot/summary.html").find("50 % full"), std::string::npos);
+  const double mass = json_of(dir + "/shot/report.json")["object"]["mass_kg"].get<double>();
+  // The folder's overrides.json fills the head again; `g2p properties` writes the contents
+  // into its report, and `g2p export` from that folder reads them back.
+  r = test::run_tool("export " + test::quote(dir + "/shot") + " -o " + test::quote(dir + "/again"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NEAR(json_of(dir + "/again/report.json")["object"]["mass_kg"].get<double>(), mass, 1e-9 * mass);
+  r = test::run_tool("properties " + test::quote(dir + "/shell") + " --overrides " + test::quote(dir + "/shot.json") +
+                     " -o " + test::quote(dir + "/props"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = test::run_tool("export " + test::quote(dir + "/props") + " -o " + test::quote(dir + "/props-exported"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const nlohmann::json exported = json_of(dir + "/props-exported/report.json");
+  EXPECT_NEAR(exported["object"]["mass_kg"].get<double>(), mass, 1e-9 * mass);
+  EXPECT_NEAR(exported["parts"][1]["contents"]["mass_kg"].get<double>(), fill, 1e-9 * fill);
+  EXPECT_NEAR(exported["parts"][1]["material_volume_m3"].get<double>(), shell["material_volume_m3"].get<double>(),
+              1e-12);
+}
+
 TEST(ToolOverrides, ABadFileIsRejectedNamingTheEntryAndNothingIsWritten) {
   const std::string dir = test::scratch_dir("ToolOverridesBad");
   test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/run") + " -q");

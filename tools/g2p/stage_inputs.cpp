@@ -263,6 +263,15 @@ Result<PropertiesOutput> load_properties_output(const std::string& command, cons
       for (int k = 0; k < 5; ++k) p.solimp[static_cast<std::size_t>(k)] = r["mujoco_solimp"][k].get<double>();
       pr.mass.mass_kg = r["mass_kg"].get<double>();
       pr.mass.volume_m3 = r["material_volume_m3"].get<double>();
+      if (r.contains("contents") && r["contents"].is_object()) {
+        const nlohmann::json& c = r["contents"];
+        p.contents_density_kg_m3 = c["density_kg_m3"].get<double>();
+        p.contents_fill = c["fill"].get<double>();
+        pr.contents.mass_kg = c["mass_kg"].get<double>();
+        pr.contents.volume_m3 = c["volume_m3"].get<double>();
+        for (int a = 0; a < 3; ++a) pr.contents.center_of_mass[a] = c["center_of_mass_m"][a].get<double>();
+        pr.mass.volume_m3 += pr.contents.volume_m3;  // the part's mass holds both
+      }
       pr.mass.area_m2 = r["area_m2"].get<double>();
       for (int a = 0; a < 3; ++a) {
         pr.mass.center_of_mass[a] = r["center_of_mass_m"][a].get<double>();

@@ -11,7 +11,8 @@
 //
 // An entry selects faces (a part of the run the file was made from, or face
 // indices of the input: the rows of faces.csv) and sets any of class,
-// structure, wall thickness and density. Classes change before the complete
+// structure, wall thickness, density and contents (a fill of a hollow part's
+// cavity: {"part": 0, "contents": {"fill": 0.8, "density_kg_m3": 1000}}). Classes change before the complete
 // stage (the parts are re-formed from the new labels); the other values
 // replace the estimator's for the parts that hold the selected faces.
 #pragma once
@@ -48,10 +49,15 @@ struct Override {
   Structure structure = Structure::kSolid;  // solid or hollow
   double wall_thickness_m = 0.0;            // > 0: the wall (implies hollow), metres
   double density_kg_m3 = 0.0;               // > 0: the density, kg/m^3 (its plausible range becomes this value)
-  std::string note;                         // the person's words, kept in the reports
+  // Contents ("contents": {"fill": 0.5, "density_kg_m3": 1000}): the share of
+  // a hollow part's cavity that a fill of this density takes (0 = empty).
+  bool set_contents = false;               // true: the two below apply
+  double contents_fill = 0.0;              // 0 to 1
+  double contents_density_kg_m3 = 1000.0;  // kg/m^3, water unless given
+  std::string note;                        // the person's words, kept in the reports
 
   bool sets_structure() const { return set_structure || wall_thickness_m > 0; }  // structure and wall
-  bool sets_properties() const { return sets_structure() || density_kg_m3 > 0; }
+  bool sets_properties() const { return sets_structure() || density_kg_m3 > 0 || set_contents; }
 };
 
 struct Overrides {
@@ -96,6 +102,7 @@ struct ResolvedOverrides {
   std::vector<int> class_entry;      // the class
   std::vector<int> structure_entry;  // solid or hollow, and the wall
   std::vector<int> density_entry;    // the density
+  std::vector<int> contents_entry;   // the contents
   std::vector<int> faces;            // per entry: how many faces it selects
 };
 
@@ -129,8 +136,8 @@ G2P_API Result<std::vector<std::string>> apply_class_overrides(const ResolvedOve
 G2P_API Result<std::vector<std::string>> apply_class_overrides(const ResolvedOverrides& resolved, const Mesh& mesh,
                                                                Projection& projection, const MaterialTable& table);
 
-// An estimator that asks `base`, then sets the structure, wall thickness and
-// density the overrides give for the part (from the entries that won any of
+// An estimator that asks `base`, then sets the structure, wall thickness,
+// density and contents the overrides give for the part (from the entries that won any of
 // its faces, later entries winning), with ValueSource::kUser and a note
 // ("correction: hollow, 4 mm walls, 7000 kg/m^3"). Both must outlive it.
 G2P_API std::unique_ptr<PropertyEstimator> make_overriding_estimator(const PropertyEstimator& base,

@@ -50,6 +50,16 @@ G2P_API Result<MassProperties> solid_mass_properties(const Mesh& mesh, double de
 // mass rho * A * t spread over the surface; the surface need not be closed).
 G2P_API Result<MassProperties> shell_mass_properties(const Mesh& mesh, double density_kg_m3, double thickness_m);
 
+// `volume_m3` of a fill (a liquid, sand, grain) of `density_kg_m3` settled in
+// the bottom of a closed, outward mesh under gravity along -Z: the part of the
+// enclosed volume below the level z = h at which that volume lies below it
+// (found by bisection to 1e-9 of the enclosed volume). Exact for the clipped
+// volume: every triangle is clipped to z <= h and closes a tetrahedron with a
+// reference point on the level plane, so the flat surface of the fill adds
+// nothing. `volume_m3` from 0 (exclusive) to the enclosed volume; fails
+// otherwise, and as solid_mass_properties fails.
+G2P_API Result<MassProperties> fill_mass_properties(const Mesh& closed, double density_kg_m3, double volume_m3);
+
 // Several parts as one body: masses add, the centre of mass is the weighted
 // mean, inertias move to it by the parallel-axis theorem.
 G2P_API MassProperties combine(const std::vector<MassProperties>& parts);
@@ -117,7 +127,13 @@ struct PartProperties {
   // closed volume's faces inside the object). When the model has both faces
   // of the wall (inner surfaces found by measure_walls), each carries t / 2.
   bool double_walled = false;
-  double friction_static = 0.5;  // Coulomb coefficients
+  // Contents: a hollow part's cavity (its closed volume less its walls) holds
+  // a fill of this density up to `contents_fill` of its volume, settled at the
+  // bottom under gravity along -Z (a bottle of water, a tank half full).
+  // 0 = empty, the default; a solid part has no cavity and ignores them.
+  double contents_density_kg_m3 = 0.0;  // kg/m^3; water 1000
+  double contents_fill = 0.0;           // share of the cavity, 0 to 1
+  double friction_static = 0.5;         // Coulomb coefficients
   double friction_dynamic = 0.5;
   double restitution = 0.5;
   // MuJoCo contact softness (MJCF solref = time constant s and damping ratio;
@@ -170,7 +186,8 @@ G2P_API std::unique_ptr<PropertyEstimator> make_vlm_estimator(std::shared_ptr<co
 struct PartReport {
   int part = -1;
   PartProperties properties;
-  MassProperties mass;  // nominal density
+  MassProperties mass;      // nominal density; the walls and the contents together
+  MassProperties contents;  // the contents alone (zero mass when empty)
   double mass_min_kg = 0.0, mass_max_kg = 0.0;
   bool completed_ok = false;  // the complete stage's checks passed
 };

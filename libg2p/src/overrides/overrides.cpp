@@ -31,13 +31,13 @@ bool positive_finite(const json& v) { return v.is_number() && std::isfinite(v.ge
 
 Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& table, const std::string& origin) {
   if (!e.is_object()) return entry_error(origin, i, "is a " + type_name(e) + ", not an object");
-  static const std::set<std::string> kKeys = {"part",          "faces", "was", "class", "structure", "wall_thickness_m",
-                                              "density_kg_m3", "note"};
+  static const std::set<std::string> kKeys = {
+      "part", "faces", "was", "class", "structure", "wall_thickness_m", "density_kg_m3", "contents", "note"};
   for (auto it = e.begin(); it != e.end(); ++it)
     if (!kKeys.count(it.key()))
-      return entry_error(
-          origin, i,
-          "unknown key '" + it.key() + "' (part, faces, was, class, structure, wall_thickness_m, density_kg_m3, note)");
+      return entry_error(origin, i,
+                         "unknown key '" + it.key() +
+                             "' (part, faces, was, class, structure, wall_thickness_m, density_kg_m3, contents, note)");
   Override o;
   const bool has_part = e.contains("part"), has_faces = e.contains("faces");
   if (has_part == has_faces)
@@ -129,12 +129,36 @@ Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& 
       return entry_error(origin, i, "'density_kg_m3' must be a positive density up to 30000 kg/m^3, not " + d.dump());
     o.density_kg_m3 = d.get<double>();
   }
+  if (e.contains("contents")) {
+    const json& c = e["contents"];
+    const std::string form = "like {\"fill\": 0.8, \"density_kg_m3\": 1000}";
+    if (!c.is_object() || !c.contains("fill"))
+      return entry_error(origin, i, "'contents' must be an object " + form + ", not " + c.dump());
+    for (auto it = c.begin(); it != c.end(); ++it)
+      if (it.key() != "fill" && it.key() != "density_kg_m3")
+        return entry_error(origin, i, "'contents' holds '" + it.key() + "' (it takes fill and density_kg_m3)");
+    const json& f = c["fill"];
+    if (!f.is_number() || !std::isfinite(f.get<double>()) || f.get<double>() < 0 || f.get<double>() > 1)
+      return entry_error(origin, i, "'contents' fill must be a share of the cavity from 0 to 1, not " + f.dump());
+    o.set_contents = true;
+    o.contents_fill = f.get<double>();
+    if (c.contains("density_kg_m3")) {
+      const json& d = c["density_kg_m3"];
+      if (!positive_finite(d) || d.get<double>() > kMaxDensity)
+        return entry_error(origin, i,
+                           "'contents' density_kg_m3 must be a positive density up to 30000 kg/m^3, not " + d.dump());
+      o.contents_density_kg_m3 = d.get<double>();
+    }
+    if (o.set_structure && o.structure == Structure::kSolid && o.contents_fill > 0)
+      return entry_error(origin, i, "fills a solid part; contents need \"structure\": \"hollow\"");
+  }
   if (e.contains("note")) {
     if (!e["note"].is_string()) return entry_error(origin, i, "'note' must be text");
     o.note = e["note"].get<std::string>();
   }
   if (o.label == kUnknownLabel && !o.sets_properties())
-    return entry_error(origin, i, "changes nothing: give class, structure, wall_thickness_m or density_kg_m3");
+    return entry_error(origin, i,
+                       "changes nothing: give class, structure, wall_thickness_m, density_kg_m3 or contents");
   return o;
 }
 
@@ -211,6 +235,7 @@ std::string overrides_json(const Overrides& overrides, const MaterialTable& tabl
     if (o.set_structure) e["structure"] = to_string(o.structure);
     if (o.wall_thickness_m > 0) e["wall_thickness_m"] = o.wall_thickness_m;
     if (o.density_kg_m3 > 0) e["density_kg_m3"] = o.density_kg_m3;
+    if (o.set_contents) e["contents"] = {{"fill", o.contents_fill}, {"density_kg_m3", o.contents_density_kg_m3}};
     if (!o.note.empty()) e["note"] = o.note;
     entries += (entries.empty() ? "\n    " : ",\n    ") + e.dump();  // one entry a line
   }
@@ -234,6 +259,7 @@ Result<ResolvedOverrides> resolve_overrides(const Overrides& overrides, int num_
   r.class_entry.assign(static_cast<std::size_t>(num_faces), -1);
   r.structure_entry.assign(static_cast<std::size_t>(num_faces), -1);
   r.density_entry.assign(static_cast<std::size_t>(num_faces), -1);
+  r.contents_entry.assign(static_cast<std::size_t>(num_faces), -1);
   // Classes by name in the run's table (the file may have been read with another).
   for (std::size_t i = 0; i < r.overrides.entries.size(); ++i) {
     Override& o = r.overrides.entries[i];
@@ -254,6 +280,7 @@ Result<ResolvedOverrides> resolve_overrides(const Overrides& overrides, int num_
       if (o.label != kUnknownLabel) r.class_entry[face] = entry;
       if (o.sets_structure()) r.structure_entry[face] = entry;
       if (o.density_kg_m3 > 0) r.density_entry[face] = entry;
+      if (o.set_contents) r.contents_entry[face] = entry;
     };
     if (o.part >= 0) {
       if (o.part >= static_cast<int>(parts.size()))
@@ -331,6 +358,15 @@ Overrides as_face_selections(const ResolvedOverrides& resolved) {
       d.note = o.note;
       if (!d.faces.empty()) out.entries.push_back(std::move(d));
     }
+    if (o.set_contents) {
+      Override c;
+      c.faces = ranges(resolved.contents_entry, static_cast<int>(i));
+      c.set_contents = true;
+      c.contents_fill = o.contents_fill;
+      c.contents_density_kg_m3 = o.contents_density_kg_m3;
+      c.note = o.note;
+      if (!c.faces.empty()) out.entries.push_back(std::move(c));
+    }
   }
   return out;
 }
@@ -396,15 +432,17 @@ class OverridingEstimator final : public PropertyEstimator {
     Result<PartProperties> r = base_.estimate(input);
     if (!r.ok() || input.part == nullptr) return r;
     // The entries that won any of the part's faces, per value, in file order.
-    std::set<int> structure, density;
+    std::set<int> structure, density, contents;
     for (int f : input.part->faces) {
       const std::size_t i = static_cast<std::size_t>(f);
       if (i < resolved_.structure_entry.size() && resolved_.structure_entry[i] >= 0)
         structure.insert(resolved_.structure_entry[i]);
       if (i < resolved_.density_entry.size() && resolved_.density_entry[i] >= 0)
         density.insert(resolved_.density_entry[i]);
+      if (i < resolved_.contents_entry.size() && resolved_.contents_entry[i] >= 0)
+        contents.insert(resolved_.contents_entry[i]);
     }
-    if (structure.empty() && density.empty()) return r;
+    if (structure.empty() && density.empty() && contents.empty()) return r;
     PartProperties& p = *r;
     std::set<int> used;
     for (int e : structure) {
@@ -436,15 +474,32 @@ class OverridingEstimator final : public PropertyEstimator {
       p.density_kg_m3 = p.density_min_kg_m3 = p.density_max_kg_m3 = o.density_kg_m3;
       p.density_source = ValueSource::kUser;
     }
+    for (int e : contents) {
+      const Override& o = resolved_.overrides.entries[static_cast<std::size_t>(e)];
+      used.insert(e);
+      p.contents_fill = o.contents_fill;
+      p.contents_density_kg_m3 = o.contents_density_kg_m3;
+    }
     std::ostringstream what;
     what << "correction: ";
+    const char* sep = "";
     if (!structure.empty()) {
       if (p.structure == Structure::kSolid)
         what << "solid";
       else
         what << "hollow, " << p.wall_thickness_m * 1000.0 << " mm walls";
+      sep = ", ";
     }
-    if (!density.empty()) what << (structure.empty() ? "" : ", ") << p.density_kg_m3 << " kg/m^3";
+    if (!density.empty()) {
+      what << sep << p.density_kg_m3 << " kg/m^3";
+      sep = ", ";
+    }
+    if (!contents.empty()) {
+      if (p.contents_fill > 0)
+        what << sep << "contents " << p.contents_fill * 100.0 << " % full at " << p.contents_density_kg_m3 << " kg/m^3";
+      else
+        what << sep << "empty";
+    }
     std::string notes;
     for (int e : used) {
       const std::string& n = resolved_.overrides.entries[static_cast<std::size_t>(e)].note;

@@ -317,8 +317,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     if (resolved)
       for (const PartReport& p : r.properties.parts)
         for (const std::string& n : p.properties.notes)
-          if (n.rfind("correction: ", 0) == 0)
-            r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n);
+          if (n.rfind("correction: ", 0) == 0)  // "part 2: hollow, 3 mm walls", as the class changes read
+            r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12));
     clock.report().notes = r.properties.notes;
     // The vlm estimator never fails a part: it falls back to the table, which
     // is a degraded optional stage the caller should hear about.

@@ -170,6 +170,9 @@ void parts_table(std::ostringstream& h, const PipelineResult& r) {
         << to_string(pr.properties.structure);
       if (pr.properties.structure == Structure::kHollow && pr.properties.wall_thickness_m > 0)
         h << ", " << number(pr.properties.wall_thickness_m * 1e3) << " mm walls";
+      if (pr.contents.mass_kg > 0)
+        h << ", " << number(pr.properties.contents_fill * 100.0) << " % full (" << number(pr.contents.mass_kg)
+          << " kg at " << number(pr.properties.contents_density_kg_m3) << " kg/m&sup3;)";
       h << "</td><td>" << number(pr.mass.mass_kg) << "</td>";
     }
     h << "</tr>\n";

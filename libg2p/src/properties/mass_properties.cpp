@@ -11,7 +11,12 @@
 //   sum A / 12 (a a^T + b b^T + c c^T + s s^T)
 // (the second moment of a triangle), times rho * t.
 // Inertia about a point from the covariance: I = trace(C) Id - C.
+// Fill: the same tetrahedra over the triangles clipped to z <= h, with r on the
+// plane z = h, so the fill's flat top (in that plane) closes zero-volume
+// tetrahedra and need not be built.
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "g2p/properties.h"
@@ -33,6 +38,15 @@ struct Moments {
 // (signed tetrahedron volume or area) from its vertices relative to the
 // reference; the first moment adds w s / first, the second
 // w / second (a a^T + b b^T + c c^T + s s^T), s = a + b + c.
+// One triangle's contribution, its vertices relative to the reference.
+void add(Moments& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double w,
+         double first, double second) {
+  const Eigen::Vector3d s = a + b + c;
+  m.zeroth += w;
+  m.first += w * s / first;
+  m.second += w / second * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+}
+
 template <typename Element>
 Moments moments(const Mesh& mesh, const Eigen::Vector3d& reference, double first, double second, Element element) {
   Moments m;
@@ -40,11 +54,36 @@ Moments moments(const Mesh& mesh, const Eigen::Vector3d& reference, double first
     const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>() - reference;
     const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>() - reference;
     const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>() - reference;
-    const double w = element(a, b, c);
-    const Eigen::Vector3d s = a + b + c;
-    m.zeroth += w;
-    m.first += w * s / first;
-    m.second += w / second * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+    add(m, a, b, c, element(a, b, c), first, second);
+  }
+  return m;
+}
+
+double tetrahedron_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return a.dot(b.cross(c)) / 6.0;
+}
+
+// Volume moments of the part of a closed mesh below z = level, about
+// `reference` (which lies on that plane): each triangle clipped to z <= level
+// (a triangle, a quadrilateral or nothing), fanned from its first corner.
+Moments moments_below(const Mesh& mesh, const Eigen::Vector3d& reference) {
+  Moments m;
+  std::array<Eigen::Vector3d, 4> kept;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    int n = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = mesh.positions[t[k]].cast<double>() - reference;
+      const Eigen::Vector3d q = mesh.positions[t[(k + 1) % 3]].cast<double>() - reference;
+      const bool p_in = p.z() <= 0.0, q_in = q.z() <= 0.0;
+      if (p_in) kept[static_cast<std::size_t>(n++)] = p;
+      if (p_in != q_in) kept[static_cast<std::size_t>(n++)] = p + (q - p) * (p.z() / (p.z() - q.z()));
+    }
+    for (int k = 1; k + 1 < n; ++k) {
+      const Eigen::Vector3d& a = kept[0];
+      const Eigen::Vector3d& b = kept[static_cast<std::size_t>(k)];
+      const Eigen::Vector3d& c = kept[static_cast<std::size_t>(k + 1)];
+      add(m, a, b, c, tetrahedron_volume(a, b, c), 4.0, 20.0);
+    }
   }
   return m;
 }
@@ -79,9 +118,7 @@ Result<MassProperties> solid_mass_properties(const Mesh& mesh, double density_kg
   if (!(density_kg_m3 > 0.0) || !std::isfinite(density_kg_m3))
     return Status::InvalidArgument("mass properties: density must be > 0 kg/m^3");
   const Eigen::Vector3d reference = bounds(mesh).center();
-  const Moments m = moments(mesh, reference, 4.0, 20.0, [](const auto& a, const auto& b, const auto& c) {
-    return a.dot(b.cross(c)) / 6.0;  // signed tetrahedron volume
-  });
+  const Moments m = moments(mesh, reference, 4.0, 20.0, tetrahedron_volume);  // signed tetrahedron volumes
   const double extent = bounds(mesh).diagonal().norm();
   if (!(m.zeroth > 1e-12 * extent * extent * extent))
     return Status::InvalidArgument("mass properties: the enclosed volume is " + std::to_string(m.zeroth) +
@@ -102,6 +139,34 @@ Result<MassProperties> shell_mass_properties(const Mesh& mesh, double density_kg
   if (!(m.zeroth > 0.0)) return Status::InvalidArgument("mass properties: the surface has no area");
   MassProperties p = finish(m, density_kg_m3 * thickness_m, reference, m.zeroth);
   p.volume_m3 = m.zeroth * thickness_m;
+  return p;
+}
+
+Result<MassProperties> fill_mass_properties(const Mesh& closed, double density_kg_m3, double volume_m3) {
+  Result<MassProperties> whole = solid_mass_properties(closed, density_kg_m3);
+  if (!whole.ok()) return whole.status().with_context("fill");
+  const double enclosed = whole->volume_m3;
+  if (!(volume_m3 > 0.0) || !std::isfinite(volume_m3) || volume_m3 > enclosed * (1.0 + 1e-9))
+    return Status::InvalidArgument("fill: a fill of " + std::to_string(volume_m3) + " m^3 in a volume of " +
+                                   std::to_string(enclosed) + " m^3 (it must be more than 0 and at most all of it)");
+  if (volume_m3 >= enclosed) return whole;
+  const Eigen::AlignedBox3d box = bounds(closed);
+  Eigen::Vector3d reference(box.center().x(), box.center().y(), 0.0);
+  // The volume below z = h grows with h from 0 at the bottom to `enclosed` at the top.
+  double lo = box.min().z(), hi = box.max().z();
+  Moments below;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (!(mid > lo && mid < hi) && i > 0) break;  // as close as doubles get
+    reference.z() = mid;
+    below = moments_below(closed, reference);
+    if (std::abs(below.zeroth - volume_m3) <= 1e-9 * enclosed) break;
+    (below.zeroth < volume_m3 ? lo : hi) = reference.z();
+  }
+  if (!(below.zeroth > 0.0))
+    return Status::InvalidArgument("fill: no volume below the level found; is the mesh closed and wound outward?");
+  MassProperties p = finish(below, density_kg_m3, reference, 0.0);
+  p.volume_m3 = below.zeroth;
   return p;
 }
 

@@ -1,10 +1,43 @@
 // estimate_properties (the whole stage) and report.json (docs/report-schema.md).
+#include <algorithm>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "g2p/io.h"
 #include "g2p/properties.h"
 
 namespace g2p {
+
+namespace {
+
+// Fills a hollow part's cavity (its closed volume less its walls) as its
+// contents ask, or says why not; the part's mass then holds both.
+void add_contents(PartReport& r, const Mesh& closed, std::vector<std::string>& report_notes) {
+  PartProperties& pp = r.properties;
+  const std::string where = "part " + std::to_string(r.part) + ": ";
+  auto skip = [&](const std::string& why) {
+    pp.notes.push_back("contents left out: " + why);
+    report_notes.push_back(where + "contents left out: " + why);
+  };
+  if (pp.structure != Structure::kHollow) return skip("the part is solid and has no cavity");
+  Result<MassProperties> whole = solid_mass_properties(closed, 1.0);
+  if (!whole.ok()) return skip(whole.status().message());
+  const double cavity = whole->volume_m3 - r.mass.volume_m3;
+  if (!(cavity > 0.0)) return skip("its walls fill its closed volume");
+  Result<MassProperties> fill =
+      fill_mass_properties(closed, pp.contents_density_kg_m3, std::min(1.0, pp.contents_fill) * cavity);
+  if (!fill.ok()) return skip(fill.status().message());
+  r.contents = *fill;
+  r.mass = combine({r.mass, *fill});
+  r.mass_min_kg += fill->mass_kg;
+  r.mass_max_kg += fill->mass_kg;
+  std::ostringstream note;
+  note << "contents: " << 100.0 * pp.contents_fill << " % of a " << cavity * 1000.0 << " l cavity at "
+       << pp.contents_density_kg_m3 << " kg/m^3, " << fill->mass_kg << " kg";
+  pp.notes.push_back(note.str());
+}
+
+}  // namespace
 
 Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vector<Part>& parts,
                                              const Completion& completion, const MaterialTable& table,
@@ -47,6 +80,7 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
     r.mass = *m;
     r.mass_min_kg = m->mass_kg * pp.density_min_kg_m3 / pp.density_kg_m3;
     r.mass_max_kg = m->mass_kg * pp.density_max_kg_m3 / pp.density_kg_m3;
+    if (pp.contents_density_kg_m3 > 0.0 && pp.contents_fill > 0.0) add_contents(r, completed.mesh, report.notes);
     if (!completed.ok) report.notes.push_back("part " + std::to_string(i) + " failed its completion checks");
     masses.push_back(r.mass);
     report.mass_min_kg += r.mass_min_kg;
@@ -93,7 +127,15 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
     j["density_max_kg_m3"] = p.density_max_kg_m3;
     j["wall_thickness_m"] = p.structure == Structure::kHollow ? json(p.wall_thickness_m) : json(nullptr);
     j["double_walled"] = p.double_walled;
-    j["material_volume_m3"] = r.mass.volume_m3;
+    j["material_volume_m3"] = r.mass.volume_m3 - r.contents.volume_m3;
+    if (r.contents.mass_kg > 0.0)
+      j["contents"] = {{"density_kg_m3", p.contents_density_kg_m3},
+                       {"fill", p.contents_fill},
+                       {"volume_m3", r.contents.volume_m3},
+                       {"mass_kg", r.contents.mass_kg},
+                       {"center_of_mass_m", vec(r.contents.center_of_mass)}};
+    else
+      j["contents"] = nullptr;
     j["area_m2"] = r.mass.area_m2;
     j["mass_min_kg"] = r.mass_min_kg;
     j["mass_max_kg"] = r.mass_max_kg;
@@ -117,7 +159,9 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
   json object = mass_json(report.object);
   object["mass_min_kg"] = report.mass_min_kg;
   object["mass_max_kg"] = report.mass_max_kg;
-  object["material_volume_m3"] = report.object.volume_m3;
+  double contents_volume = 0.0;
+  for (const PartReport& r : report.parts) contents_volume += r.contents.volume_m3;
+  object["material_volume_m3"] = report.object.volume_m3 - contents_volume;
   object["area_m2"] = report.object.area_m2;
   const ObjectSize& size = report.size;
   object["size"] = {

@@ -85,6 +85,7 @@ function partDetails(p) {
       : p.structure === 'solid' ? '- (solid)' : '-'],
     ['density', p.density_kg_m3 ? `${fmt(p.density_kg_m3)} kg/m\u00b3` : '-'],
     ['mass', p.mass_kg !== undefined ? `${fmt(p.mass_kg)} kg` : '-'],
+    ...(p.contents_mass_kg ? [['contents', `${fmt(p.contents_fill * 100, 3)} % full, ${fmt(p.contents_mass_kg)} kg`]] : []),
     ['volume', p.volume_m3 ? `${fmt(p.volume_m3 * 1e6)} cm\u00b3` : '-'],
   ];
   const box = document.createDocumentFragment();
@@ -135,6 +136,15 @@ function correctionForm(p, index, classes, existing, onAdd) {
   Object.assign(density, { type: 'number', name: 'g2p-fix-density', min: '0', step: 'any', placeholder: 'as estimated' });
   if (was.density_kg_m3) density.value = String(was.density_kg_m3);
   field('density (kg/m\u00b3)', density);
+  // Contents of a hollow part: the share of its cavity a fill takes, and the fill's density.
+  const fill = document.createElement('input');
+  Object.assign(fill, { type: 'number', name: 'g2p-fix-fill', min: '0', max: '100', step: 'any', placeholder: 'empty' });
+  if (was.contents) fill.value = String(was.contents.fill * 100);
+  field('filled (%)', fill);
+  const fillDensity = document.createElement('input');
+  Object.assign(fillDensity, { type: 'number', name: 'g2p-fix-fill-density', min: '0', step: 'any', placeholder: 'water, 1000' });
+  if (was.contents && was.contents.density_kg_m3) fillDensity.value = String(was.contents.density_kg_m3);
+  field('fill density (kg/m\u00b3)', fillDensity);
   const error = text('div', '', 'warn');
   const add = text('button', 'Add correction', 'g2p-fix-add');
   add.type = 'button';
@@ -147,8 +157,15 @@ function correctionForm(p, index, classes, existing, onAdd) {
     if (mm !== null && !(mm > 0 && mm <= 10000)) { error.textContent = 'the wall must be more than 0 and at most 10000 mm'; return; }
     if (mm !== null && structure.value === 'solid') { error.textContent = 'a solid part has no wall'; return; }
     if (rho !== null && !(rho > 0 && rho <= 30000)) { error.textContent = 'the density must be between 0 and 30000 kg/m\u00b3'; return; }
+    const pct = fill.value === '' ? null : Number(fill.value);
+    const fillRho = fillDensity.value === '' ? null : Number(fillDensity.value);
+    if (pct !== null && !(pct >= 0 && pct <= 100)) { error.textContent = 'filled must be from 0 to 100 %'; return; }
+    if (fillRho !== null && !(fillRho > 0 && fillRho <= 30000)) { error.textContent = 'the fill density must be between 0 and 30000 kg/m\u00b3'; return; }
+    if (fillRho !== null && pct === null) { error.textContent = 'say how full the part is'; return; }
+    if (pct > 0 && structure.value === 'solid') { error.textContent = 'a solid part holds no contents'; return; }
     if (mm !== null) entry.wall_thickness_m = mm / 1000;
     if (rho !== null) entry.density_kg_m3 = rho;
+    if (pct !== null) entry.contents = fillRho !== null ? { fill: pct / 100, density_kg_m3: fillRho } : { fill: pct / 100 };
     if (Object.keys(entry).length === 2) { error.textContent = 'nothing changed'; return; }
     error.textContent = '';
     onAdd(index, entry);
@@ -285,9 +302,10 @@ function start(section, model) {
     fixesBox.append(text('b', `Corrections (${fixes.length})`));
     const ol = document.createElement('ol');
     for (const f of fixes) {
-      const what = ['class', 'structure', 'wall_thickness_m', 'density_kg_m3'].filter((k) => k in f)
+      const what = ['class', 'structure', 'wall_thickness_m', 'density_kg_m3', 'contents'].filter((k) => k in f)
         .map((k) => (k === 'wall_thickness_m' ? `wall ${fmt(f[k] * 1e3, 3)} mm` : k === 'density_kg_m3'
-          ? `${fmt(f[k])} kg/m\u00b3` : f[k]));
+          ? `${fmt(f[k])} kg/m\u00b3` : k === 'contents' ? (f[k].fill > 0 ? `${fmt(f[k].fill * 100, 3)} % full` +
+            ` (${fmt(f[k].density_kg_m3 || 1000)} kg/m\u00b3)` : 'empty') : f[k]));
       ol.append(text('li', `${parts[f.part].data.name} (${f.was.class}): ${what.join(', ')}`));
     }
     const download = text('button', 'Download overrides.json', 'g2p-fix-download');

@@ -53,8 +53,9 @@ TEST(SummaryBrowser, The3DViewDrawsTheHammerAndEveryControlChangesThePicture) {
 }
 
 // The correction round trip: a person picks the hammer's handle in the page,
-// makes it plastic of 1100 kg/m^3 and downloads the overrides; `g2p export`
-// applies them to the run's folder, and report.json says so.
+// makes it plastic of 1100 kg/m^3, a third full of water, and downloads the
+// overrides; `g2p export` applies them to the run's folder, and report.json
+// says so.
 TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   const std::string& page = hammer_page();
   if (!has_viewer(page))
@@ -64,7 +65,7 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   const nlohmann::json before = nlohmann::json::parse(test::read_file(run + "/run.json"));
   ASSERT_EQ(before["parts"][0]["material"], "Wood");
   const test::ValidatorRun v =
-      test::run_summary_browser(page, "--correct 0:Plastic:1100 --download " + test::quote(dir + "/overrides.json"));
+      test::run_summary_browser(page, "--correct 0:Plastic:1100:30 --download " + test::quote(dir + "/overrides.json"));
   SKIP_WITHOUT_BROWSER(v);
   ASSERT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
   const nlohmann::json fix = nlohmann::json::parse(test::read_file(dir + "/overrides.json"));
@@ -72,6 +73,7 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   ASSERT_EQ(fix["overrides"].size(), 1u) << fix.dump();
   EXPECT_EQ(fix["overrides"][0]["part"], 0);
   EXPECT_EQ(fix["overrides"][0]["was"]["class"], "Wood");
+  EXPECT_DOUBLE_EQ(fix["overrides"][0]["contents"]["fill"].get<double>(), 0.3) << fix.dump();
   const test::ToolRun r = test::run_tool("export " + test::quote(run) + " --overrides " +
                                          test::quote(dir + "/overrides.json") + " -o " + test::quote(dir + "/fixed"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
@@ -82,6 +84,9 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   ASSERT_NE(handle, nullptr) << report.dump(1);
   EXPECT_DOUBLE_EQ((*handle)["density_kg_m3"].get<double>(), 1100.0);
   EXPECT_EQ((*handle)["sources"]["density"], "user");
+  ASSERT_TRUE((*handle)["contents"].is_object()) << handle->dump(1);  // plastic is hollow: the water weighs
+  EXPECT_DOUBLE_EQ((*handle)["contents"]["density_kg_m3"].get<double>(), 1000.0);
+  EXPECT_GT((*handle)["contents"]["mass_kg"].get<double>(), 0.0);
   EXPECT_EQ(report["parts"].size(), before["parts"].size());
 }
 

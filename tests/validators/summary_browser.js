@@ -10,9 +10,10 @@
 // --screenshot saves the whole page at the end; --screenshot-top the first
 // 1280 x 900 pixels while the mouse rests on a part (the picture in README.md).
 //
-// --correct PART:CLASS[:DENSITY] --download OUT.json uses the correction
+// --correct PART:CLASS[:DENSITY[:FILLED]] --download OUT.json uses the correction
 // control as a person would: clicks part PART in the list, chooses CLASS (and
-// types DENSITY in kg/m^3), adds the correction, checks that the picture
+// types DENSITY in kg/m^3 and FILLED, the percent of its cavity a fill of
+// water takes), adds the correction, checks that the picture
 // changes (the part takes its new class's colour) and saves the overrides file
 // the page downloads as OUT.json (instead of the toggle checks); with
 // --screenshot-top, the picture is taken once the correction is listed.
@@ -190,7 +191,7 @@ async function main() {
         return after;
       }
       if (correct) {
-        const [part, cls, density] = correct.split(':');
+        const [part, cls, density, filled] = correct.split(':');
         const item = section.locator('.g2p-parts li').nth(Number(part));
         check(await item.count() === 1, `the parts list has no part ${part}`);
         await item.locator('span').last().click();  // pins the part: its correction form appears
@@ -198,6 +199,7 @@ async function main() {
         check(await form.count() === 1, 'clicking a part shows no correction form (.g2p-fix)');
         await form.locator('select[name=g2p-fix-class]').selectOption(cls);
         if (density) await form.locator('input[name=g2p-fix-density]').fill(density);
+        if (filled) await form.locator('input[name=g2p-fix-fill]').fill(filled);
         await form.locator('button.g2p-fix-add').click();
         await page.mouse.move(box.x + 2, box.y + 2);
         await frames(page);

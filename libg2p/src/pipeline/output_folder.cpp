@@ -224,6 +224,10 @@ nlohmann::json part_summary_json(const PipelineResult& r, std::size_t i) {
     j["structure"] = to_string(pr.properties.structure);
     j["wall_thickness_m"] = pr.properties.wall_thickness_m;
     j["mass_kg"] = pr.mass.mass_kg;
+    if (pr.contents.mass_kg > 0) {  // a filled hollow part: mass_kg holds the fill too
+      j["contents_fill"] = pr.properties.contents_fill;
+      j["contents_mass_kg"] = pr.contents.mass_kg;
+    }
   }
   return j;
 }

@@ -64,8 +64,9 @@ function text(tag, content, className) {
   return e;
 }
 
+// `digits` significant digits, without trailing zeros after the point (1100 stays 1100).
 function fmt(v, digits = 4) {
-  return Number(v).toPrecision(digits).replace(/\.?0+(e|$)/, '$1');
+  return String(Number(Number(v).toPrecision(digits)));
 }
 
 function webglAvailable() {

@@ -209,6 +209,14 @@ async function main() {
         if (top_shot) await page.screenshot({ path: top_shot });  // the correction control, for the docs
         const listed = await section.locator('.g2p-fixes li').allInnerTexts();
         check(listed.length === 1 && listed[0].includes(cls), `the corrections list shows ${JSON.stringify(listed)}`);
+        if (density) {
+          check(listed[0].includes(`${density} kg/m\u00b3`), `the corrections list shows ${JSON.stringify(listed)}, ` +
+            `not the density ${density}`);
+        }
+        if (filled) {
+          check(listed[0].includes(`${filled} % full (1000 kg/m\u00b3)`), `the corrections list shows ` +
+            `${JSON.stringify(listed)}, not ${filled} % full of water`);
+        }
         const [download] = await Promise.all([
           page.waitForEvent('download', { timeout: 10000 }),
           section.locator('button.g2p-fix-download').click(),

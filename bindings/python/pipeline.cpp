@@ -169,7 +169,9 @@ py::list properties_list(const PipelineResult& r) {
     d["mass_kg"] = pr.mass.mass_kg;
     d["mass_range_kg"] = py::make_tuple(pr.mass_min_kg, pr.mass_max_kg);
     d["volume_m3"] = pr.mass.volume_m3 - pr.contents.volume_m3;
-    d["contents_mass_kg"] = pr.contents.mass_kg;
+    d["contents_mass_kg"] = pr.contents.mass_kg;  // 0 when empty
+    d["contents_fill"] = pr.contents.mass_kg > 0 ? p.contents_fill : 0.0;
+    d["contents_density_kg_m3"] = p.contents_density_kg_m3;
     d["area_m2"] = pr.mass.area_m2;
     d["center_of_mass"] = py::cast(pr.mass.center_of_mass);
     d["inertia"] = py::cast(pr.mass.inertia);
@@ -244,7 +246,7 @@ void bind_pipeline(py::module_& m) {
 
   py::class_<Overrides>(m, "Overrides",
                         "A person's corrections (summary.html's 3D view, docs/pipeline.md#overrides): classes, "
-                        "solid/hollow, wall thickness and density per part or face. Read them with "
+                        "solid/hollow, wall thickness, density and contents per part or face. Read them with "
                         "g2p.read_overrides(path) or g2p.parse_overrides(text); give them to "
                         "PipelineOptions(overrides=...).")
       .def(py::init<>())

@@ -140,7 +140,7 @@ function correctionForm(p, index, classes, existing, onAdd) {
   // Contents of a hollow part: the share of its cavity a fill takes, and the fill's density.
   const fill = document.createElement('input');
   Object.assign(fill, { type: 'number', name: 'g2p-fix-fill', min: '0', max: '100', step: 'any', placeholder: 'empty' });
-  if (was.contents) fill.value = String(was.contents.fill * 100);
+  if (was.contents) fill.value = fmt(was.contents.fill * 100, 6);
   field('filled (%)', fill);
   const fillDensity = document.createElement('input');
   Object.assign(fillDensity, { type: 'number', name: 'g2p-fix-fill-density', min: '0', step: 'any', placeholder: 'water, 1000' });
@@ -164,6 +164,9 @@ function correctionForm(p, index, classes, existing, onAdd) {
     if (fillRho !== null && !(fillRho > 0 && fillRho <= 30000)) { error.textContent = 'the fill density must be between 0 and 30000 kg/m\u00b3'; return; }
     if (fillRho !== null && pct === null) { error.textContent = 'say how full the part is'; return; }
     if (pct > 0 && structure.value === 'solid') { error.textContent = 'a solid part holds no contents'; return; }
+    if (pct > 0 && p.structure === 'solid' && structure.value !== 'hollow' && mm === null) {
+      error.textContent = 'this part is solid: choose hollow to fill it'; return;
+    }
     if (mm !== null) entry.wall_thickness_m = mm / 1000;
     if (rho !== null) entry.density_kg_m3 = rho;
     if (pct !== null) entry.contents = fillRho !== null ? { fill: pct / 100, density_kg_m3: fillRho } : { fill: pct / 100 };

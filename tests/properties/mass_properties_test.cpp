@@ -98,6 +98,33 @@ TEST(MassProperties, AFillSettlesAtTheBottomOfItsVolume) {
   EXPECT_NEAR(half->volume_m3, 1.0, 1e-8);
   EXPECT_TRUE(half->center_of_mass.isApprox(Eigen::Vector3d(0, 0, 0.5), 1e-8)) << half->center_of_mass.transpose();
   EXPECT_TRUE(half->inertia.isApprox(Eigen::Matrix3d::Identity() * 1000.0 / 6.0, 1e-6)) << half->inertia;
+  Result<MassProperties> low = fill_mass_properties(tank, 1000.0, 0.3);  // found over many bisection steps
+  ASSERT_TRUE(low.ok());
+  EXPECT_NEAR(low->volume_m3, 0.3, 1e-8);
+  EXPECT_NEAR(low->center_of_mass.z(), 0.15, 1e-8);
+  // Levels through a ring of vertices: a tank whose sides are split at `ring`
+  // (the level lands on the ring at the first step for 1.0, after many for 0.6).
+  for (const float ring : {1.0f, 0.6f}) {
+    Mesh split;
+    const float corner[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, 0.5f}, {-0.5f, 0.5f}};  // counter-clockwise
+    for (const float z : {0.f, ring, 2.f})
+      for (const auto& c : corner) split.positions.emplace_back(c[0], c[1], z);
+    auto at = [](int layer, int i) { return 4 * layer + (i % 4); };
+    for (int layer = 0; layer < 2; ++layer)
+      for (int i = 0; i < 4; ++i) {
+        split.triangles.emplace_back(at(layer, i), at(layer, i + 1), at(layer + 1, i + 1));
+        split.triangles.emplace_back(at(layer, i), at(layer + 1, i + 1), at(layer + 1, i));
+      }
+    split.triangles.emplace_back(at(0, 0), at(0, 2), at(0, 1));
+    split.triangles.emplace_back(at(0, 0), at(0, 3), at(0, 2));
+    split.triangles.emplace_back(at(2, 0), at(2, 1), at(2, 2));
+    split.triangles.emplace_back(at(2, 0), at(2, 2), at(2, 3));
+    ASSERT_NEAR(solid_mass_properties(split, 1.0)->volume_m3, 2.0, 1e-9);
+    Result<MassProperties> to_ring = fill_mass_properties(split, 1000.0, ring);
+    ASSERT_TRUE(to_ring.ok()) << to_ring.status().to_string();
+    EXPECT_NEAR(to_ring->volume_m3, ring, 1e-8) << ring;
+    EXPECT_NEAR(to_ring->center_of_mass.z(), 0.5 * ring, 1e-8) << ring;
+  }
   // Full: the solid itself.
   Result<MassProperties> full = fill_mass_properties(tank, 1000.0, 2.0);
   ASSERT_TRUE(full.ok());

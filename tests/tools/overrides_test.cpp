@@ -143,6 +143,26 @@ TEST(ToolOverrides, ContentsWeighInTheRunAndEveryFolderThatFollows) {
   EXPECT_NEAR(exported["parts"][1]["contents"]["mass_kg"].get<double>(), fill, 1e-9 * fill);
   EXPECT_NEAR(exported["parts"][1]["material_volume_m3"].get<double>(), shell["material_volume_m3"].get<double>(),
               1e-12);
+
+  // A fill asked of the solid wooden handle is not given, and the run says so.
+  test::write_file(dir + "/solid.json", R"({"format": "g2p-overrides", "version": 1, "overrides": [
+    {"part": 0, "contents": {"fill": 0.5}}]})");
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/solid") + " -q --overrides " +
+                     test::quote(dir + "/solid.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: properties: part 0: contents left out: the part is solid and has no cavity (make it "
+                       "hollow to fill it"),
+            std::string::npos)
+      << r.err;
+  const nlohmann::json solid = json_of(dir + "/solid/report.json");
+  EXPECT_TRUE(solid["parts"][0]["contents"].is_null());
+  // The handle weighs what it weighs unfilled (the shell run left it alone).
+  EXPECT_NEAR(solid["parts"][0]["mass_kg"].get<double>(),
+              json_of(dir + "/shell/report.json")["parts"][0]["mass_kg"].get<double>(), 1e-12);
+  r = test::run_tool("properties " + test::quote(dir + "/shell") + " --overrides " + test::quote(dir + "/solid.json") +
+                     " -o " + test::quote(dir + "/solid-props"));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.err.find("g2p properties: warning: part 0: contents left out"), std::string::npos) << r.err;
 }
 
 TEST(ToolOverrides, ABadFileIsRejectedNamingTheEntryAndNothingIsWritten) {

@@ -53,7 +53,7 @@ TEST(SummaryBrowser, The3DViewDrawsTheHammerAndEveryControlChangesThePicture) {
 }
 
 // The correction round trip: a person picks the hammer's handle in the page,
-// makes it plastic of 1100 kg/m^3, a third full of water, and downloads the
+// makes it hollow plastic of 1100 kg/m^3, 30 % full of water, and downloads the
 // overrides; `g2p export` applies them to the run's folder, and report.json
 // says so.
 TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
@@ -74,6 +74,7 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   EXPECT_EQ(fix["overrides"][0]["part"], 0);
   EXPECT_EQ(fix["overrides"][0]["was"]["class"], "Wood");
   EXPECT_DOUBLE_EQ(fix["overrides"][0]["contents"]["fill"].get<double>(), 0.3) << fix.dump();
+  EXPECT_EQ(fix["overrides"][0]["structure"], "hollow");
   const test::ToolRun r = test::run_tool("export " + test::quote(run) + " --overrides " +
                                          test::quote(dir + "/overrides.json") + " -o " + test::quote(dir + "/fixed"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
@@ -84,7 +85,7 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   ASSERT_NE(handle, nullptr) << report.dump(1);
   EXPECT_DOUBLE_EQ((*handle)["density_kg_m3"].get<double>(), 1100.0);
   EXPECT_EQ((*handle)["sources"]["density"], "user");
-  ASSERT_TRUE((*handle)["contents"].is_object()) << handle->dump(1);  // plastic is hollow: the water weighs
+  ASSERT_TRUE((*handle)["contents"].is_object()) << handle->dump(1);  // made hollow: the water weighs
   EXPECT_DOUBLE_EQ((*handle)["contents"]["density_kg_m3"].get<double>(), 1000.0);
   EXPECT_GT((*handle)["contents"]["mass_kg"].get<double>(), 0.0);
   EXPECT_EQ(report["parts"].size(), before["parts"].size());

@@ -13,7 +13,7 @@
 // --correct PART:CLASS[:DENSITY[:FILLED]] --download OUT.json uses the correction
 // control as a person would: clicks part PART in the list, chooses CLASS (and
 // types DENSITY in kg/m^3 and FILLED, the percent of its cavity a fill of
-// water takes), adds the correction, checks that the picture
+// water takes, which the form refuses until the part is made hollow), adds the correction, checks that the picture
 // changes (the part takes its new class's colour) and saves the overrides file
 // the page downloads as OUT.json (instead of the toggle checks); with
 // --screenshot-top, the picture is taken once the correction is listed.
@@ -199,7 +199,15 @@ async function main() {
         check(await form.count() === 1, 'clicking a part shows no correction form (.g2p-fix)');
         await form.locator('select[name=g2p-fix-class]').selectOption(cls);
         if (density) await form.locator('input[name=g2p-fix-density]').fill(density);
-        if (filled) await form.locator('input[name=g2p-fix-fill]').fill(filled);
+        if (filled) {
+          // A solid part holds nothing: the form says so until the part is made hollow.
+          await form.locator('input[name=g2p-fix-fill]').fill(filled);
+          await form.locator('button.g2p-fix-add').click();
+          const said = await form.locator('.warn').innerText();
+          check(said.includes('choose hollow'), `a fill of a solid part was not refused (the form says "${said}")`);
+          check(await section.locator('.g2p-fixes li').count() === 0, 'a refused correction was listed');
+          await form.locator('select[name=g2p-fix-structure]').selectOption('hollow');
+        }
         await form.locator('button.g2p-fix-add').click();
         await page.mouse.move(box.x + 2, box.y + 2);
         await frames(page);

@@ -221,7 +221,7 @@ void add_run_command(CLI::App& app, Command& run) {
   cmd->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
   cmd->add_option("--overrides", args->overrides,
                   "Corrections to apply (JSON from summary.html's 3D view, docs/pipeline.md#overrides): classes, "
-                  "solid/hollow, wall thickness, density per part or face");
+                  "solid/hollow, wall thickness, density, contents per part or face");
   cmd->add_option("--name", args->name, "Asset name (default: the model file's stem)");
   cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
       ->delimiter(',')

@@ -341,6 +341,8 @@ Result<PropertiesReport> run_estimation(const std::string& command, const Estima
     return report;
   }
   report->size = object_size(object.model);
+  for (const std::string& n : report->notes)  // asked for, not given: say so where it cannot be missed
+    if (n.find(kContentsLeftOut) != std::string::npos) std::cerr << "g2p " << command << ": warning: " << n << "\n";
   return report;
 }
 

@@ -11,7 +11,7 @@ namespace g2p::cli {
 void add_overrides_flag(CLI::App* cmd, std::string& path) {
   cmd->add_option("--overrides", path,
                   "Corrections to apply (JSON from summary.html's 3D view, docs/pipeline.md#overrides): classes, "
-                  "solid/hollow, wall thickness, density per part or face");
+                  "solid/hollow, wall thickness, density, contents per part or face");
 }
 
 namespace {

@@ -62,7 +62,7 @@ struct Override {
 
 struct Overrides {
   std::vector<Override> entries;  // in file order; where two select the same face, each value (class;
-                                  // structure with wall; density) comes from the later entry that sets it
+                                  // structure with wall; density; contents) comes from the later entry that sets it
   std::string model;              // the model the run was made from (for people; not checked)
   int faces_total = -1;           // the input's face count; checked when >= 0
 
@@ -84,8 +84,10 @@ struct Overrides {
 // the entry and the key for an unknown key or class, a selection that is
 // missing, doubled or negative, a "was" on a face selection, a structure
 // other than solid/hollow, a wall thickness or density that is not positive
-// and finite (or a density above 30,000 kg/m^3, denser than any material), an
-// entry that changes nothing, or a version other than kOverridesVersion.
+// and finite (or a density above 30,000 kg/m^3, denser than any material),
+// contents without a fill from 0 to 1 or with a bad density, a fill of a part
+// the entry makes solid, an entry that changes nothing, or a version other
+// than kOverridesVersion.
 // `origin` names the text in errors (a file path, say).
 G2P_API Result<Overrides> parse_overrides(const std::string& json_text, const MaterialTable& table,
                                           const std::string& origin = "overrides");

@@ -130,10 +130,11 @@ struct PartProperties {
   // Contents: a hollow part's cavity (its closed volume less its walls) holds
   // a fill of this density up to `contents_fill` of its volume, settled at the
   // bottom under gravity along -Z (a bottle of water, a tank half full).
-  // 0 = empty, the default; a solid part has no cavity and ignores them.
-  double contents_density_kg_m3 = 0.0;  // kg/m^3; water 1000
-  double contents_fill = 0.0;           // share of the cavity, 0 to 1
-  double friction_static = 0.5;         // Coulomb coefficients
+  // A fill of 0 is empty, the default; a solid part has no cavity and keeps
+  // none (a note says so, beginning with kContentsLeftOut).
+  double contents_density_kg_m3 = 1000.0;  // kg/m^3; water
+  double contents_fill = 0.0;              // share of the cavity, 0 to 1
+  double friction_static = 0.5;            // Coulomb coefficients
   double friction_dynamic = 0.5;
   double restitution = 0.5;
   // MuJoCo contact softness (MJCF solref = time constant s and damping ratio;
@@ -201,6 +202,11 @@ struct PropertiesReport {
   ObjectSize size;
   std::vector<std::string> notes;
 };
+
+// The words that begin the note of a part whose contents were asked for but
+// not given ("contents left out: the part is solid ..."), in its notes and
+// (after "part N: ") in the report's.
+inline constexpr const char* kContentsLeftOut = "contents left out: ";
 
 // Estimates every completed part and combines them. Parts whose completion
 // failed (no closed mesh) are left out of the totals and noted.

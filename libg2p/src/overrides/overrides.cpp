@@ -132,14 +132,16 @@ Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& 
   if (e.contains("contents")) {
     const json& c = e["contents"];
     const std::string form = "like {\"fill\": 0.8, \"density_kg_m3\": 1000}";
-    if (!c.is_object() || !c.contains("fill"))
-      return entry_error(origin, i, "'contents' must be an object " + form + ", not " + c.dump());
+    if (!c.is_object()) return entry_error(origin, i, "'contents' must be an object " + form + ", not " + c.dump());
+    if (!c.contains("fill"))
+      return entry_error(origin, i, "'contents' needs \"fill\", the share of the cavity from 0 to 1 (80 % is 0.8)");
     for (auto it = c.begin(); it != c.end(); ++it)
       if (it.key() != "fill" && it.key() != "density_kg_m3")
         return entry_error(origin, i, "'contents' holds '" + it.key() + "' (it takes fill and density_kg_m3)");
     const json& f = c["fill"];
     if (!f.is_number() || !std::isfinite(f.get<double>()) || f.get<double>() < 0 || f.get<double>() > 1)
-      return entry_error(origin, i, "'contents' fill must be a share of the cavity from 0 to 1, not " + f.dump());
+      return entry_error(origin, i,
+                         "'contents' fill must be a share of the cavity from 0 to 1 (80 % is 0.8), not " + f.dump());
     o.set_contents = true;
     o.contents_fill = f.get<double>();
     if (c.contains("density_kg_m3")) {

@@ -320,6 +320,8 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
           if (n.rfind("correction: ", 0) == 0)  // "part 2: hollow, 3 mm walls", as the class changes read
             r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12));
     clock.report().notes = r.properties.notes;
+    for (const std::string& n : r.properties.notes)  // contents asked for and not given
+      if (n.find(kContentsLeftOut) != std::string::npos) r.warnings.push_back("properties: " + n);
     // The vlm estimator never fails a part: it falls back to the table, which
     // is a degraded optional stage the caller should hear about.
     if (!estimator.custom && o.estimator.name == "vlm") {

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "g2p/properties.h"
 
@@ -146,9 +147,13 @@ Result<MassProperties> fill_mass_properties(const Mesh& closed, double density_k
   Result<MassProperties> whole = solid_mass_properties(closed, density_kg_m3);
   if (!whole.ok()) return whole.status().with_context("fill");
   const double enclosed = whole->volume_m3;
-  if (!(volume_m3 > 0.0) || !std::isfinite(volume_m3) || volume_m3 > enclosed * (1.0 + 1e-9))
-    return Status::InvalidArgument("fill: a fill of " + std::to_string(volume_m3) + " m^3 in a volume of " +
-                                   std::to_string(enclosed) + " m^3 (it must be more than 0 and at most all of it)");
+  if (!(volume_m3 > 0.0) || !std::isfinite(volume_m3) || volume_m3 > enclosed * (1.0 + 1e-9)) {
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "fill: a fill of %g m^3 in a volume of %g m^3 (it must be more than 0 and at most all of it)",
+                  volume_m3, enclosed);
+    return Status::InvalidArgument(what);
+  }
   if (volume_m3 >= enclosed) return whole;
   const Eigen::AlignedBox3d box = bounds(closed);
   Eigen::Vector3d reference(box.center().x(), box.center().y(), 0.0);

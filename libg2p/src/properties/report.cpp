@@ -1,5 +1,4 @@
 // estimate_properties (the whole stage) and report.json (docs/report-schema.md).
-#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -12,20 +11,29 @@ namespace {
 
 // Fills a hollow part's cavity (its closed volume less its walls) as its
 // contents ask, or says why not; the part's mass then holds both.
-void add_contents(PartReport& r, const Mesh& closed, std::vector<std::string>& report_notes) {
+void add_contents(PartReport& r, const Mesh& closed, bool closed_ok, std::vector<std::string>& report_notes) {
   PartProperties& pp = r.properties;
-  const std::string where = "part " + std::to_string(r.part) + ": ";
   auto skip = [&](const std::string& why) {
-    pp.notes.push_back("contents left out: " + why);
-    report_notes.push_back(where + "contents left out: " + why);
+    pp.notes.push_back(kContentsLeftOut + why);
+    report_notes.push_back("part " + std::to_string(r.part) + ": " + kContentsLeftOut + why);
   };
-  if (pp.structure != Structure::kHollow) return skip("the part is solid and has no cavity");
+  std::ostringstream bad;
+  if (!(pp.contents_fill >= 0.0 && pp.contents_fill <= 1.0)) {
+    bad << "the fill " << pp.contents_fill << " is not a share of the cavity from 0 to 1 (80 % is 0.8)";
+    return skip(bad.str());
+  }
+  if (!(pp.contents_density_kg_m3 > 0.0 && pp.contents_density_kg_m3 <= 30000.0)) {
+    bad << "the fill's density " << pp.contents_density_kg_m3 << " kg/m^3 is not between 0 and 30000";
+    return skip(bad.str());
+  }
+  if (pp.structure != Structure::kHollow)
+    return skip("the part is solid and has no cavity (make it hollow to fill it: \"structure\": \"hollow\")");
+  if (!closed_ok) return skip("its closed volume failed the complete stage's checks, so its cavity is not known");
   Result<MassProperties> whole = solid_mass_properties(closed, 1.0);
   if (!whole.ok()) return skip(whole.status().message());
   const double cavity = whole->volume_m3 - r.mass.volume_m3;
   if (!(cavity > 0.0)) return skip("its walls fill its closed volume");
-  Result<MassProperties> fill =
-      fill_mass_properties(closed, pp.contents_density_kg_m3, std::min(1.0, pp.contents_fill) * cavity);
+  Result<MassProperties> fill = fill_mass_properties(closed, pp.contents_density_kg_m3, pp.contents_fill * cavity);
   if (!fill.ok()) return skip(fill.status().message());
   r.contents = *fill;
   r.mass = combine({r.mass, *fill});
@@ -80,7 +88,7 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
     r.mass = *m;
     r.mass_min_kg = m->mass_kg * pp.density_min_kg_m3 / pp.density_kg_m3;
     r.mass_max_kg = m->mass_kg * pp.density_max_kg_m3 / pp.density_kg_m3;
-    if (pp.contents_density_kg_m3 > 0.0 && pp.contents_fill > 0.0) add_contents(r, completed.mesh, report.notes);
+    if (pp.contents_fill != 0.0) add_contents(r, completed.mesh, completed.ok, report.notes);
     if (!completed.ok) report.notes.push_back("part " + std::to_string(i) + " failed its completion checks");
     masses.push_back(r.mass);
     report.mass_min_kg += r.mass_min_kg;

@@ -35,10 +35,6 @@ struct Moments {
   Eigen::Matrix3d second = Eigen::Matrix3d::Zero();  // integral of x x^T
 };
 
-// Moments of the mesh about `reference`. `element` gives a triangle's weight w
-// (signed tetrahedron volume or area) from its vertices relative to the
-// reference; the first moment adds w s / first, the second
-// w / second (a a^T + b b^T + c c^T + s s^T), s = a + b + c.
 // One triangle's contribution, its vertices relative to the reference.
 void add(Moments& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double w,
          double first, double second) {
@@ -48,6 +44,10 @@ void add(Moments& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const E
   m.second += w / second * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
 }
 
+// Moments of the mesh about `reference`. `element` gives a triangle's weight w
+// (signed tetrahedron volume or area) from its vertices relative to the
+// reference; the first moment adds w s / first, the second
+// w / second (a a^T + b b^T + c c^T + s s^T), s = a + b + c.
 template <typename Element>
 Moments moments(const Mesh& mesh, const Eigen::Vector3d& reference, double first, double second, Element element) {
   Moments m;

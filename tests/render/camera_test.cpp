@@ -133,6 +133,14 @@ TEST(CamerasJson, RoundTrip) {
   }
   EXPECT_EQ(cameras_from_json("{}").status().code(), StatusCode::kParseError);
   EXPECT_NE(cameras_from_json(R"({"views": [{"width": 3}]})").status().message().find("views[0]"), std::string::npos);
+  // A size that is not a whole number of pixels is refused (a float such as 2e107 used to be cast to int).
+  for (const char* size : {"2.2e107", "640.5", "0", "-3", "99999"}) {
+    const std::string text = std::string(R"({"views": [{"width": )") + size + R"(, "height": 480}]})";
+    Result<std::vector<Camera>> bad = cameras_from_json(text);
+    EXPECT_EQ(bad.status().code(), StatusCode::kParseError) << size;
+    EXPECT_NE(bad.status().message().find("'width' must be a whole number of pixels"), std::string::npos)
+        << bad.status().message();
+  }
 }
 
 // camera_space_normals on a real asset: every surface the camera sees faces

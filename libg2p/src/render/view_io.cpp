@@ -109,6 +109,13 @@ Result<std::vector<Camera>> cameras_from_json(const std::string& json_text) {
     const std::string where = "cameras JSON: views[" + std::to_string(i) + "]";
     try {
       Camera c;
+      // Whole numbers only: a float such as 2e107 read as int is undefined behaviour.
+      for (const char* key : {"width", "height"}) {
+        const json& n = v.at(key);
+        if (!n.is_number_integer() || n.get<long long>() < 1 || n.get<long long>() > 16384)
+          return Status::ParseError(where + ": '" + key + "' must be a whole number of pixels from 1 to 16384, not " +
+                                    n.dump());
+      }
       c.width = v.at("width").get<int>();
       c.height = v.at("height").get<int>();
       c.orthographic = v.at("projection").get<std::string>() == "orthographic";

@@ -78,6 +78,12 @@ Result<ModelCard> read_card(const std::string& path) {
     if (std::filesystem::path(card.model_path).is_relative())
       card.model_path = (std::filesystem::path(path).parent_path() / card.model_path).string();
     const json& input = doc.at("input");
+    for (const char* key : {"width", "height"}) {
+      const json& n = input.at(key);
+      if (!n.is_number_integer() || n.get<long long>() < 1 || n.get<long long>() > 16384)
+        return Status::ParseError(path + ": input." + key + " must be a whole number of pixels from 1 to 16384, not " +
+                                  n.dump());
+    }
     card.width = input.at("width").get<int>();
     card.height = input.at("height").get<int>();
     const std::string order = input.value("channel_order", "RGB");

@@ -156,6 +156,12 @@ TEST(ToolOverrides, ContentsWeighInTheRunAndEveryFolderThatFollows) {
       << r.err;
   const nlohmann::json solid = json_of(dir + "/solid/report.json");
   EXPECT_TRUE(solid["parts"][0]["contents"].is_null());
+  // The list of corrections applied names the fill and that it was left out.
+  const nlohmann::json solid_run = json_of(dir + "/solid/run.json");
+  ASSERT_EQ(solid_run["overrides"].size(), 1u) << solid_run["overrides"].dump();
+  const std::string applied = solid_run["overrides"][0].get<std::string>();
+  EXPECT_EQ(applied.rfind("part 0: contents 50 % full", 0), 0u) << applied;
+  EXPECT_NE(applied.find("; contents left out: the part is solid"), std::string::npos) << applied;
   // The handle weighs what it weighs unfilled (the shell run left it alone).
   EXPECT_NEAR(solid["parts"][0]["mass_kg"].get<double>(),
               json_of(dir + "/shell/report.json")["parts"][0]["mass_kg"].get<double>(), 1e-12);

@@ -315,10 +315,16 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     r.properties = std::move(*report);
     r.properties.size = object_size(r.model);
     if (resolved)
-      for (const PartReport& p : r.properties.parts)
+      for (const PartReport& p : r.properties.parts) {
+        // A fill the part could not take is named beside its correction, so
+        // that the list never claims contents the report left out.
+        std::string left_out;
+        for (const std::string& n : p.properties.notes)
+          if (n.rfind(kContentsLeftOut, 0) == 0) left_out = "; " + n;
         for (const std::string& n : p.properties.notes)
           if (n.rfind("correction: ", 0) == 0)  // "part 2: hollow, 3 mm walls", as the class changes read
-            r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12));
+            r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12) + left_out);
+      }
     clock.report().notes = r.properties.notes;
     for (const std::string& n : r.properties.notes)  // contents asked for and not given
       if (n.find(kContentsLeftOut) != std::string::npos) r.warnings.push_back("properties: " + n);

@@ -89,6 +89,58 @@ TEST(MassProperties, TwoMaterialHammerBalancesInItsHead) {
   EXPECT_GT(hammer.inertia(0, 0), head.inertia(0, 0) + handle.inertia(0, 0));
 }
 
+// combine's parallel-axis terms, products of inertia included, against two
+// checks that share no code with it: one integration of both boxes as one
+// mesh (equal densities), and the boxes' closed forms (unequal densities).
+TEST(MassProperties, CombinedPartsEqualTheWholeAboutItsCentre) {
+  const Eigen::Vector3f a_min(0, 0, 0), a_max(1, 1, 1), b_min(1, 0.25f, 0.5f), b_max(3, 0.75f, 2);
+  std::vector<Eigen::Vector3f> pa, pb;
+  std::vector<std::array<unsigned, 3>> ta, tb;
+  test::box_geometry(a_min, a_max, pa, ta);
+  test::box_geometry(b_min, b_max, pb, tb);
+  std::vector<Eigen::Vector3f> both = pa;
+  both.insert(both.end(), pb.begin(), pb.end());
+  std::vector<std::array<unsigned, 3>> tboth = ta;
+  for (std::array<unsigned, 3> t : tb) tboth.push_back({t[0] + 8u, t[1] + 8u, t[2] + 8u});
+  ASSERT_EQ(pa.size(), 8u);
+  const Mesh box_a = test::mesh_from_geometry(pa, ta), box_b = test::mesh_from_geometry(pb, tb);
+  const MassProperties whole = *solid_mass_properties(test::mesh_from_geometry(both, tboth), 1000.0);
+  const MassProperties joined = combine({*solid_mass_properties(box_a, 1000.0), *solid_mass_properties(box_b, 1000.0)});
+  EXPECT_NEAR(joined.mass_kg, whole.mass_kg, 1e-9);
+  EXPECT_TRUE(joined.center_of_mass.isApprox(whole.center_of_mass, 1e-12));
+  EXPECT_TRUE(joined.inertia.isApprox(whole.inertia, 1e-9)) << joined.inertia << "\nvs\n" << whole.inertia;
+  EXPECT_GT(std::abs(whole.inertia(0, 2)), 10.0);  // the offset boxes have products of inertia
+
+  // Box a of steel, box b of oak: m/12 (b^2 + c^2, ...) about each centre, moved
+  // to the common centre by m (|d|^2 I - d d^T).
+  const MassProperties mixed = combine({*solid_mass_properties(box_a, 7800.0), *solid_mass_properties(box_b, 700.0)});
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  double mass = 0.0;
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  const struct {
+    Eigen::Vector3d lo, hi;
+    double density;
+  } boxes[] = {{a_min.cast<double>(), a_max.cast<double>(), 7800.0},
+               {b_min.cast<double>(), b_max.cast<double>(), 700.0}};
+  for (const auto& b : boxes) {
+    const Eigen::Vector3d s = b.hi - b.lo;
+    mass += b.density * s.prod();
+    moment += b.density * s.prod() * 0.5 * (b.lo + b.hi);
+  }
+  const Eigen::Vector3d centre = moment / mass;
+  for (const auto& b : boxes) {
+    const Eigen::Vector3d s = b.hi - b.lo, d = 0.5 * (b.lo + b.hi) - centre;
+    const double m = b.density * s.prod();
+    const Eigen::Vector3d own(s.y() * s.y() + s.z() * s.z(), s.x() * s.x() + s.z() * s.z(),
+                              s.x() * s.x() + s.y() * s.y());
+    expected += Eigen::Matrix3d(own.asDiagonal()) * (m / 12.0);
+    expected += m * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  }
+  EXPECT_NEAR(mixed.mass_kg, mass, 1e-9 * mass);
+  EXPECT_TRUE(mixed.center_of_mass.isApprox(centre, 1e-12));
+  EXPECT_TRUE(mixed.inertia.isApprox(expected, 1e-9)) << mixed.inertia << "\nvs\n" << expected;
+}
+
 TEST(MassProperties, AFillSettlesAtTheBottomOfItsVolume) {
   // A 1 x 1 x 2 m tank half full of water holds a 1 m cube of water at the bottom.
   const Mesh tank = test::box_mesh({-0.5f, -0.5f, 0.f}, {0.5f, 0.5f, 2.f});

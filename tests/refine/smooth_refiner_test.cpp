@@ -81,18 +81,21 @@ TEST_P(SmoothOnAssets, NeverWorsensOracleLabelsAndRepairsNoise) {
   const double before = accuracy(s, clean.labels.seen, clean.labels.label);
   const double after = accuracy(s, clean.labels.seen, r->labels);
   EXPECT_GE(after, before - 0.005) << GetParam();
-  // Heavy noise (45% of pixels, 3 views): smoothing raises the accuracy.
+  // Heavy noise (45% of pixels, 3 views): smoothing raises the accuracy by
+  // more than 2 points on every asset (measured: 2.6 on the avocado to 15 on
+  // SheenChair), which a refiner that changes nothing would not.
   const Projection noisy = *project(s.model.mesh, s.views, oracle_maps(s, 0.45, 7), 12, no_merging);
   Result<RefineResult> fixed = refine_with("smooth", noisy, s);
   ASSERT_TRUE(fixed.ok());
   const double noisy_before = accuracy(s, noisy.labels.seen, noisy.labels.label);
   const double noisy_after = accuracy(s, noisy.labels.seen, fixed->labels);
-  EXPECT_GE(noisy_after, noisy_before) << GetParam();
+  EXPECT_GT(noisy_after, noisy_before + 0.02) << GetParam();
   std::printf("%s: oracle %.4f -> %.4f; 45%% noise %.4f -> %.4f\n", GetParam(), before, after, noisy_before,
               noisy_after);
   // Every change is recorded, with a reason.
   int changed = 0;
   for (std::size_t f = 0; f < fixed->labels.size(); ++f) changed += fixed->labels[f] != noisy.labels.label[f];
+  EXPECT_GT(changed, 0);
   ASSERT_EQ(static_cast<int>(fixed->changes.size()), changed);
   for (const LabelChange& c : fixed->changes) {
     EXPECT_EQ(c.from, noisy.labels.label[c.face]);

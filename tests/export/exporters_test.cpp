@@ -312,8 +312,10 @@ TEST(Exporters, UrdfdomAndCheckUrdfReadTheUrdf) {
   auto link = model->getLink("hammer");
   ASSERT_NE(link, nullptr);
   ASSERT_NE(link->inertial, nullptr);
-  // urdfdom's exporter writes 6 significant digits: up to 5e-6 relative.
-  expect_relative(link->inertial->mass, asset.total.mass_kg, 6e-6, "URDF mass");
+  // The inertial is written with 9 significant digits (urdfdom alone writes 6).
+  expect_relative(link->inertial->mass, asset.total.mass_kg, 1e-8, "URDF mass");
+  expect_relative(link->inertial->ixx, asset.total.inertia(0, 0), 1e-8, "URDF ixx");
+  expect_relative(link->inertial->iyz, asset.total.inertia(1, 2), 1e-8, "URDF iyz");
   EXPECT_EQ(link->visual_array.size(), asset.parts.size());
   std::size_t hulls = 0;
   for (const AssetPart& p : asset.parts) hulls += p.collision.hulls.size();
@@ -331,6 +333,39 @@ TEST(Exporters, UrdfdomAndCheckUrdfReadTheUrdf) {
   }
   if (std::filesystem::exists("/usr/bin/check_urdf"))
     EXPECT_EQ(std::system(("/usr/bin/check_urdf " + dir + "/hammer.urdf > /dev/null").c_str()), 0);
+
+  // MuJoCo's URDF importer finds the meshes in meshes/ and compiles the link
+  // with libg2p's mass properties.
+  char error[1000] = "";
+  mjModel* m = mj_loadXML((dir + "/hammer.urdf").c_str(), nullptr, error, sizeof error);
+  ASSERT_NE(m, nullptr) << error;
+  EXPECT_EQ(m->ngeom, static_cast<int>(hulls));
+  expect_relative(m->body_mass[1], asset.total.mass_kg, 1e-6, "MuJoCo mass from the URDF");
+  mj_deleteModel(m);
+}
+
+// A thin plate's principal moments sit at the triangle inequality's edge
+// (A + B = C); six digits could round them past it and MuJoCo would refuse the
+// URDF, nine keep them.
+TEST(Exporters, AThinPlatesUrdfInertiaKeepsItsTriangleInequality) {
+  SimulationAsset plate = hammer_asset(kMetal);
+  plate.name = "plate";
+  const double m = 0.4, a = 1.0, b = 0.2, c = 0.0002;  // a 1 x 0.2 m sheet 0.2 mm thick
+  plate.total.mass_kg = m;
+  plate.total.center_of_mass = Eigen::Vector3d(0.123456789, 0, 0.001);
+  plate.total.inertia =
+      Eigen::Vector3d(m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12).asDiagonal();
+  const std::string dir = test::scratch_dir("ExportThinUrdf");
+  ASSERT_TRUE(write_asset(dir, plate, {"urdf"}).ok());
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(test::read_file(dir + "/plate.urdf"));
+  ASSERT_NE(model, nullptr);
+  const urdf::InertialSharedPtr in = model->getLink("plate")->inertial;
+  EXPECT_GE(in->ixx + in->iyy, in->izz);
+  EXPECT_NEAR(in->origin.position.x, 0.123456789, 1e-9);
+  char error[1000] = "";
+  mjModel* mj = mj_loadXML((dir + "/plate.urdf").c_str(), nullptr, error, sizeof error);
+  ASSERT_NE(mj, nullptr) << error;
+  mj_deleteModel(mj);
 }
 
 #ifdef G2P_TEST_WITH_SDFORMAT
@@ -479,6 +514,45 @@ TEST(Exporters, GlbWritesVertexColoursAsColor0) {
   const test::ValidatorRun validator = test::run_gltf_validator(path);
   if (validator.available)
     EXPECT_NE(validator.run.out.find(": 0 errors, 0 warnings"), std::string::npos) << validator.run.out;
+}
+
+// A body of 64 small convex pieces lying flat touches the floor at more points
+// than MuJoCo 2.2's default contact buffer (nconmax 100) holds; the drop check
+// says that contacts were dropped instead of reporting a clean rest.
+TEST(Exporters, TheDropCheckReportsWhenMujocosContactBufferOverflows) {
+  const std::string dir = test::scratch_dir("ExportContactFull");
+  std::string geoms;
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 8; ++j)
+      geoms += "      <geom class=\"g2p_collision\" mesh=\"tile\" pos=\"" + std::to_string(0.03 * i) + " " +
+               std::to_string(0.03 * j) + " 0\"/>\n";
+  test::write_file(dir + "/tiles.xml",
+                   "<mujoco model=\"tiles\">\n  <compiler meshdir=\"meshes\"/>\n  <default>\n    <default "
+                   "class=\"g2p_collision\"><geom type=\"mesh\" group=\"3\" contype=\"1\" conaffinity=\"1\"/>"
+                   "</default>\n  </default>\n  <asset>\n    <mesh name=\"tile\" vertex=\"0 0 0  0.02 0 0  0 0.02 0  "
+                   "0.02 0.02 0  0 0 0.01  0.02 0 0.01  0 0.02 0.01  0.02 0.02 0.01\"/>\n  </asset>\n  <worldbody>\n"
+                   "    <body name=\"tiles\">\n      <freejoint/>\n" +
+                       geoms + "    </body>\n  </worldbody>\n</mujoco>\n");
+  const auto log_size = [] {
+    std::error_code ec;
+    const auto n = std::filesystem::file_size("MUJOCO_LOG.TXT", ec);
+    return ec ? std::uintmax_t{0} : n;
+  };
+  const std::uintmax_t log_before = log_size();
+  Result<EngineCheck> c = check_in_mujoco(dir + "/tiles.xml", 0.05, 1.0);
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  ASSERT_TRUE(c->dropped);
+  ASSERT_FALSE(c->warnings.empty());
+  EXPECT_NE(c->warnings.front().find("contact buffer was full"), std::string::npos) << c->warnings.front();
+  // MuJoCo's own log file in the working directory did not grow.
+  EXPECT_EQ(log_size(), log_before);
+  // The hammer's drop is clean.
+  const SimulationAsset hammer = hammer_asset(kMetal);
+  const std::string hdir = test::scratch_dir("ExportCleanDrop");
+  ASSERT_TRUE(write_asset(hdir, hammer, {"mjcf"}).ok());
+  Result<EngineCheck> clean = check_in_mujoco(hdir + "/hammer.xml");
+  ASSERT_TRUE(clean.ok()) << clean.status().to_string();
+  EXPECT_TRUE(clean->warnings.empty()) << clean->warnings.front();
 }
 
 TEST(Exporters, BadInputIsRefused) {

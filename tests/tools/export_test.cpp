@@ -35,6 +35,12 @@ TEST(ToolExport, WritesAssetsThatValidateInMujoco) {
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("PASS"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("MuJoCo"), std::string::npos) << r.out;
+  // A second MJCF beside the exported one (a user's copy with a floor, say) is
+  // not picked at random: validate names both and stops.
+  std::filesystem::copy_file(dir + "/moved/hammer.xml", dir + "/moved/hammer_floor.xml");
+  r = run_tool("validate " + quote(dir + "/moved"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("several MJCF (.xml) files (hammer.xml, hammer_floor.xml)"), std::string::npos) << r.err;
 }
 
 TEST(ToolExport, StartsFromAPropertiesOutput) {

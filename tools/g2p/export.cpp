@@ -224,12 +224,22 @@ int run_validate(const ValidateArgs& args) {
               << (fs::exists(args.dir, ec) ? ": not a folder (give a g2p export folder)\n" : ": no such folder\n");
     return kExitFailure;
   }
+  std::vector<std::string> found;
   for (const auto& e : fs::directory_iterator(args.dir, ec))
-    if (e.path().extension() == ".xml") mjcf = e.path().string();
-  if (ec || mjcf.empty()) {
+    if (e.path().extension() == ".xml") found.push_back(e.path().filename().string());
+  if (ec || found.empty()) {
     std::cerr << "g2p validate: error: " << args.dir << ": no MJCF (.xml) file (is this a g2p export folder?)\n";
     return kExitFailure;
   }
+  if (found.size() > 1) {
+    std::sort(found.begin(), found.end());
+    std::string names;
+    for (const std::string& f : found) names += (names.empty() ? "" : ", ") + f;
+    std::cerr << "g2p validate: error: " << args.dir << ": several MJCF (.xml) files (" << names
+              << "); validate reads the one g2p export wrote: move the others out\n";
+    return kExitFailure;
+  }
+  mjcf = (fs::path(args.dir) / found.front()).string();
   if (!have_mujoco()) {
     std::cerr << "g2p validate: error: this libg2p was built without MuJoCo (G2P_WITH_MUJOCO=OFF)\n";
     return kExitFailure;
@@ -241,7 +251,7 @@ int run_validate(const ValidateArgs& args) {
     return kExitFailure;
   }
   // Without a free joint nothing is dropped; only the numbers are compared.
-  bool pass = !c->dropped || (c->finite && c->resting_lowest_m > -0.01);
+  bool pass = !c->dropped || (c->finite && c->resting_lowest_m > -0.01 && c->warnings.empty());
   std::printf("%s: %s\n", mjcf.c_str(), c->engine.c_str());
   std::printf("  %-24s %-36s %s\n", "", "engine", "libg2p (report.json)");
   std::ifstream in(args.dir + "/report.json");
@@ -274,6 +284,7 @@ int run_validate(const ValidateArgs& args) {
         "  drop from %.3g m for %.3g s: lowest point %.4g m, at rest %.4g m above the plane, final speed %.3g m/s%s\n",
         args.height, args.seconds, c->lowest_point_m, c->resting_lowest_m, c->final_speed_m_s,
         c->finite ? "" : ", NOT FINITE");
+  for (const std::string& w : c->warnings) std::printf("  MuJoCo warned during the drop: %s\n", w.c_str());
   std::printf("%s\n", pass ? "PASS" : "FAIL");
   return pass ? kExitOk : kExitFailure;
 }

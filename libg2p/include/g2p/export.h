@@ -121,7 +121,11 @@ struct EngineCheck {
   double resting_lowest_m = 0.0;  // the lowest vertex's height at the end (soft contacts: slightly < 0)
   double final_speed_m_s = 0.0;   // of the centre of mass at the end
   double final_height_m = 0.0;    // of the centre of mass at the end
-  std::string engine;             // "MuJoCo 2.2.2"
+  // What the engine warned of during the drop: a full contact or constraint
+  // buffer (contacts were dropped: too many hulls touching at once for the
+  // engine's default <size nconmax>), bad accelerations. Empty when clean.
+  std::vector<std::string> warnings;
+  std::string engine;  // "MuJoCo 2.2.2"
 };
 
 // Whether libg2p was built with MuJoCo.

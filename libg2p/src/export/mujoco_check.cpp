@@ -63,6 +63,7 @@ Result<mjModel*> load_mjcf_text(const std::string& xml, const std::string& what)
 bool have_mujoco() { return true; }
 
 Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_height_m, double drop_seconds) {
+  const detail::QuietMujocoWarnings quiet;
   Result<std::string> text = detail::mjcf_with_absolute_meshdir(mjcf_path);
   if (!text.ok()) return text.status();
   std::string xml = *text;
@@ -125,6 +126,20 @@ Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double drop_he
   out.resting_lowest_m = lowest_vertex(m, d) - floor_z;
   out.final_speed_m_s = Eigen::Vector3d(d->qvel[0], d->qvel[1], d->qvel[2]).norm();
   out.final_height_m = d->xipos[3 + 2] - floor_z;
+  const struct {
+    int index;
+    const char* what;
+  } warnings[] = {
+      {mjWARN_CONTACTFULL, "the contact buffer was full (nconmax), so contacts were dropped"},
+      {mjWARN_CNSTRFULL, "the constraint buffer was full (njmax), so constraints were dropped"},
+      {mjWARN_BADQACC, "the accelerations became bad (NaN or huge) and the state was reset"},
+      {mjWARN_BADQVEL, "the velocities became bad (NaN or huge) and the state was reset"},
+      {mjWARN_BADQPOS, "the positions became bad (NaN or huge) and the state was reset"},
+  };
+  for (const auto& w : warnings)
+    if (d->warning[w.index].number > 0)
+      out.warnings.push_back(std::string(w.what) + " (" + std::to_string(d->warning[w.index].number) + " times; " +
+                             std::to_string(m->nconmax) + " contacts, " + std::to_string(m->njmax) + " rows)");
   mj_deleteData(d);
   mj_deleteModel(m);
   return out;

@@ -32,6 +32,7 @@ std::string num(double v) {
 }  // namespace
 
 Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path, const ContactCheckOptions& o) {
+  const detail::QuietMujocoWarnings quiet;
   if (o.grid < 0 || o.grid > 50) return Status::InvalidArgument("--balls must be 0..50 (balls per side of the grid)");
   if (o.grid == 0 && o.points.empty()) return Status::InvalidArgument("no probe balls: give --balls N or positions");
   if (!(o.ball_radius_m >= 0) || !(o.seconds > 0) || !(o.ball_density_kg_m3 > 0) || !(o.rest_speed_m_s > 0))

@@ -9,6 +9,23 @@
 
 namespace g2p::detail {
 
+// MuJoCo reports warnings through a global handler that, when the program has
+// set none, appends them to MUJOCO_LOG.TXT in the working directory. The checks
+// read mjData::warning instead, so while one runs, a program without its own
+// handler gets none of those files. (A handler the program set is kept.)
+class QuietMujocoWarnings {
+ public:
+  QuietMujocoWarnings() : previous_(mju_user_warning) {
+    if (previous_ == nullptr) mju_user_warning = [](const char*) {};
+  }
+  ~QuietMujocoWarnings() { mju_user_warning = previous_; }
+  QuietMujocoWarnings(const QuietMujocoWarnings&) = delete;
+  QuietMujocoWarnings& operator=(const QuietMujocoWarnings&) = delete;
+
+ private:
+  void (*previous_)(const char*);
+};
+
 // A geom that collides with something (the exporter's visual geoms have
 // contype and conaffinity 0).
 inline bool collides(const mjModel* m, int geom) {

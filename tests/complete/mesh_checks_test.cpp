@@ -64,6 +64,28 @@ TEST(MeshChecks, FindsHolesFlipsNonManifoldVerticesAndIntersections) {
   EXPECT_FALSE(ov.watertight());
 }
 
+// A surface folded onto itself (the partition completer once simplified a
+// sofa's foot into two triangles and their reverses) is closed and manifold
+// and encloses a volume of rounding error: not outward, not watertight, as the
+// mass properties would refuse it. A thin but real solid still passes.
+TEST(MeshChecks, ASurfaceFoldedOntoItselfEnclosesNothing) {
+  const auto tetrahedron = [](float height) {
+    Mesh m;
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3f, 0.3f, height}};
+    m.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+    return m;
+  };
+  const MeshChecks folded = check_closed_mesh(tetrahedron(1e-13f));
+  EXPECT_TRUE(folded.closed && folded.manifold);
+  EXPECT_GT(folded.volume_m3, 0.0);
+  EXPECT_FALSE(folded.outward);
+  EXPECT_FALSE(folded.watertight());
+  const MeshChecks thin = check_closed_mesh(tetrahedron(1e-4f));  // 0.1 mm over a 1 m base
+  EXPECT_TRUE(thin.outward);
+  EXPECT_TRUE(thin.watertight());
+  EXPECT_NEAR(thin.volume_m3, 1e-4 / 6.0, 1e-9);
+}
+
 TEST(MeshChecks, DistanceToThePatch) {
   const Mesh box = test::box_mesh({0, 0, 0}, {1, 1, 1});
   const Mesh far = test::box_mesh({0, 0, 3}, {1, 1, 4});

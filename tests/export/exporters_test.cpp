@@ -586,6 +586,10 @@ TEST_P(ExportAssets, MujocoAgreesAndTheDropSettles) {
   const std::vector<Part> parts = partition(model.mesh, *build_face_graph(model.mesh), labels, face_part);
   const Completion completion = *(*make_completer("partition"))->complete({&model.mesh, &parts, &table});
   const PropertiesReport report = *estimate_properties(model.mesh, parts, completion, table, **make_estimator("table"));
+  // A part whose closed volume passed its checks has a mass (the checks and
+  // the mass properties agree on what encloses a volume).
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    if (completion.parts[i].ok) EXPECT_GT(report.parts[i].mass.mass_kg, 0.0) << name << " part " << i;
   const SimulationAsset asset = *make_asset(name, model.mesh, parts, completion, report, table);
   const std::string dir = test::scratch_dir("ExportAsset" + name);
   ASSERT_TRUE(write_asset(dir, asset, {"mjcf", "urdf", "sdf"}).ok());

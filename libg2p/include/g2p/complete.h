@@ -33,7 +33,10 @@ struct CompletionInput {
 struct G2P_API MeshChecks {
   bool closed = false;    // every edge has exactly two triangles, wound in opposite directions
   bool manifold = false;  // closed, and the triangles around every vertex form a single fan
-  bool outward = false;   // positive enclosed volume (normals point out)
+  // Enclosed volume above 1e-12 of the bounding-box diagonal cubed (normals
+  // point out); a surface folded onto itself (a triangle and its reverse)
+  // encloses nothing and is not outward. The mass properties use the same bound.
+  bool outward = false;
   bool self_intersection_free = false;
   bool self_intersections_checked = false;  // false when the mesh was too large to test (see notes)
   int num_components = 0;                   // edge-connected pieces

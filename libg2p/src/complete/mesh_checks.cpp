@@ -105,7 +105,8 @@ MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshChec
     six_v += a.dot(b.cross(d));
   }
   c.volume_m3 = six_v / 6.0;
-  c.outward = c.closed && c.volume_m3 > 0;
+  const double diagonal = bounds(mesh).diagonal().norm();
+  c.outward = c.closed && c.volume_m3 > 1e-12 * diagonal * diagonal * diagonal;
 
   if (nf <= options.max_faces_for_intersections) {
     const detail::TriangleBins bins(mesh);

@@ -591,9 +591,11 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
         done = true;
         break;
       }
-      out.notes.push_back("partition: simplifying by " + std::to_string(tolerance) + " cells made " +
-                          std::to_string(checks.num_self_intersections) +
-                          " triangle pairs touch or intersect; the dense surface is kept");
+      out.notes.push_back("partition: simplifying by " + std::to_string(tolerance) + " cells " +
+                          (checks.outward ? "made " + std::to_string(checks.num_self_intersections) +
+                                                " triangle pairs touch or intersect"
+                                          : std::string("folded the surface onto itself (no volume left)")) +
+                          "; the dense surface is kept");
     }
     if (!done) out.checks = check_closed_mesh(out.mesh, &patch);
     out.ok = out.checks.watertight() && out.checks.relative_distance <= max_relative_distance_;

@@ -278,7 +278,8 @@ TEST(VlmHelpers, RedactUrl) {
   EXPECT_EQ(redact_url("http://127.0.0.1:8000/v1"), "http://127.0.0.1:8000/v1");
   EXPECT_EQ(redact_url("https://user:pass@host/v1"), "https://***@host/v1");
   EXPECT_EQ(redact_url("https://host/v1?key=abc&api-version=2&flag"), "https://host/v1?key=***&api-version=***&flag");
-  EXPECT_EQ(redact_url("https://u@host:443/p?token=t#frag"), "https://***@host:443/p?token=***#frag");
+  EXPECT_EQ(redact_url("https://u@host:443/p?token=t#frag"), "https://***@host:443/p?token=***#***");
+  EXPECT_EQ(redact_url("https://host/v1#access_token=PW4SECRET"), "https://host/v1#***");
   EXPECT_EQ(redact_url("https://host/a@b"), "https://host/a@b");  // an @ in the path is no user
 }
 
@@ -291,6 +292,35 @@ TEST(VlmRefiner, AKeyInTheUrlReachesTheServerAndNoMessage) {
   EXPECT_EQ(server.attempts(), 1);  // the endpoint's path went before the query: the server was reached
   EXPECT_EQ(notes(*r).find("qk-secret-99"), std::string::npos) << notes(*r);
   EXPECT_NE(notes(*r).find("chat/completions?key=***"), std::string::npos) << notes(*r);
+}
+
+// Servers echo what they were sent in their errors ("Incorrect API key
+// provided: sk-..."), and error pages are cut to 300 bytes: the message keeps
+// neither the key nor a broken character, so JSON writers and logs take it.
+TEST(VlmRefiner, AServersErrorNeitherRepeatsTheKeyNorBreaksTheText) {
+  const Scene s = hammer();
+  ::setenv("G2P_TEST_VLM_KEY", "sk-SECRETKEY123", 1);
+  FakeVlmServer echo([](int, const json&, httplib::Response& res) {
+    res.status = 401;
+    res.set_content("{\"error\": \"Incorrect API key provided: sk-SECRETKEY123 (header: Bearer sk-SECRETKEY123)\"}",
+                    "application/json");
+  });
+  Result<RefineResult> r = run(s, echo.url(), {{"retries", "0"}});
+  ::unsetenv("G2P_TEST_VLM_KEY");
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_TRUE(r->fell_back);
+  EXPECT_EQ(notes(*r).find("SECRETKEY123"), std::string::npos) << notes(*r);
+  EXPECT_NE(notes(*r).find("HTTP 401: {\"error\": \"Incorrect API key provided: ***"), std::string::npos) << notes(*r);
+
+  // 299 bytes, then an "é" that the 300-byte cut would split, then a Latin-1 byte.
+  FakeVlmServer page([](int, const json&, httplib::Response& res) {
+    res.status = 403;
+    res.set_content(std::string(299, 'a') + "\xc3\xa9 Zugriff verweigert \xe9", "text/html");
+  });
+  r = run(s, page.url(), {{"retries", "0"}});
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_NE(notes(*r).find(std::string(299, 'a') + "..."), std::string::npos) << notes(*r);
+  EXPECT_NO_THROW(json(notes(*r)).dump());  // strict: throws on bytes that are not UTF-8
 }
 
 TEST(VlmHelpers, JsonExtractionAndBase64) {

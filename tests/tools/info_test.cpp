@@ -36,6 +36,26 @@ TEST(ToolInfo, JsonSummary) {
   EXPECT_NEAR(j["bounds_m"]["max"][2].get<double>(), 0.34, 1e-6);
 }
 
+// OBJ and MTL files from older tools carry Latin-1 names, and file names can
+// be Latin-1 too. Both once threw out of the JSON writers (an abort); names
+// are now read as Latin-1 when they are not UTF-8, and paths are written
+// with U+FFFD in place of the bytes that are not.
+TEST(ToolInfo, Latin1MaterialAndFileNamesAreWrittenAsUtf8) {
+  const std::string dir = test::scratch_dir("ToolInfoLatin1");
+  const std::string obj =
+      "mtllib m.mtl\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nusemtl Caf\xe9\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+  test::write_file(dir + "/m.mtl", "newmtl Caf\xe9\nKd 0.8 0.2 0.2\n");
+  test::write_file(dir + "/caf\xe9.obj", obj);
+  ToolRun r = run_tool("info --json " + quote(dir + "/caf\xe9.obj"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["materials"][0]["name"], "Caf\u00e9");
+  r = run_tool("run " + quote(dir + "/caf\xe9.obj") + " -o " + quote(dir + "/out") + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json run = nlohmann::json::parse(test::read_file(dir + "/out/run.json"));
+  EXPECT_NE(run["model"].get<std::string>().find("caf\uFFFD.obj"), std::string::npos) << run["model"];
+}
+
 TEST(ToolInfo, EveryMalformedGltfFailsWithAMessage) {
   int checked = 0;
   const std::string root = test::assimp_model("glTF2");

@@ -19,6 +19,7 @@
 #include "g2p/project.h"
 #include "g2p/regions.h"
 #include "g2p/segment.h"
+#include "json_out.h"
 #include "stage_outputs.h"
 
 namespace g2p::cli {
@@ -268,7 +269,7 @@ int run_eval_seg(const EvalArgs& args) {
           {"accuracy", calibration.accuracy()}}},
         {"models", per_model}};
     std::ofstream out(args.json_out, std::ios::binary | std::ios::trunc);
-    out << doc.dump(2) << "\n";
+    out << json_out(doc) << "\n";
     if (!out) {
       std::cerr << "g2p eval seg: error: " << args.json_out << ": cannot write\n";
       return kExitFailure;
@@ -329,7 +330,7 @@ int run_eval_mass(const MassArgs& args) {
   if (!args.json_out.empty()) {
     const nlohmann::json j = {
         {"objects", e->objects}, {"ade_kg", e->ade_kg}, {"alde", e->alde}, {"ape", e->ape}, {"mnre", e->mnre}};
-    if (Status s = write_text_file(args.json_out, j.dump(2) + "\n"); !s.ok()) {
+    if (Status s = write_text_file(args.json_out, json_out(j) + "\n"); !s.ok()) {
       std::cerr << "g2p eval mass: error: " << s.to_string() << "\n";
       return kExitFailure;
     }
@@ -466,7 +467,7 @@ int run_eval_compare(const CompareArgs& args) {
                               {"resamples", d->resamples},
                               {"models", d->models},
                               {"iou_per_class", per_class}};
-    if (Status s = write_text_file(args.json_out, j.dump(2) + "\n"); !s.ok()) {
+    if (Status s = write_text_file(args.json_out, json_out(j) + "\n"); !s.ok()) {
       std::cerr << "g2p eval compare: error: " << s.to_string() << "\n";
       return kExitFailure;
     }

@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
+#include "json_out.h"
 #include "stage_inputs.h"
 
 namespace g2p::cli {
@@ -205,7 +206,7 @@ int run_contact_check(const ValidateArgs& args, const std::string& mjcf) {
                  {"resting_lowest_m", c->drop.resting_lowest_m},
                  {"final_speed_m_s", c->drop.final_speed_m_s},
                  {"object_above_plane", c->object_above_plane}};
-    if (Status s = write_text_file(args.json, j.dump(2) + "\n"); !s.ok()) {
+    if (Status s = write_text_file(args.json, json_out(j) + "\n"); !s.ok()) {
       std::cerr << "g2p validate: error: --json: " << s.to_string() << "\n";
       return kExitFailure;
     }

@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/io.h"
+#include "json_out.h"
 
 namespace g2p::cli {
 namespace {
@@ -99,7 +100,7 @@ int run_info(const InfoArgs& args) {
   for (const FaceSource& s : model->mesh.face_source)
     if (s.material >= 0 && s.material < static_cast<int>(faces_per_material.size())) ++faces_per_material[s.material];
   if (args.json)
-    std::cout << to_json(*model, faces_per_material).dump(2) << "\n";
+    std::cout << json_out(to_json(*model, faces_per_material)) << "\n";
   else
     print_text(*model, faces_per_material);
   return kExitOk;

@@ -1,6 +1,9 @@
 // g2p: command-line front end of libg2p. Thin: parses flags into the library's
 // option structs, calls the library, reports and exits non-zero on failure.
+#include <exception>
 #include <iostream>
+#include <new>
+#include <string>
 
 #include "commands.h"
 #include "g2p/version.h"
@@ -29,5 +32,18 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? g2p::cli::kExitOk : g2p::cli::kExitUsage;
   }
-  return run ? run() : g2p::cli::kExitUsage;
+  if (!run) return g2p::cli::kExitUsage;
+  // The commands report failures as Status; an exception reaching here is out
+  // of memory or a bug. Catching it unwinds the stack, so a command's
+  // temporary folders are removed, and the user gets a line, not an abort.
+  const std::string command =
+      app.get_subcommands().empty() ? std::string("g2p") : "g2p " + app.get_subcommands().front()->get_name();
+  try {
+    return run();
+  } catch (const std::bad_alloc&) {
+    std::cerr << command << ": error: out of memory (fewer or smaller views, --views and --resolution, need less)\n";
+  } catch (const std::exception& e) {
+    std::cerr << command << ": internal error: " << e.what() << " (a bug in g2p; please report it with the command)\n";
+  }
+  return g2p::cli::kExitFailure;
 }

@@ -9,6 +9,7 @@
 #include "common.h"
 #include "g2p/project.h"
 #include "g2p/refine.h"
+#include "json_out.h"
 #include "stage_outputs.h"
 
 namespace g2p::cli {
@@ -86,7 +87,7 @@ int run_project(const ProjectArgs& args) {
   Status s = write_views(args.out, *views);
   if (s.ok()) s = write_label_maps(args.out + "/segmented", maps, *table);
   if (s.ok()) s = write_projection(args.out, *model, *views, *projection, *table, refine_report);
-  if (s.ok()) s = write_text_file(args.out + "/project.json", manifest.dump(2) + "\n");
+  if (s.ok()) s = write_text_file(args.out + "/project.json", json_out(manifest) + "\n");
   if (!s.ok()) return fail(s);
   int seen = 0;
   for (std::uint8_t v : projection->labels.seen) seen += v;

@@ -14,6 +14,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "json_out.h"
 #include "stage_outputs.h"
 #include "stage_overrides.h"
 
@@ -134,7 +135,7 @@ int run_refine(const RefineCommandArgs& args) {
   nlohmann::json refined_manifest = manifest;
   refined_manifest["refined_from"] = std::filesystem::absolute(args.dir).string();
   refined_manifest["refiner"] = args.refine.name;
-  if (s.ok()) s = write_text_file(out + "/project.json", refined_manifest.dump(2) + "\n");
+  if (s.ok()) s = write_text_file(out + "/project.json", json_out(refined_manifest) + "\n");
   if (s.ok()) s = write_overrides(out, corrections, *table);
   if (!s.ok()) return fail(s);
   std::cout << "refined with '" << args.refine.name << "': " << projection->parts.size() << " parts -> " << out << "\n";

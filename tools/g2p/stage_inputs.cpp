@@ -1,4 +1,5 @@
 #include "stage_inputs.h"
+#include "json_out.h"
 
 #include <chrono>
 #include <filesystem>
@@ -155,7 +156,7 @@ Status write_properties_manifest(const std::string& out, const LabelledSourceArg
                             {"truth", source.truth.empty() ? "" : fs::absolute(source.truth).string()},
                             {"key", source.key},
                             {"materials", source.materials.empty() ? "" : fs::absolute(source.materials).string()}};
-  return write_text_file(out + "/properties.json", j.dump(2) + "\n");
+  return write_text_file(out + "/properties.json", json_out(j) + "\n");
 }
 
 bool is_properties_folder(const std::string& dir) {

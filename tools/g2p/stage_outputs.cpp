@@ -1,4 +1,5 @@
 #include "stage_outputs.h"
+#include "json_out.h"
 
 #include <iostream>
 
@@ -97,7 +98,7 @@ int refine_projection(const std::string& command, const RefineArgs& args, const 
 Status write_projection(const std::string& out, const Model& model, const std::vector<View>& views,
                         const Projection& projection, const MaterialTable& table, const nlohmann::json& report) {
   G2P_RETURN_IF_ERROR(g2p::write_projection(out, model, views, projection, table));
-  return write_text_file(out + "/refine.json", report.dump(2) + "\n");
+  return write_text_file(out + "/refine.json", json_out(report) + "\n");
 }
 
 void print_parts(const Projection& projection, const MaterialTable& table) {

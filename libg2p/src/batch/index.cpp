@@ -10,6 +10,7 @@
 
 #include "core/csv.h"
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/batch.h"
 #include "g2p/pipeline.h"
 #include "g2p/version.h"
@@ -179,7 +180,8 @@ Status write_batch_index(const std::string& output_dir, const std::vector<BatchR
   nlohmann::json assets = nlohmann::json::array();
   for (const BatchRow& r : rows) assets.push_back(row_json(r));
   const nlohmann::json j = {{"format", kIndexFormat}, {"version", 1}, {"g2p", version()}, {"assets", assets}};
-  G2P_RETURN_IF_ERROR(detail::write_file_atomically((fs::path(output_dir) / "index.json").string(), j.dump(2) + "\n"));
+  G2P_RETURN_IF_ERROR(
+      detail::write_file_atomically((fs::path(output_dir) / "index.json").string(), detail::json_text(j, 2) + "\n"));
   return detail::write_file_atomically((fs::path(output_dir) / "index.csv").string(), index_csv(rows));
 }
 

@@ -5,6 +5,7 @@
 
 #include "complete/backends.h"
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/io.h"
 
 namespace g2p {
@@ -177,7 +178,7 @@ Status write_completion(const std::string& dir, const Completion& completion, co
     parts.push_back(j);
   }
   doc["parts"] = parts;
-  return write_text_file(dir + "/completion.json", doc.dump(2) + "\n");
+  return write_text_file(dir + "/completion.json", detail::json_text(doc, 2) + "\n");
 }
 
 }  // namespace g2p

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/materials.h"
 
 namespace g2p {
@@ -237,7 +238,7 @@ std::string MaterialTable::to_json() const {
     if (c.max_wall_thickness_m > 0) classes.back()["max_wall_thickness_m"] = c.max_wall_thickness_m;
   }
   json doc = {{"format", kFormat}, {"version", kFormatVersion}, {"name", name_}, {"classes", classes}};
-  return doc.dump(2) + "\n";
+  return detail::json_text(doc, 2) + "\n";
 }
 
 Status MaterialTable::save(const std::string& path) const { return detail::write_file_atomically(path, to_json()); }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/json_text.h"
 #include "g2p/eval.h"
 
 namespace g2p {
@@ -135,7 +136,7 @@ std::string ConfusionMatrix::to_json(const MaterialTable& table) const {
               {"accuracy", std::isnan(a) ? json(nullptr) : json(a)},
               {"total_weight", total()},
               {"matrix_rows_truth_columns_predicted_then_unknown", matrix}};
-  return doc.dump(2) + "\n";
+  return detail::json_text(doc, 2) + "\n";
 }
 
 }  // namespace g2p

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "export/asset_names.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
@@ -160,7 +161,7 @@ std::string asset_report_json(const PropertiesReport& report, const SimulationAs
         {"visual", {{"triangles", p.visual.num_faces()}, {"file", "meshes/" + p.name + "_visual.obj"}}},
         {"collision", collision}};
   }
-  return doc.dump(2) + "\n";
+  return detail::json_text(doc, 2) + "\n";
 }
 
 Status write_asset_report(const std::string& path, const PropertiesReport& report, const SimulationAsset& asset,

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "export/asset_names.h"
 #include "g2p/export.h"
 #include "io/image_io.h"
@@ -79,7 +80,7 @@ class GlbBuilder {
   std::string glb() {
     while (bin.size() % 4) bin.push_back('\0');
     doc["buffers"] = json::array({{{"byteLength", bin.size()}}});
-    std::string text = doc.dump();
+    std::string text = detail::json_text(doc);
     while (text.size() % 4) text.push_back(' ');
     std::string out;
     auto u32 = [&](std::uint32_t v) {

@@ -21,6 +21,7 @@
 #include <unordered_set>
 
 #include "assimp_convert.h"
+#include "core/utf8.h"
 #include "g2p/io.h"
 #include "gltf_layout.h"
 #include "real_size.h"
@@ -205,8 +206,8 @@ class SceneFlattener {
     const Eigen::Matrix3d normal_matrix = linear.inverse().transpose();
 
     SourcePrimitive prim;
-    prim.mesh_name = src.mName.C_Str();
-    prim.node_name = node.mName.C_Str();
+    prim.mesh_name = detail::utf8_name(src.mName.C_Str());
+    prim.node_name = detail::utf8_name(node.mName.C_Str());
     prim.mesh = mesh_index;
     prim.material = scene_.mNumMaterials > 0 ? static_cast<std::int32_t>(src.mMaterialIndex) : -1;
     prim.first_face = mesh.num_faces();

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "assimp_convert.h"
+#include "core/utf8.h"
 #include "image_io.h"
 
 namespace g2p::detail {
@@ -150,7 +151,7 @@ std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::s
     }
     const aiMaterial& mat = *scene.mMaterials[i];
     aiString name;
-    if (mat.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) m.name = name.C_Str();
+    if (mat.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) m.name = detail::utf8_name(name.C_Str());
     const std::string what = "material " + std::to_string(i) + " '" + m.name + "'";
 
     aiColor4D color(1.f, 1.f, 1.f, 1.f);

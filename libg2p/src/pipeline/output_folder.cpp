@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/io.h"
 #include "g2p/pipeline.h"
 #include "pipeline/run_summary.h"
@@ -56,7 +57,7 @@ Status write_manifests(const std::string& tmp, const fs::path& final_dir, const 
       {"weld", o.project.weld_tolerance},
       {"min_part_area", o.project.partition.min_part_area_fraction},
       {"written_by", "g2p run"}};
-  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/project.json", project.dump(2) + "\n"));
+  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/project.json", detail::json_text(project, 2) + "\n"));
   const nlohmann::json properties = {{"format", "g2p-properties"},
                                      {"version", 1},
                                      {"source", final_dir.string()},
@@ -64,7 +65,7 @@ Status write_manifests(const std::string& tmp, const fs::path& final_dir, const 
                                      {"key", ""},
                                      {"materials", materials},
                                      {"written_by", "g2p run"}};
-  return write_text_file(tmp + "/properties.json", properties.dump(2) + "\n");
+  return write_text_file(tmp + "/properties.json", detail::json_text(properties, 2) + "\n");
 }
 
 // intermediates/: per-face votes and part patches (the per-view class
@@ -115,7 +116,7 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
     refine_json["notes"] = r.refinement.notes;
     refine_json["changed_faces"] = r.refinement.changes.size();
   }
-  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/refine.json", refine_json.dump(2) + "\n"));
+  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/refine.json", detail::json_text(refine_json, 2) + "\n"));
   // The closed volumes can be dense (grid-based): only on request.
   if (out.intermediates) G2P_RETURN_IF_ERROR(write_completion(tmp + "/completed", r.completion, r.table, {"obj"}));
   std::vector<std::string> engine_formats;
@@ -277,7 +278,7 @@ std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions
                             {"assets", files},
                             {"overrides", r.overrides_applied},
                             {"warnings", r.warnings}};
-  return j.dump(2);
+  return detail::json_text(j, 2);
 }
 
 }  // namespace g2p

@@ -1,4 +1,5 @@
 #include "pipeline/summary_viewer.h"
+#include "core/json_text.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -148,7 +149,7 @@ SummaryViewer summary_viewer(const PipelineResult& r, std::size_t max_triangles)
     return v;
   }
   std::size_t drawn = 0;
-  const std::string json = script_safe(viewer_json(r, max_triangles, drawn).dump());
+  const std::string json = script_safe(detail::json_text(viewer_json(r, max_triangles, drawn)));
   const std::size_t total = static_cast<std::size_t>(r.model.mesh.num_faces());
   v.section =
       "<section id=\"g2p-3d\"><h2>3D view</h2>\n"

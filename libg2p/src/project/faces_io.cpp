@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include "core/csv.h"
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/project.h"
 #include "g2p/segment.h"
 
@@ -134,7 +135,8 @@ Status write_projection(const std::string& dir, const Model& model, const std::v
                      {"faces", p.faces.size()},
                      {"area_m2", p.area_m2}});
   }
-  return detail::write_file_atomically(dir + "/parts.json", nlohmann::json{{"parts", parts}}.dump(2) + "\n");
+  return detail::write_file_atomically(dir + "/parts.json",
+                                       detail::json_text(nlohmann::json{{"parts", parts}}, 2) + "\n");
 }
 
 }  // namespace g2p

@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/json_text.h"
 #include "g2p/io.h"
 #include "g2p/properties.h"
 
@@ -181,7 +182,7 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
       {"looks_normalised", size.looks_normalised}};
   json doc = {{"format", "g2p.properties"}, {"version", 1},   {"material_table", table.name()},
               {"object", object},           {"parts", parts}, {"notes", report.notes}};
-  return doc.dump(2) + "\n";
+  return detail::json_text(doc, 2) + "\n";
 }
 
 Status write_report(const std::string& path, const PropertiesReport& report, const MaterialTable& table) {

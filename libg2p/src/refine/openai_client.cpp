@@ -6,7 +6,10 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <vector>
 
+#include "core/json_text.h"
+#include "core/utf8.h"
 #include "g2p/vlm.h"
 
 namespace g2p {
@@ -89,6 +92,46 @@ void init_curl_once() {
   std::call_once(once, [] { curl_global_init(CURL_GLOBAL_DEFAULT); });
 }
 
+// The secrets a URL carries: its user information and each query value.
+std::vector<std::string> url_secrets(const std::string& url) {
+  std::vector<std::string> out;
+  const std::size_t scheme = url.find("://");
+  const std::size_t host = scheme == std::string::npos ? 0 : scheme + 3;
+  const std::size_t path = url.find_first_of("/?#", host);
+  const std::size_t at = url.rfind('@', path == std::string::npos ? std::string::npos : path);
+  if (at != std::string::npos && at > host) {
+    const std::string info = url.substr(host, at - host);
+    out.push_back(info);
+    if (const std::size_t colon = info.find(':'); colon != std::string::npos) out.push_back(info.substr(colon + 1));
+  }
+  for (std::size_t eq = url.find('=', host); eq != std::string::npos; eq = url.find('=', eq + 1))
+    out.push_back(url.substr(eq + 1, url.find_first_of("&#", eq + 1) - eq - 1));
+  return out;
+}
+
+// The start of a server's error body for a message: every secret (and any
+// "Bearer" token) replaced by ***, at most 300 bytes cut where a UTF-8
+// character begins, and bytes that are not UTF-8 read as Latin-1 (a proxy's
+// error page), so that the message can go into JSON and logs.
+std::string server_excerpt(std::string body, const std::vector<std::string>& secrets) {
+  for (const std::string& secret : secrets) {
+    if (secret.size() < 4) continue;  // too short to search for without mangling the text
+    for (std::size_t at = body.find(secret); at != std::string::npos; at = body.find(secret, at + 3))
+      body.replace(at, secret.size(), "***");
+  }
+  for (std::size_t at = body.find("Bearer "); at != std::string::npos; at = body.find("Bearer ", at + 7)) {
+    const std::size_t end = body.find_first_of(" \t\r\n\"',;}", at + 7);
+    body.replace(at + 7, (end == std::string::npos ? body.size() : end) - at - 7, "***");
+  }
+  const std::size_t limit = 300;
+  if (body.size() > limit) {
+    std::size_t cut = limit;
+    while (cut > 0 && (static_cast<unsigned char>(body[cut]) & 0xC0) == 0x80) --cut;
+    body = body.substr(0, cut) + "...";
+  }
+  return detail::utf8_name(body);
+}
+
 class OpenAiClient final : public VlmClient {
  public:
   explicit OpenAiClient(OpenAiClientOptions o) : o_(std::move(o)) {}
@@ -106,7 +149,7 @@ class OpenAiClient final : public VlmClient {
     if (!request.system.empty()) messages.push_back({{"role", "system"}, {"content", request.system}});
     messages.push_back({{"role", "user"}, {"content", content}});
     const std::string payload =
-        json{{"model", o_.model}, {"temperature", o_.temperature}, {"messages", messages}}.dump();
+        detail::json_text(json{{"model", o_.model}, {"temperature", o_.temperature}, {"messages", messages}});
     // The endpoint's path goes before any query string (`.../v1?key=K` ->
     // `.../v1/chat/completions?key=K`); messages show the URL redacted.
     const std::size_t query = o_.base_url.find_first_of("?#");
@@ -115,6 +158,12 @@ class OpenAiClient final : public VlmClient {
     if (base.empty() || base.back() != '/') base += '/';
     const std::string url_with_secrets = base + "chat/completions" + tail;
     const std::string url = redact_url(url_with_secrets);
+
+    // What a server may echo back in an error (the key, the URL's own
+    // credentials), never to be repeated in a message.
+    std::vector<std::string> secrets = url_secrets(url_with_secrets);
+    if (const char* key = o_.api_key_env.empty() ? nullptr : std::getenv(o_.api_key_env.c_str()); key != nullptr)
+      secrets.emplace_back(key);
 
     double wait_s = o_.backoff_s;  // before the next attempt: backoff, 2 backoff, 4 backoff... or Retry-After
     std::string last_error;
@@ -159,7 +208,7 @@ class OpenAiClient final : public VlmClient {
         last_error = "vlm: " + url + " answered HTTP " + std::to_string(status);
       } else if (status != 200) {
         return Status::Unavailable("vlm: " + url + " answered HTTP " + std::to_string(status) + ": " +
-                                   body.data.substr(0, 300));
+                                   server_excerpt(body.data, secrets));
       } else {
         const json doc = json::parse(body.data, nullptr, /*allow_exceptions=*/false);
         if (doc.is_discarded() || !doc.contains("choices") || !doc["choices"].is_array() || doc["choices"].empty())
@@ -187,6 +236,9 @@ std::string redact_url(const std::string& url) {
   const std::size_t path = out.find_first_of("/?#", host);
   const std::size_t at = out.rfind('@', path == std::string::npos ? std::string::npos : path);
   if (at != std::string::npos && at >= host) out.replace(host, at - host, "***");
+  // A fragment never reaches the server but can hold a token (`#access_token=`).
+  if (const std::size_t hash = out.find('#', host); hash != std::string::npos && hash + 1 < out.size())
+    out = out.substr(0, hash + 1) + "***";
   const std::size_t query = out.find('?');
   if (query == std::string::npos) return out;
   const std::size_t fragment = out.find('#', query);

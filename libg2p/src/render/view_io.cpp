@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
 #include "render/shading.h"
@@ -96,7 +97,7 @@ std::string cameras_to_json(const std::vector<Camera>& cameras) {
                "OpenCV: the camera looks along +z, x right, y down; pixel (i, j) has its centre at (i + 0.5, j + "
                "0.5); perspective fx, fy in pixels, orthographic fx, fy in pixels per metre; metres, world +Z up"},
               {"views", views}};
-  return doc.dump(2) + "\n";
+  return detail::json_text(doc, 2) + "\n";
 }
 
 Result<std::vector<Camera>> cameras_from_json(const std::string& json_text) {

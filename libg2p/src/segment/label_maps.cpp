@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/file_util.h"
+#include "core/json_text.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
@@ -92,7 +93,7 @@ Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& map
   for (int c = 0; c < table.size(); ++c)
     classes.push_back({{"index", c}, {"name", table[c].name}, {"color", table[c].color}});
   const nlohmann::json doc = {{"table", table.name()}, {"unknown_index", 255}, {"classes", classes}};
-  return detail::write_file_atomically(base + "classes.json", doc.dump(2) + "\n");
+  return detail::write_file_atomically(base + "classes.json", detail::json_text(doc, 2) + "\n");
 }
 
 }  // namespace g2p

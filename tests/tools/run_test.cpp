@@ -76,6 +76,32 @@ TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   EXPECT_TRUE(fs::exists(dir + "/out/hammer.urdf"));
   EXPECT_FALSE(fs::exists(dir + "/out/hammer.xml"));
 
+  // --overwrite never replaces a folder that holds the model, the working
+  // directory or files that are not a g2p output; each is refused before any
+  // work, exit 2, and nothing is touched.
+  fs::copy_file(test::source_path("examples/data/hammer.obj"), dir + "/out/hammer_in.obj");
+  r = test::run_tool("run " + test::quote(dir + "/out/hammer_in.obj") + " -o " + test::quote(dir + "/out") + kQuick +
+                     " --overwrite");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("holds the model being run"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/out/hammer_in.obj"));
+  // From inside the folder, as ../out: the same folder, the working directory.
+  r = test::run_command("cd " + test::quote(dir + "/out") + " && " + test::quote(G2P_TEST_TOOL) + " run " + hammer() +
+                        " -o ../out" + kQuick + " --overwrite");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("is or holds the working directory"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/out/hammer.urdf"));
+  fs::create_directories(dir + "/mine");
+  test::write_file(dir + "/mine/notes.txt", "precious");
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/mine") + kQuick + " --overwrite");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("is not a g2p output folder"), std::string::npos) << r.err;
+  EXPECT_EQ(test::read_file(dir + "/mine/notes.txt"), "precious");
+  fs::create_directories(dir + "/empty");
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/empty") + kQuick + " --overwrite -q");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/empty/run.json"));
+
   // --soft reaches the project stage: soft votes, the same two parts on the hammer.
   r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/soft") + kQuick + " --soft --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

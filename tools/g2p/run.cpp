@@ -89,6 +89,7 @@ int run_pipeline(const RunArgs& args) {
     return usage(args.out + " exists; choose another folder or pass --overwrite (replaced only once the run succeeds)");
   OutputOptions folder;
   folder.overwrite = args.overwrite;
+  folder.input_path = args.model;
   if (Status s = check_output_folder(args.out, folder); !s.ok()) return usage("-o " + s.message());
 
   PipelineOptions o;

@@ -236,6 +236,10 @@ class G2P_API Pipeline {
 struct OutputOptions {
   bool overwrite = false;      // replace an existing folder (only once the new one is complete)
   bool intermediates = false;  // also every view's buffers, per-view probabilities, votes and part patches
+  // The model being run ("": not checked). An existing folder that holds it
+  // is never replaced, with or without `overwrite` (write_pipeline_output
+  // fills it from the result).
+  std::string input_path;
 };
 
 // Writes the run into `dir`: views/ (renders, face IDs, contact sheet),
@@ -252,8 +256,10 @@ G2P_API Status write_pipeline_output(const std::string& dir, const PipelineResul
                                      const PipelineOptions& options = {}, const OutputOptions& output = {});
 
 // Whether write_pipeline_output could write `dir`, checked before a run so
-// that a bad folder fails at once, not after the work: `dir` must not exist
-// (unless output.overwrite, and then it must be a folder), and the nearest
+// that a bad folder fails at once, not after the work: `dir` must not exist,
+// unless output.overwrite, and then it must be a folder that is empty or
+// holds a g2p output (run.json, report.json or project.json), that holds
+// neither output.input_path nor the working directory; and the nearest
 // existing folder above it must be writable. The message names the folder.
 G2P_API Status check_output_folder(const std::string& dir, const OutputOptions& output = {});
 

@@ -143,10 +143,44 @@ Status write_contents(const std::string& tmp, const fs::path& final_dir, const P
 
 namespace {
 
+// The output folder as an absolute path with "..", "." and links resolved:
+// `-o ../X` run from inside X names X itself, whose parent is where the
+// temporary and previous folders go.
 fs::path final_folder(const std::string& dir) {
   std::error_code ec;
-  const fs::path target = fs::absolute(fs::path(dir).lexically_normal(), ec);
+  fs::path target = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  if (ec) target = fs::absolute(fs::path(dir), ec).lexically_normal();
   return target.filename().empty() ? target.parent_path() : target;
+}
+
+// Whether `inner` is `folder` or lies below it (both absolute and normal).
+bool lies_inside(const fs::path& inner, const fs::path& folder) {
+  auto i = inner.begin();
+  for (auto f = folder.begin(); f != folder.end(); ++f, ++i)
+    if (i == inner.end() || *i != *f) return false;
+  return true;
+}
+
+// What an existing folder may hold for --overwrite to replace it.
+Status check_replaceable(const fs::path& folder, const OutputOptions& output) {
+  std::error_code ec;
+  if (!output.input_path.empty()) {
+    const fs::path input = fs::weakly_canonical(fs::absolute(output.input_path, ec), ec);
+    if (!ec && lies_inside(input, folder))
+      return Status::InvalidArgument(folder.string() + ": holds the model being run (" + input.string() +
+                                     "), which replacing the folder would delete; write the output elsewhere");
+  }
+  const fs::path cwd = fs::weakly_canonical(fs::current_path(ec), ec);
+  if (!ec && lies_inside(cwd, folder))
+    return Status::InvalidArgument(folder.string() +
+                                   ": is or holds the working directory, which replacing it would delete; "
+                                   "write the output elsewhere");
+  if (fs::is_empty(folder, ec)) return Status::Ok();
+  for (const char* mark : {"run.json", "report.json", "project.json"})
+    if (fs::exists(folder / mark, ec)) return Status::Ok();
+  return Status::InvalidArgument(folder.string() +
+                                 ": exists and is not a g2p output folder (no run.json, report.json or "
+                                 "project.json), so it is not replaced; choose a new folder");
 }
 
 }  // namespace
@@ -159,6 +193,7 @@ Status check_output_folder(const std::string& dir, const OutputOptions& output) 
     return Status::InvalidArgument(final_dir.string() + ": exists and is not a folder");
   if (fs::exists(final_dir, ec) && !output.overwrite)
     return Status::InvalidArgument(final_dir.string() + ": exists; choose another folder or allow overwriting");
+  if (fs::exists(final_dir, ec)) G2P_RETURN_IF_ERROR(check_replaceable(final_dir, output));
   fs::path above = final_dir.parent_path();
   while (!above.empty() && !fs::exists(above, ec) && above != above.parent_path()) above = above.parent_path();
   if (!fs::is_directory(above, ec))
@@ -180,7 +215,9 @@ Status write_pipeline_output(const std::string& dir, const PipelineResult& resul
     return Status::InvalidArgument("write_pipeline_output: the result is incomplete (did the run succeed?)");
   std::error_code ec;
   const fs::path final_dir = final_folder(dir);
-  G2P_RETURN_IF_ERROR(check_output_folder(dir, output));
+  OutputOptions checked = output;
+  if (checked.input_path.empty() && result.model.info.path != "<memory>") checked.input_path = result.model.info.path;
+  G2P_RETURN_IF_ERROR(check_output_folder(dir, checked));
   const fs::path parent = final_dir.parent_path();
   G2P_RETURN_IF_ERROR(detail::ensure_directory(parent.string()));
   const std::string tag = "." + final_dir.filename().string() + ".g2p-" + std::to_string(::getpid());
@@ -198,7 +235,10 @@ Status write_pipeline_output(const std::string& dir, const PipelineResult& resul
     if (ec) {
       s = Status::IoError(final_dir.string() + ": cannot move the new output into place: " + ec.message());
       std::error_code back;
-      if (fs::exists(old)) fs::rename(old, final_dir, back);  // the previous output stays as it was
+      if (fs::exists(old)) {
+        fs::rename(old, final_dir, back);  // the previous output stays as it was
+        if (back) s = Status::IoError(s.message() + "; the previous output is kept at " + old.string());
+      }
     }
   }
   if (!s.ok()) {

@@ -62,5 +62,17 @@ TEST(ImageIo, AFullDiskIsNamedAsSuch) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/run.json"));
 }
 
+// A folder where the file should go: the message says what is in the way (it
+// once read "cannot replace the file: Success"), and nothing is left behind.
+TEST(WriteTextFile, AFolderInTheWayIsNamed) {
+  const std::string dir = test::scratch_dir("WriteTextFileFolder");
+  std::filesystem::create_directories(dir + "/report.json");
+  const Status s = write_text_file(dir + "/report.json", "{}\n");
+  EXPECT_EQ(s.code(), StatusCode::kIoError);
+  EXPECT_EQ(s.message().find("Success"), std::string::npos) << s.to_string();
+  EXPECT_NE(s.message().find("a folder of that name is in the way"), std::string::npos) << s.to_string();
+  EXPECT_FALSE(std::filesystem::exists(dir + "/.tmp.report.json"));
+}
+
 }  // namespace
 }  // namespace g2p

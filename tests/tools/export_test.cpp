@@ -77,6 +77,12 @@ TEST(ToolExport, BadInputFailsWithAMessage) {
   r = run_tool("export " + quote(test::source_path("examples/data/hammer.obj")) + " -o " + quote(dir + "/x") +
                " --format gltf");
   EXPECT_EQ(r.exit_code, 2);
+  // A drop from below the plane or for NaN seconds once ran no steps and printed PASS.
+  for (const std::string& flags : {"--drop-height -5", "--seconds nan", "--seconds 1e12", "--contact-seconds 0"}) {
+    r = run_tool("validate " + quote(dir) + " " + flags);
+    EXPECT_EQ(r.exit_code, 2) << flags;
+    EXPECT_NE(r.err.find(flags.substr(0, flags.find(' ')) + ": takes a number in"), std::string::npos) << r.err;
+  }
 }
 
 TEST(ToolValidate, ContactCheckDropsBallsAndWritesJson) {

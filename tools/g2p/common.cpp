@@ -1,11 +1,32 @@
 #include "common.h"
 
+#include <cmath>
 #include <iostream>
 #include <map>
+#include <sstream>
 
 #include "commands.h"
 
 namespace g2p::cli {
+
+CLI::Validator finite_number(double lo, double hi, bool above_lo) {
+  std::ostringstream range;
+  range << (above_lo ? "(" : "[") << lo << ", " << hi << "]";
+  return CLI::Validator(
+      [lo, hi, above_lo, range = range.str()](std::string& text) -> std::string {
+        double v = 0.0;
+        std::size_t used = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size() || !std::isfinite(v) || v < lo || v > hi || (above_lo && v == lo))
+          return "takes a number in " + range + ", not '" + text + "'";
+        return std::string();
+      },
+      "NUMBER in " + range.str());
+}
 
 void add_import_flags(CLI::App* cmd, ImportArgs& args) {
   cmd->add_option("--unit", args.unit,
@@ -13,10 +34,10 @@ void add_import_flags(CLI::App* cmd, ImportArgs& args) {
   cmd->add_option("--height", args.height,
                   "The object's real height in metres: the model is scaled to it (for generated meshes, which come "
                   "normalised to about a metre)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_number(0.0, 1e5, true));
   cmd->add_option("--longest-side", args.longest_side,
                   "The object's real longest side in metres: the model is scaled to it")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_number(0.0, 1e5, true));
   cmd->add_option("--up", args.up, "Up axis of the file: auto, x, y, z")
       ->transform(CLI::IsMember({"auto", "x", "y", "z"}, CLI::ignore_case));
   cmd->add_flag("--keep-axes", args.keep_axes, "Keep the file's axes (default: rotate its up axis to +Z)");

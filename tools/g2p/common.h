@@ -25,6 +25,10 @@ struct ImportArgs {
   bool lenient = false;  // keep the good triangles of a damaged file (warnings instead of an error)
 };
 
+// A flag's check: a finite number from lo (or above it, when above_lo) to hi.
+// CLI11's own range checks let NaN through.
+CLI::Validator finite_number(double lo, double hi, bool above_lo = false);
+
 void add_import_flags(CLI::App* cmd, ImportArgs& args);
 
 // The flags as import options (an unknown --unit is an error).

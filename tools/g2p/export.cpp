@@ -312,8 +312,9 @@ void add_export_command(CLI::App& app, Command& run) {
   CLI::App* v = app.add_subcommand(
       "validate", "Load an exported MJCF in MuJoCo, compare, and drop it on a plane (--contact: drop balls onto it)");
   v->add_option("dir", vargs->dir, "Output folder of g2p export")->required();
-  v->add_option("--drop-height", vargs->height, "Drop height above the plane, m (default 0.2)");
-  v->add_option("--seconds", vargs->seconds, "Simulated time, s (default 2)");
+  v->add_option("--drop-height", vargs->height, "Drop height above the plane, m (default 0.2)")
+      ->check(finite_number(0.0, 100.0));
+  v->add_option("--seconds", vargs->seconds, "Simulated time, s (default 2)")->check(finite_number(0.0, 600.0, true));
   v->add_flag("--contact", vargs->contact,
               "Contact check: fix the object, drop probe balls onto a grid over it and report where they rest");
   v->add_option("--balls", vargs->contact_options.grid,
@@ -321,7 +322,8 @@ void add_export_command(CLI::App& app, Command& run) {
   v->add_option("--at", vargs->at, "--contact: also drop a ball over X,Y (metres, object's frame; repeatable)");
   v->add_option("--ball-radius", vargs->contact_options.ball_radius_m,
                 "--contact: ball radius, m (default 2 % of the object's longest side, at least 5 mm)");
-  v->add_option("--contact-seconds", vargs->contact_options.seconds, "--contact: simulated time, s (default 3)");
+  v->add_option("--contact-seconds", vargs->contact_options.seconds, "--contact: simulated time, s (default 3)")
+      ->check(finite_number(0.0, 600.0, true));
   v->add_option("--json", vargs->json, "--contact: also write the result as JSON to this file");
   v->add_flag("--fail-on-unstable", vargs->fail_on_unstable,
               "--contact: exit 1 when a ball is still moving at the end or the dropped object sank into the plane");

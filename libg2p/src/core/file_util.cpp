@@ -32,8 +32,10 @@ Status write_file_atomically(const std::string& path, const std::string& bytes) 
   std::error_code ec;
   fs::rename(tmp, target, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() resets ec
     fs::remove(tmp, ec);
-    return Status::IoError(path + ": cannot replace the file: " + ec.message());
+    return Status::IoError(path + ": cannot replace the file: " + why +
+                           (fs::is_directory(target, ec) ? " (a folder of that name is in the way)" : ""));
   }
   return Status::Ok();
 }

@@ -250,6 +250,35 @@ TEST(Overrides, TheEstimatorTakesThePersonsValuesForTheSelectedPartsOnly) {
   EXPECT_EQ(p1->density_source, ValueSource::kTable);
 }
 
+// A person's wall thicker than the part can hold (a 10 m wall on a 10 cm
+// part once made a 0.03 kg avocado weigh 53 kg) is weighed as solid, and the
+// correction says so.
+TEST(Overrides, WallsThePartCannotHoldAreWeighedAsSolid) {
+  const Labelled h = hammer();
+  FixedEstimator base;
+  CompletedPart closed;
+  closed.checks.area_m2 = 0.01;    // 100 cm^2
+  closed.checks.volume_m3 = 2e-5;  // 20 cm^3: a shell of 2 mm or more would outweigh it
+  for (const char* wall : {"10", "0.002"}) {
+    Result<Overrides> o = parse_overrides(
+        file(std::string(R"({"part": 0, "structure": "hollow", "wall_thickness_m": )") + wall + "}"), table());
+    ASSERT_TRUE(o.ok()) << o.status().to_string();
+    const ResolvedOverrides r = *resolve_overrides(*o, h.model.mesh.num_faces(), h.parts, h.labels, table());
+    const std::unique_ptr<PropertyEstimator> e = make_overriding_estimator(base, r);
+    Result<PartProperties> p = e->estimate(PropertyInput{&h.model.mesh, &h.parts[0], &closed, &table()});
+    ASSERT_TRUE(p.ok());
+    EXPECT_EQ(p->structure, Structure::kSolid) << wall;
+    EXPECT_NE(p->notes.back().find("mm walls are more than the part holds"), std::string::npos) << p->notes.back();
+  }
+  Result<Overrides> o =
+      parse_overrides(file(R"({"part": 0, "structure": "hollow", "wall_thickness_m": 0.001})"), table());
+  const ResolvedOverrides r = *resolve_overrides(*o, h.model.mesh.num_faces(), h.parts, h.labels, table());
+  Result<PartProperties> p =
+      make_overriding_estimator(base, r)->estimate(PropertyInput{&h.model.mesh, &h.parts[0], &closed, &table()});
+  ASSERT_TRUE(p.ok());
+  EXPECT_EQ(p->structure, Structure::kHollow);  // 1 mm walls fit
+}
+
 TEST(Overrides, EntriesThatSetDifferentValuesOfOnePartAddUp) {
   const Labelled h = hammer();
   // A density first, then (another correction) the part made hollow: both stand.

@@ -482,11 +482,23 @@ class OverridingEstimator final : public PropertyEstimator {
       p.contents_fill = o.contents_fill;
       p.contents_density_kg_m3 = o.contents_density_kg_m3;
     }
+    // Walls the part cannot hold (a shell over its area would outweigh the
+    // part as solid) are weighed as solid, and the correction says so.
+    std::ostringstream too_thick;
+    if (!structure.empty() && p.structure == Structure::kHollow && input.completed != nullptr &&
+        input.completed->checks.area_m2 * p.wall_thickness_m >= input.completed->checks.volume_m3) {
+      too_thick << " are more than the part holds (a shell over its " << input.completed->checks.area_m2
+                << " m^2 would exceed its " << input.completed->checks.volume_m3 << " m^3), so it is weighed as solid";
+      p.structure = Structure::kSolid;
+      p.double_walled = false;
+    }
     std::ostringstream what;
     what << "correction: ";
     const char* sep = "";
     if (!structure.empty()) {
-      if (p.structure == Structure::kSolid)
+      if (!too_thick.str().empty())
+        what << "hollow, " << p.wall_thickness_m * 1000.0 << " mm walls" << too_thick.str();
+      else if (p.structure == Structure::kSolid)
         what << "solid";
       else
         what << "hollow, " << p.wall_thickness_m * 1000.0 << " mm walls";

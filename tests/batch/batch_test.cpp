@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/test_data.h"
+#include "support/tool_run.h"
 
 namespace g2p {
 namespace {
@@ -131,6 +132,16 @@ TEST(BatchInputs, FoldersPatternsAndUniqueNames) {
   Result<std::vector<BatchAsset>> folder = list_batch_inputs({dir + "/a"});
   ASSERT_TRUE(folder.ok()) << folder.status().to_string();
   ASSERT_EQ(folder->size(), 2u);  // the two OBJ files; not the .mtl or the .txt
+  // Folders g2p wrote inside the input (a batch's -o with its index, a run, a
+  // run's temporary folder) hold outputs, not models: the scan skips them.
+  for (const char* out : {"/a/out", "/a/out/tool", "/a/.run.g2p-77.tmp"}) fs::create_directories(dir + out);
+  test::write_file(dir + "/a/out/index.json", "{}");
+  test::write_file(dir + "/a/out/tool/run.json", "{}");
+  hammer_copy(dir + "/a/out/tool", "tool");
+  hammer_copy(dir + "/a/.run.g2p-77.tmp", "tool");
+  Result<std::vector<BatchAsset>> again = list_batch_inputs({dir + "/a"});
+  ASSERT_TRUE(again.ok()) << again.status().to_string();
+  EXPECT_EQ(again->size(), 2u);
   Result<std::vector<BatchAsset>> pattern = list_batch_inputs({dir + "/a/*.obj", dir + "/missing.glb"});
   ASSERT_TRUE(pattern.ok());
   ASSERT_EQ(pattern->size(), 2u);  // a named file that does not exist is kept: its run says why
@@ -147,6 +158,19 @@ TEST(BatchInputs, FoldersPatternsAndUniqueNames) {
   std::vector<BatchAsset> clash{{"a.obj", "same", {}, "m.csv:2"}, {"b.obj", "same", {}, "m.csv:3"}};
   const Status s = name_batch_assets(clash);
   EXPECT_NE(s.message().find("m.csv:3: the name 'same' is already used by m.csv:2"), std::string::npos) << s.message();
+}
+
+// A run refused for a bad flag records the flag's message, not CLI11's
+// trailing "Run with --help for more information.".
+TEST(BatchRun, ARefusedRunRecordsItsReason) {
+  const std::string dir = test::scratch_dir("BatchRefused");
+  const std::string model = hammer_copy(dir, "tool");
+  test::ToolRun r =
+      test::run_tool("batch " + test::quote(model) + " -o " + test::quote(dir + "/out") + " --views 0 -q");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const std::string index = test::read_file(dir + "/out/index.csv");
+  EXPECT_NE(index.find("tool,failed,--views: Value 0 not in range"), std::string::npos) << index;
+  EXPECT_EQ(index.find("Run with --help"), std::string::npos) << index;
 }
 
 // AddressSanitizer makes the tool several times slower.

@@ -152,6 +152,20 @@ std::string safe_name(const std::string& name) {
   return s;
 }
 
+// A folder g2p wrote (a batch's output with its index, a run's folder, a
+// run's temporary or previous folder): its GLB, OBJ and MJCF files are
+// outputs, not models, so a folder scan does not go into it. Without this, a
+// batch whose -o lies inside its input folder took its own outputs as models
+// on every rerun.
+bool is_g2p_output(const fs::path& dir) {
+  const std::string name = dir.filename().string();
+  if (!name.empty() && name[0] == '.' && name.find(".g2p-") != std::string::npos) return true;
+  std::error_code ec;
+  for (const char* mark : {"index.json", "run.json", "report.json", "project.json"})
+    if (fs::exists(dir / mark, ec)) return true;
+  return false;
+}
+
 }  // namespace
 
 const std::vector<std::string>& batch_manifest_columns() {
@@ -194,6 +208,10 @@ Result<std::vector<BatchAsset>> list_batch_inputs(const std::vector<std::string>
       std::vector<std::string> files;
       for (auto it = fs::recursive_directory_iterator(input, fs::directory_options::skip_permission_denied, ec);
            !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        if (it->is_directory(ec)) {
+          if (is_g2p_output(it->path())) it.disable_recursion_pending();
+          continue;
+        }
         if (it->is_regular_file(ec) && is_supported_extension(it->path().extension().string()))
           files.push_back(it->path().string());
       }

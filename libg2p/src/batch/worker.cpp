@@ -118,8 +118,10 @@ std::string signal_name(int signal) {
 std::string last_error_line(const std::string& stderr_text) {
   std::istringstream in(stderr_text);
   std::string last;
-  for (std::string line; std::getline(in, line);)
-    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  for (std::string line; std::getline(in, line);)  // CLI11's trailer says nothing of the cause
+    if (line.find_first_not_of(" \t\r") != std::string::npos &&
+        line.rfind("Run with --help for more information.", 0) != 0)
+      last = line;
   while (!last.empty() && (last.back() == '\r' || last.back() == ' ')) last.pop_back();
   for (const std::string prefix : {"g2p run: ", "error: "})
     if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());

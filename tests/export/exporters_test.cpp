@@ -425,20 +425,20 @@ TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
   SimulationAsset asset;
   const std::string path = hammer_glb("ExportGlb", model, parts, asset);
   ASSERT_FALSE(path.empty());
-  // libg2p's own strict glTF import reads it back: the input's faces plus the
-  // convex hulls, the input's materials, the same place in space.
+  // libg2p's own strict glTF import reads it back as a viewer draws it: the
+  // input's faces and materials in the same place, and no hull (hull nodes
+  // carry no mesh, only a physics shape).
   Result<Model> back = load_model(path);
   ASSERT_TRUE(back.ok()) << back.status().to_string();
-  int collision_faces = 0, hulls = 0;
-  for (const AssetPart& p : asset.parts)
-    for (const Mesh& h : p.collision.hulls) collision_faces += h.num_faces(), ++hulls;
-  EXPECT_EQ(back->mesh.num_faces(), model.mesh.num_faces() + collision_faces);
+  int hulls = 0;
+  for (const AssetPart& p : asset.parts) hulls += static_cast<int>(p.collision.hulls.size());
+  EXPECT_EQ(back->mesh.num_faces(), model.mesh.num_faces());
   ASSERT_EQ(back->materials.size(), model.materials.size());
   EXPECT_EQ(back->materials[0].name, model.materials[0].name);
   EXPECT_FLOAT_EQ(back->materials[0].metallic, model.materials[0].metallic);
   const Eigen::AlignedBox3d a = bounds(model.mesh), b = bounds(back->mesh);
-  EXPECT_LT((a.min() - b.min()).norm(), 2e-3);  // the hulls of the closed volumes reach a little past the input
-  EXPECT_LT((a.max() - b.max()).norm(), 2e-3);
+  EXPECT_LT((a.min() - b.min()).norm(), 1e-5);
+  EXPECT_LT((a.max() - b.max()).norm(), 1e-5);
   // The JSON chunk: properties in the nodes' extras, in glTF's +Y-up frame.
   const std::string bytes = test::read_file(path);
   std::uint32_t json_length = 0;
@@ -456,6 +456,39 @@ TEST(Exporters, GlbKeepsTheLookAndCarriesTheProperties) {
   }
   EXPECT_EQ(parts_with_density, 2);
   EXPECT_EQ(collision_nodes, hulls);
+
+  // OMI_physics_body and OMI_physics_shape: the body's motion on the root, a
+  // convex shape per hull, a collider per hull node.
+  const nlohmann::json& motion = doc["nodes"][0]["extensions"]["OMI_physics_body"]["motion"];
+  EXPECT_EQ(motion["type"], "dynamic");
+  EXPECT_NEAR(motion["mass"].get<double>(), asset.total.mass_kg, 1e-9);
+  EXPECT_NEAR(motion["centerOfMass"][1].get<double>(), asset.total.center_of_mass.z(), 1e-9);
+  // Diagonal and orientation give back the tensor in glTF's axes (the extras').
+  const Eigen::Quaterniond q(
+      motion["inertiaOrientation"][3].get<double>(), motion["inertiaOrientation"][0].get<double>(),
+      motion["inertiaOrientation"][1].get<double>(), motion["inertiaOrientation"][2].get<double>());
+  const Eigen::Vector3d diagonal(motion["inertiaDiagonal"][0].get<double>(), motion["inertiaDiagonal"][1].get<double>(),
+                                 motion["inertiaDiagonal"][2].get<double>());
+  const Eigen::Matrix3d tensor = q.toRotationMatrix() * diagonal.asDiagonal() * q.toRotationMatrix().transpose();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      EXPECT_NEAR(tensor(i, j), root["inertia_kg_m2"][i][j].get<double>(), 1e-9 * diagonal.maxCoeff()) << i << j;
+  const nlohmann::json& shapes = doc["extensions"]["OMI_physics_shape"]["shapes"];
+  ASSERT_EQ(static_cast<int>(shapes.size()), hulls);
+  int colliders = 0;
+  for (const auto& n : doc["nodes"]) {
+    if (!n.contains("extensions")) continue;
+    if (!n["extensions"]["OMI_physics_body"].contains("collider")) continue;
+    ++colliders;
+    EXPECT_FALSE(n.contains("mesh")) << n.dump();
+    const nlohmann::json& shape = shapes[n["extensions"]["OMI_physics_body"]["collider"]["shape"].get<std::size_t>()];
+    EXPECT_EQ(shape["type"], "convex");
+    EXPECT_EQ(shape["convex"]["mesh"], n["extras"]["g2p"]["mesh"]);
+    EXPECT_EQ(doc["meshes"][shape["convex"]["mesh"].get<std::size_t>()]["name"], n["name"]);
+  }
+  EXPECT_EQ(colliders, hulls);
+  EXPECT_NE(std::find(doc["extensionsUsed"].begin(), doc["extensionsUsed"].end(), "OMI_physics_shape"),
+            doc["extensionsUsed"].end());
 }
 
 TEST(Exporters, KhronosValidatorFindsNoErrorInTheGlb) {

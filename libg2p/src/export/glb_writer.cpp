@@ -144,6 +144,22 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
   json totals = mass_extras(asset.total);
   totals["frame"] = "glTF: +Y up, metres; libg2p's +Z-up frame rotated by (x, y, z) -> (x, z, -y)";
   root["extras"]["g2p"] = totals;
+  // The body for engines that read OMI_physics_body (Godot 4): dynamic, with
+  // libg2p's mass, centre of mass and principal inertia; its axes as a
+  // quaternion (x, y, z, w) in glTF's frame.
+  {
+    const MassProperties& m = asset.total;
+    const Eigen::Vector3d c = r * m.center_of_mass;
+    const Eigen::Vector3d moments = m.principal_moments();
+    const Eigen::Quaterniond axes(r * m.principal_axes());
+    root["extensions"]["OMI_physics_body"]["motion"] = {
+        {"type", "dynamic"},
+        {"mass", m.mass_kg},
+        {"centerOfMass", {c.x(), c.y(), c.z()}},
+        {"inertiaDiagonal", {moments.x(), moments.y(), moments.z()}},
+        {"inertiaOrientation", {axes.x(), axes.y(), axes.z(), axes.w()}}};
+  }
+  json shapes = json::array();
   std::vector<json> nodes;
   for (const AssetPart& p : asset.parts) {
     if (p.part < 0 || p.part >= static_cast<int>(parts.size()))
@@ -213,9 +229,15 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
       g.doc["meshes"].push_back({{"name", name},
                                  {"primitives", json::array({{{"attributes", {{"POSITION", g.accessor(hpos, 3, true)}}},
                                                               {"indices", g.indices(hidx)}}})}});
-      nodes.push_back({{"name", name},
-                       {"mesh", static_cast<int>(g.doc["meshes"].size()) - 1},
-                       {"extras", {{"g2p", {{"collision", true}, {"part", p.name}, {"hull", k}}}}}});
+      // The node draws nothing (no "mesh"): a viewer shows the object, not
+      // its hulls. The hull is an OMI_physics_shape convex shape, and
+      // extras.g2p.mesh names it for importers that read extras.
+      const int hull_mesh = static_cast<int>(g.doc["meshes"].size()) - 1;
+      shapes.push_back({{"type", "convex"}, {"convex", {{"mesh", hull_mesh}}}});
+      nodes.push_back(
+          {{"name", name},
+           {"extensions", {{"OMI_physics_body", {{"collider", {{"shape", static_cast<int>(shapes.size()) - 1}}}}}}},
+           {"extras", {{"g2p", {{"collision", true}, {"part", p.name}, {"hull", k}, {"mesh", hull_mesh}}}}}});
     }
   }
   g.doc["nodes"] = json::array({root});
@@ -223,6 +245,8 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
     g.doc["nodes"][0]["children"].push_back(static_cast<int>(g.doc["nodes"].size()));
     g.doc["nodes"].push_back(std::move(n));
   }
+  if (!shapes.empty()) g.doc["extensions"]["OMI_physics_shape"]["shapes"] = shapes;
+  g.doc["extensionsUsed"] = json::array({"OMI_physics_body", "OMI_physics_shape"});
   g.doc["scenes"] = json::array({{{"nodes", {0}}}});
   g.doc["scene"] = 0;
   return detail::write_file_atomically(path, g.glb());

@@ -377,6 +377,14 @@ std::string read_gltf_json_bytes(const std::string& path) {
 // compacted material numbering by the file's own.
 Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bool strict, Model& model) {
   Result<detail::GltfLayout> layout = detail::read_gltf_layout(gltf_bytes);
+  if (layout.ok() && layout->primitives.size() != scene.mNumMeshes) {
+    // assimp 5.2 converts only the meshes that nodes place, so a mesh only a
+    // physics shape uses (libg2p's own GLB hulls) has no assimp mesh.
+    std::vector<detail::GltfPrimitive> placed;
+    for (const detail::GltfPrimitive& p : layout->primitives)
+      if (p.placed) placed.push_back(p);
+    if (placed.size() == scene.mNumMeshes) layout->primitives = std::move(placed);
+  }
   if (!layout.ok() || layout->primitives.size() != scene.mNumMeshes) {
     model.info.warnings.push_back("could not match assimp's meshes to the glTF primitives (" +
                                   (layout.ok() ? std::string("count differs") : layout.status().message()) +

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <set>
 
 namespace g2p::detail {
 namespace {
@@ -174,6 +175,11 @@ Result<GltfLayout> read_gltf_layout(const std::string& bytes) {
     for (const json& m : *mats) layout.materials.push_back(parse_material(m));
   }
   const int num_materials = static_cast<int>(layout.materials.size());
+  std::set<long long> placed;  // the meshes nodes use
+  if (auto nodes = doc.find("nodes"); nodes != doc.end() && nodes->is_array())
+    for (const json& n : *nodes)
+      if (n.is_object())
+        if (auto m = n.find("mesh"); m != n.end() && m->is_number_integer()) placed.insert(m->get<long long>());
   if (auto meshes = doc.find("meshes"); meshes != doc.end() && meshes->is_array()) {
     for (std::size_t i = 0; i < meshes->size(); ++i) {
       const json& mesh = (*meshes)[i];
@@ -184,6 +190,7 @@ Result<GltfLayout> read_gltf_layout(const std::string& bytes) {
         GltfPrimitive prim;
         prim.mesh = static_cast<int>(i);
         prim.primitive = static_cast<int>(k);
+        prim.placed = placed.count(static_cast<long long>(i)) > 0;
         if (auto n = mesh.find("name"); n != mesh.end() && n->is_string()) prim.mesh_name = n->get<std::string>();
         if (p.is_object()) {
           if (auto it = p.find("material"); it != p.end() && it->is_number_integer()) prim.material = it->get<int>();

@@ -25,6 +25,7 @@ struct GltfPrimitive {
   long long triangles = -1;     // triangles the primitive declares; -1 if unknown
   std::string problem;          // what is wrong with its accessors, empty if nothing
   bool color_has_alpha = true;  // false when COLOR_0 is VEC3 (RGB only: alpha is 1)
+  bool placed = true;           // false when no node uses its mesh (a physics shape's hull, say)
 };
 
 struct GltfLayout {

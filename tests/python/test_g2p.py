@@ -314,11 +314,16 @@ class PythonBackendsTest(unittest.TestCase):
         r = pipeline.run_file(HAMMER)
         self.assertEqual(completer.parts_seen, 2)
         self.assertEqual(r.stage(g2p.Stage.COMPLETE)["backend"], "custom")
+        self.assertEqual(len(r.properties), 2)  # both parts weighed by the Python estimator
         for p in r.properties:
             self.assertEqual(p["density_kg_m3"], 1000.0)
             self.assertEqual(p["sources"]["density"], "user")
             self.assertAlmostEqual(p["mass_kg"], 1000.0 * p["volume_m3"], places=9)
-        # Water is lighter than the steel head: the centre of mass drops.
+        self.assertAlmostEqual(r.mass_kg, sum(p["mass_kg"] for p in r.properties), places=9)
+        self.assertGreater(r.mass_kg, 0.0)
+        # Water is lighter than the steel head: the centre of mass drops from
+        # the head (z 0.30-0.34 m) towards the middle of the handle.
+        self.assertGreater(r.center_of_mass[2], 0.05)
         self.assertLess(r.center_of_mass[2], 0.25)
 
     def test_python_estimator_errors_fail_the_run_with_the_traceback(self):

@@ -175,6 +175,7 @@ TEST(Regions, FeaturesDescribeVotesColourAndPlace) {
   const std::size_t height = column("height"), share = column("log_area_share"), value = column("value");
   ASSERT_LT(height, w);
   double lowest = 2, highest = -1;
+  int pure = 0;
   for (std::size_t i = 0; i < r.regions.size(); ++i) {
     const float* row = x->data() + i * w;
     double votes_sum = 0, object_sum = 0;
@@ -193,8 +194,10 @@ TEST(Regions, FeaturesDescribeVotesColourAndPlace) {
     if (by_class.size() == 1 && by_class.begin()->first >= 0 && votes_sum > 0) {
       const int truth = by_class.begin()->first;
       EXPECT_GT(row[truth], 0.9f) << "region " << i;
+      ++pure;
     }
   }
+  EXPECT_GE(pure, 10) << "pure regions with votes checked";
   EXPECT_LT(lowest, 0.3);   // the legs
   EXPECT_GT(highest, 0.6);  // the back
 }

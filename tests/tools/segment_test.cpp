@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -301,8 +302,24 @@ TEST(ToolProject, WritesFacesPartsAndRefines) {
     EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
   const std::string csv = test::read_file(out + "/faces.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 105);  // header + 104 faces
+  // The hammer's names say oak handle and steel head: two parts, Wood (92
+  // faces) and Metal (12), and every face's label in faces.csv is its material's.
   const nlohmann::json parts = nlohmann::json::parse(test::read_file(out + "/parts.json"));
-  EXPECT_GE(parts["parts"].size(), 1u);
+  ASSERT_EQ(parts["parts"].size(), 2u) << parts.dump();
+  std::map<std::string, std::size_t> faces_of;
+  for (const auto& p : parts["parts"]) faces_of[p["label"].get<std::string>()] = p["faces"].get<std::size_t>();
+  EXPECT_EQ(faces_of["Wood"], 92u);
+  EXPECT_EQ(faces_of["Metal"], 12u);
+  std::istringstream rows(csv);
+  std::string row;
+  std::getline(rows, row);  // header
+  int checked = 0;
+  while (std::getline(rows, row)) {
+    const bool oak = row.find(",oak_handle,") != std::string::npos;
+    EXPECT_NE(row.find(oak ? ",oak_handle,Wood," : ",steel_head,Metal,"), std::string::npos) << row;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 104);
   EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner oracle-vlm").exit_code, 2);
   EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner smooth --refine-set x").exit_code, 2);
 }

@@ -83,6 +83,15 @@ TEST(TrainRegions, TrainsOnTheRowsEvalSegWrites) {
   EXPECT_GT(plain["training"]["regions"].get<int>(), 5);
   EXPECT_EQ(odd["training"]["regions"], plain["training"]["regions"]);
   EXPECT_EQ(odd["training"]["models"], plain["training"]["models"]) << "the two renamed keys are two models";
+  // --check scored the classifier on rows.csv, its own training regions (by
+  // other names): it must beat the regions' own votes there, and a classifier
+  // that answered one class for everything would not (measured: 0.99 against
+  // 0.88).
+  const nlohmann::json& check = odd["validation"];
+  EXPECT_GE(check["regions"].get<int>(), plain["training"]["regions"].get<int>());
+  EXPECT_GT(check["area_weighted_accuracy"].get<double>(), check["votes_alone_accuracy"].get<double>() + 0.05)
+      << check.dump();
+  EXPECT_GT(check["area_weighted_accuracy"].get<double>(), 0.9) << check.dump();
 
   // A row cut short: refused, naming the file and the line.
   std::string cut = lines[0] + "\n" + lines[1] + "\n" + lines[2].substr(0, lines[2].rfind(',')) + "\n";

@@ -203,6 +203,20 @@ TEST(ImportErrors, NonFiniteCoordinatesNameTheVertex) {
       << model.status().message();
 }
 
+// A NaN vertex of an OBJ used to vanish: assimp's vertex join merged it into
+// another vertex (its face became a degenerate one) and the run went on. It is
+// refused, naming the vertex, as a NaN is in any other format.
+TEST(ImportErrors, ANanVertexIsNotJoinedAway) {
+  const std::string dir = test::scratch_dir("ImportErrors.NaNObj");
+  test::write_file(dir + "/nan.obj",
+                   "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nv nan 1 1\n"
+                   "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\nf 1 2 5\n");
+  Result<Model> model = load_model(dir + "/nan.obj");
+  ASSERT_FALSE(model.ok());
+  EXPECT_NE(model.status().message().find("non-finite position (nan, 1, 1)"), std::string::npos)
+      << model.status().message();
+}
+
 TEST(ImportErrors, OnlyPointsOrLines) {
   for (const char* f : {"OBJ/testpoints.obj", "OBJ/testline.obj", "OBJ/point_cloud.obj"}) {
     Result<Model> model = load_model(test::assimp_model(f));

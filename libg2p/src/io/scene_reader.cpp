@@ -26,6 +26,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -111,6 +112,22 @@ bool write_all(int fd, const char* p, std::size_t n) {
   return true;
 }
 
+// Whether a vertex position is NaN or infinite. JoinIdenticalVertices would
+// merge such a vertex into another one (its spatial sort orders NaN anywhere),
+// so the importer's check never saw it and the face silently changed shape;
+// unjoined, the importer refuses it (or drops its faces with --lenient).
+bool has_non_finite_position(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes && scene.mMeshes != nullptr; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr || mesh->mVertices == nullptr) continue;
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return true;
+    }
+  }
+  return false;
+}
+
 // assimp 5.2's JoinIdenticalVertices compares no vertex colours (fixed after
 // 5.2 by assimp pull request 4872) and would merge vertices that differ only
 // in colour: a scene with colours is read without it, and the importer joins
@@ -121,7 +138,7 @@ const aiScene* read_in(Assimp::Importer& importer, const SceneSource& source, un
   const aiScene* scene = source.data != nullptr
                              ? importer.ReadFileFromMemory(source.data, source.size, first, source.hint.c_str())
                              : importer.ReadFile(source.path, first);
-  if (scene == nullptr || join == 0 || has_vertex_colors(*scene)) return scene;
+  if (scene == nullptr || join == 0 || has_vertex_colors(*scene) || has_non_finite_position(*scene)) return scene;
   return importer.ApplyPostProcessing(join);
 }
 

@@ -456,6 +456,17 @@ TEST(LearnedSegmenter, LoadsItsNetworkOnlyForAModelThatNeedsIt) {
   EXPECT_EQ(missing.code(), StatusCode::kNotFound);
   EXPECT_NE(missing.message().find(dir + "/nowhere.onnx: the model card's network file is missing"), std::string::npos)
       << missing.message();
+
+  // A card without a required key, or with a value of the wrong kind, says
+  // which, without the JSON library's exception codes.
+  test::write_file(dir + "/card_no_model.json", R"({"input": {"width": 32, "height": 32}, "classes": ["Wood"]})");
+  Status no_model = make_segmenter("learned", {{"model_card", dir + "/card_no_model.json"}}).status();
+  EXPECT_NE(no_model.message().find("the model card needs 'model'"), std::string::npos) << no_model.message();
+  test::write_file(dir + "/card_number.json", R"({"model": 3, "input": {"width": 32, "height": 32}, "classes": []})");
+  Status number = make_segmenter("learned", {{"model_card", dir + "/card_number.json"}}).status();
+  EXPECT_NE(number.message().find("a value of the wrong kind (type must be string, but is number)"), std::string::npos)
+      << number.message();
+  EXPECT_EQ(number.message().find("json.exception"), std::string::npos) << number.message();
 }
 
 }  // namespace

@@ -55,8 +55,10 @@ TEST(OracleSegmenter, LabelFileErrors) {
   EXPECT_EQ(*ok, (std::vector<int>{table.find("Wood"), kUnknownLabel, kUnknownLabel}));
 
   Model empty_model;
-  auto no_file = std::move(*make_segmenter("oracle"));
-  EXPECT_EQ(no_file->set_model(empty_model, table).code(), StatusCode::kInvalidArgument);
+  Result<std::unique_ptr<Segmenter>> no_file = make_segmenter("oracle");  // refused when made
+  ASSERT_FALSE(no_file.ok());
+  EXPECT_EQ(no_file.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(no_file.status().message().find("labels=FILE.json"), std::string::npos) << no_file.status().message();
   auto missing = std::move(*make_segmenter("oracle", {{"labels", "/nonexistent/labels.json"}}));
   EXPECT_EQ(missing->set_model(empty_model, table).code(), StatusCode::kNotFound);
   EXPECT_EQ(make_segmenter("oracle", {{"label", "x"}}).status().code(), StatusCode::kInvalidArgument);

@@ -72,6 +72,15 @@ Result<ModelCard> read_card(const std::string& path) {
     return Status::ParseError(path + ": 'version' must be a positive integer");
   if (doc.contains("version") && doc["version"].get<int>() > 1)
     return Status::Unsupported(path + ": model card version " + doc["version"].dump() + " is newer than 1");
+  const struct {
+    const char* key;
+    const char* what;
+  } required[] = {{"model", "the .onnx file, relative to the card"},
+                  {"input", "the network's input: width, height and normalisation"},
+                  {"classes", "the class of each output channel, in order"}};
+  for (const auto& r : required)
+    if (!doc.contains(r.key))
+      return Status::ParseError(path + ": the model card needs '" + r.key + "' (" + r.what + "); docs/segment.md");
   ModelCard card;
   try {
     card.model_path = doc.at("model").get<std::string>();
@@ -124,7 +133,12 @@ Result<ModelCard> read_card(const std::string& path) {
     }
     card.classes = doc.at("classes").get<std::vector<std::string>>();
   } catch (const json::exception& e) {
-    return Status::ParseError(path + ": " + e.what());
+    // "[json.exception.type_error.302] type must be string, but is number":
+    // the part after the bracket says what was wrong.
+    std::string why = e.what();
+    if (const std::size_t end = why.find("] "); why.rfind("[json.exception.", 0) == 0 && end != std::string::npos)
+      why = why.substr(end + 2);
+    return Status::ParseError(path + ": a value of the wrong kind (" + why + "); docs/segment.md lists the fields");
   }
   if (card.width < 8 || card.height < 8 || card.width > 8192 || card.height > 8192)
     return Status::ParseError(path + ": input size outside 8..8192");

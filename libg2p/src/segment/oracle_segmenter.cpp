@@ -65,6 +65,9 @@ class OracleSegmenter final : public Segmenter {
       else
         return Status::InvalidArgument("oracle: unknown setting '" + k + "' (known: labels, key)");
     }
+    // Refused when made, before a run loads and renders anything.
+    if (labels_path_.empty())
+      return Status::InvalidArgument("oracle: needs the setting labels=FILE.json (the ground truth, labels.json form)");
     return Status::Ok();
   }
 

@@ -23,11 +23,13 @@ core=(
   nlohmann-json3-dev libcli11-dev libcurl4-openssl-dev
   liburdfdom-dev libqhull-dev
 )
-# Tests, validation with real consumers, benchmarks, bindings; Chromium for
+# Tests, validation with real consumers, benchmarks, bindings; WordNet for the
+# object table's check (scripts/objects/build_objects.py --check); Chromium for
 # the summary.html browser tests (headless).
 extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
+  wordnet-base
   libmujoco-dev libgl-dev libopengl-dev libbullet-extras-dev
   liburdfdom-tools libsdformat-dev libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-onnx

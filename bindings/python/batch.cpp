@@ -36,6 +36,9 @@ py::dict row_dict(const BatchRow& r) {
   d["mass_kg"] = r.mass_kg;
   d["mass_min_kg"] = r.mass_min_kg;
   d["mass_max_kg"] = r.mass_max_kg;
+  d["kind"] = r.kind;
+  d["kind_confidence"] = r.kind_confidence;
+  d["mass_in_kind_range"] = r.mass_in_kind_range;
   d["seconds"] = r.seconds;
   d["stage_seconds"] = r.stage_seconds;
   d["peak_rss_mib"] = static_cast<double>(r.peak_rss_bytes) / (1024.0 * 1024.0);
@@ -61,6 +64,9 @@ BatchRow row_of_dict(const py::dict& d) {
   r.mass_kg = get("mass_kg", 0.0);
   r.mass_min_kg = get("mass_min_kg", 0.0);
   r.mass_max_kg = get("mass_max_kg", 0.0);
+  r.kind = get("kind", std::string());
+  r.kind_confidence = get("kind_confidence", 0.0);
+  r.mass_in_kind_range = get("mass_in_kind_range", std::string());
   r.seconds = get("seconds", 0.0);
   r.stage_seconds = get("stage_seconds", std::map<std::string, double>());
   r.peak_rss_bytes = static_cast<std::size_t>(get("peak_rss_mib", 0.0) * 1024.0 * 1024.0);

@@ -197,6 +197,7 @@ void bind_pipeline(py::module_& m) {
   py::enum_<Stage>(m, "Stage")
       .value("LOAD", Stage::kLoad)
       .value("RENDER", Stage::kRender)
+      .value("IDENTIFY", Stage::kIdentify)
       .value("SEGMENT", Stage::kSegment)
       .value("PROJECT", Stage::kProject)
       .value("REFINE", Stage::kRefine)
@@ -281,6 +282,19 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("renderer", &PipelineOptions::renderer)
       .def_readwrite("views", &PipelineOptions::views)
       .def_readwrite("render", &PipelineOptions::render)
+      .def_readwrite("identifier", &PipelineOptions::identifier,
+                     "identify backend: auto (default), object, names, detector, vlm, none")
+      .def_readwrite("object", &PipelineOptions::object, "the object in your words ('exercise bike'); '' = none")
+      .def_property(
+          "size_from", [](const PipelineOptions& o) { return std::string(to_string(o.size_policy)); },
+          [](PipelineOptions& o, const std::string& v) {
+            Result<SizePolicy> p = parse_size_policy(v);
+            if (!p.ok()) throw py::value_error(p.status().message());
+            o.size_policy = *p;
+          },
+          "'kind' (a normalised mesh takes its identified kind's typical size) or 'file'")
+      .def_readwrite("size_confidence", &PipelineOptions::size_confidence,
+                     "the least identification confidence for which a size is assumed")
       .def_readwrite("segmenter", &PipelineOptions::segmenter)
       .def_readwrite("project", &PipelineOptions::project)
       .def_readwrite("refiner", &PipelineOptions::refiner)
@@ -342,6 +356,16 @@ void bind_pipeline(py::module_& m) {
           "inertia", [](const PyPipelineResult& r) { return Eigen::Matrix3d(r.properties.object.inertia); },
           "(3, 3) kg m^2 about the centre of mass")
       .def_property_readonly("asset_name", [](const PyPipelineResult& r) { return r.asset.name; })
+      .def_property_readonly(
+          "identification",
+          [](const PyPipelineResult& r) {
+            return json_loads(identification_json(r.identification, ObjectTable::shipped(), r.size_assumed_m));
+          },
+          "what the object was identified as: a dict (kind, confidence, source, candidates, ...)")
+      .def_property_readonly(
+          "kind", [](const PyPipelineResult& r) { return r.identification.kind(); }, "the object's kind, or 'unknown'")
+      .def_readonly("size_assumed_m", &PipelineResult::size_assumed_m,
+                    "> 0: the longest side the run gave a normalised mesh from its kind")
       .def_property_readonly("stages",
                              [](const PyPipelineResult& r) {
                                py::list l;

@@ -54,10 +54,10 @@ TEST(Pipeline, TurnsTheHammerIntoAWoodenHandleAndASteelHead) {
   EXPECT_NEAR(r->asset.total.mass_kg, r->properties.object.mass_kg, 1e-9);
 
   // Every stage ran, in order, and was timed and measured.
-  const Stage order[] = {Stage::kLoad,     Stage::kRender,     Stage::kSegment,   Stage::kProject, Stage::kRefine,
-                         Stage::kComplete, Stage::kProperties, Stage::kDecompose, Stage::kExport};
-  ASSERT_EQ(r->stages.size(), 9u);
-  for (std::size_t i = 0; i < 9; ++i) {
+  const Stage order[] = {Stage::kLoad,   Stage::kRender,   Stage::kIdentify,   Stage::kSegment,   Stage::kProject,
+                         Stage::kRefine, Stage::kComplete, Stage::kProperties, Stage::kDecompose, Stage::kExport};
+  ASSERT_EQ(r->stages.size(), 10u);
+  for (std::size_t i = 0; i < 10; ++i) {
     EXPECT_EQ(r->stages[i].stage, order[i]);
     EXPECT_TRUE(r->stages[i].ok);
     EXPECT_GE(r->stages[i].seconds, 0.0);
@@ -65,6 +65,8 @@ TEST(Pipeline, TurnsTheHammerIntoAWoodenHandleAndASteelHead) {
   }
   EXPECT_EQ(r->stage(Stage::kSegment)->backend, "hybrid");  // the default
   EXPECT_EQ(r->stage(Stage::kRefine)->backend, "smooth");
+  EXPECT_EQ(r->stage(Stage::kIdentify)->backend, "auto");
+  EXPECT_EQ(r->identification.kind(), "hammer");  // its file and mesh names
   EXPECT_TRUE(r->warnings.empty());
   EXPECT_GT(r->seconds, 0.0);
 
@@ -89,9 +91,11 @@ TEST(Pipeline, WarnsOfAnImplausibleSizeAndOfPartsLeftOut) {
   o.import = hundredfold;
   Result<PipelineResult> big = Pipeline(o).run_file(hammer());
   ASSERT_TRUE(big.ok()) << big.status().to_string();
-  ASSERT_EQ(big->warnings.size(), 1u);
-  EXPECT_NE(big->warnings[0].find("--unit"), std::string::npos) << big->warnings[0];
-  EXPECT_NE(big->warnings[0].find("34 m long"), std::string::npos) << big->warnings[0];
+  // Two warnings: the size, and the mass against a hammer's (its names say what it is).
+  ASSERT_EQ(big->warnings.size(), 2u);
+  EXPECT_NE(big->warnings[0].find("outside a hammer's usual"), std::string::npos) << big->warnings[0];
+  EXPECT_NE(big->warnings[1].find("--unit"), std::string::npos) << big->warnings[1];
+  EXPECT_NE(big->warnings[1].find("34 m long"), std::string::npos) << big->warnings[1];
 
   // Debian's spider (centimetres in an OBJ, so about 190 m): many thin parts
   // get no closed volume, and the warning names them.
@@ -298,7 +302,7 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
   EXPECT_EQ(run["format"], "g2p-run");
   EXPECT_EQ(run["parts"].size(), 2u);
   EXPECT_NEAR(run["object"]["mass_kg"].get<double>(), r->properties.object.mass_kg, 1e-9);
-  EXPECT_EQ(run["stages"].size(), 9u);
+  EXPECT_EQ(run["stages"].size(), 10u);
   const std::string html = test::read_file(dir + "/summary.html");
   EXPECT_NE(html.find("Metal"), std::string::npos);
   EXPECT_NE(html.find("Wood"), std::string::npos);

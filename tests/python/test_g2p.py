@@ -167,12 +167,15 @@ class HammerPipelineTest(unittest.TestCase):
     def test_stage_reports_progress_and_summary(self):
         r = self.result
         self.assertEqual([s["stage"] for s in r.stages],
-                         ["load", "render", "segment", "project", "refine", "complete", "properties", "decompose",
-                          "export"])
+                         ["load", "render", "identify", "segment", "project", "refine", "complete", "properties",
+                          "decompose", "export"])
         for s in r.stages:
             self.assertTrue(s["ok"], s)
             self.assertGreaterEqual(s["seconds"], 0.0)
         self.assertEqual(r.stage(g2p.Stage.SEGMENT)["backend"], "hybrid")  # the default
+        self.assertEqual(r.kind, "hammer")  # its file and mesh names
+        self.assertEqual(r.identification["source"], "names")
+        self.assertEqual(r.summary_json()["identification"]["kind"], "hammer")
         self.assertEqual(r.warnings, [])
         self.assertGreater(r.seconds, 0.0)
         self.assertEqual(self.progress[-1].stage, g2p.Stage.EXPORT)

@@ -135,6 +135,29 @@ void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args) {
       "pbr: names=on|off, temperature=T)");
 }
 
+void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
+  cmd->add_option("--object", args.object,
+                  "What the object is, in your words (\"exercise bike\", \"a wooden chair with metal legs\"): "
+                  "it wins over what the names and the views suggest; words that name no kind of the object "
+                  "table are an error naming the nearest (g2p identify --list)");
+  cmd->add_option("--identifier", args.name,
+                  "How the object is identified: auto (--object, else names and the COCO detector), object, "
+                  "names, detector, vlm, none")
+      ->capture_default_str();
+  cmd->add_option("--identify-set", args.settings,
+                  "Identifier setting KEY=VALUE, repeatable (auto: detector=on|off, model_card, min_score; "
+                  "detector: model_card=FILE, min_score, min_iou; vlm: url, model, api_key_env, max_views)");
+  cmd->add_option("--size-from", args.size_from,
+                  "A mesh that looks normalised, with no --height or --longest-side: kind (its kind's typical "
+                  "size when identified confidently) or file (keep the file's size)")
+      ->check(CLI::IsMember({"kind", "file"}))
+      ->capture_default_str();
+  cmd->add_option("--size-confidence", args.size_confidence,
+                  "The least identification confidence for which --size-from kind assumes a size")
+      ->check(finite_number(0.0, 1.0))
+      ->capture_default_str();
+}
+
 Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,
                                                        int& exit_code) {
   BackendSettings settings;

@@ -9,6 +9,7 @@
 
 #include "g2p/io.h"
 #include "g2p/materials.h"
+#include "g2p/pipeline.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
 
@@ -65,6 +66,18 @@ struct SegmenterArgs {
 void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args);
 Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,
                                                        int& exit_code);
+
+// What the object is, and the size its kind may give it: --object,
+// --identifier, --identify-set, --size-from, --size-confidence.
+struct IdentifyArgs {
+  std::string object;  // the user's words; "" = none
+  std::string name = PipelineOptions{}.identifier.name;
+  std::vector<std::string> settings;
+  std::string size_from = to_string(PipelineOptions{}.size_policy);
+  double size_confidence = PipelineOptions{}.size_confidence;
+};
+
+void add_identify_flags(CLI::App* cmd, IdentifyArgs& args);
 
 // The material table of --materials ("" = the paper's default).
 Result<MaterialTable> load_table_flag(const std::string& command, const std::string& path, int& exit_code);

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   g2p::cli::Command run;
   g2p::cli::add_run_command(app, run);
   g2p::cli::add_batch_command(app, run);
+  g2p::cli::add_identify_command(app, run);
   g2p::cli::add_info_command(app, run);
   g2p::cli::add_render_command(app, run);
   g2p::cli::add_segment_command(app, run);

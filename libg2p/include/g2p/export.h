@@ -40,6 +40,9 @@ struct SimulationAsset {
   std::vector<AssetPart> parts;
   MassProperties total;  // about the centre of mass, in the object's frame (+Z up, metres)
   std::vector<std::string> notes;
+  // What the object was identified as, as identification_json() writes it
+  // (identify.h): report.json's "identification". "" = not identified.
+  std::string identification_json;
 };
 
 // Gathers the stages' results. Parts without a closed volume are left out

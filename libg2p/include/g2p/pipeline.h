@@ -1,6 +1,8 @@
 // The whole Gen2Physics method in one call: a mesh in, simulation-ready parts
 // out. Pipeline runs the six stages (render, segment, project, refine,
-// complete, properties) and builds the simulation asset; every stage's backend
+// complete, properties), with the object identified after render (what it is
+// sets a normalised mesh's size and checks its mass), and builds the
+// simulation asset; every stage's backend
 // is chosen by name through its registry or given as an object (a user's own
 // Segmenter, say). write_pipeline_output() then writes the output folder
 // atomically (docs/pipeline.md lists what it holds).
@@ -21,6 +23,7 @@
 #include "g2p/complete.h"
 #include "g2p/decompose.h"
 #include "g2p/export.h"
+#include "g2p/identify.h"
 #include "g2p/io.h"
 #include "g2p/materials.h"
 #include "g2p/model.h"
@@ -36,9 +39,20 @@
 namespace g2p {
 
 // The steps of one run, in order. kLoad only runs in Pipeline::run_file.
-enum class Stage { kLoad, kRender, kSegment, kProject, kRefine, kComplete, kProperties, kDecompose, kExport };
-constexpr int kNumStages = 9;
-G2P_API const char* to_string(Stage stage);  // "load", "render", ... "decompose", "export"
+enum class Stage {
+  kLoad,
+  kRender,
+  kIdentify,
+  kSegment,
+  kProject,
+  kRefine,
+  kComplete,
+  kProperties,
+  kDecompose,
+  kExport
+};
+constexpr int kNumStages = 10;
+G2P_API const char* to_string(Stage stage);  // "load", "render", "identify", ... "decompose", "export"
 
 // ---- Progress and cancellation ------------------------------------------------
 
@@ -91,6 +105,17 @@ struct PipelineOptions {
   BackendChoice renderer{"embree", {}};
   ViewOptions views;
   RenderOptions render;
+
+  // Identify (after render): what the object is, from the user's words, the
+  //    file's names and the views: "auto" (the default), "object", "names",
+  //    "detector", "vlm", "none" (identify.h, docs/identify.md).
+  BackendChoice identifier{"auto", {}};
+  std::string object;  // the user's words for the object ("exercise bike"; g2p run --object); "" = none
+  // A mesh that looks normalised (ImportInfo::looks_normalised), with no size
+  // given, gets its kind's typical longest side when the kind is known with
+  // at least `size_confidence`; SizePolicy::kFile keeps the file's size.
+  SizePolicy size_policy = SizePolicy::kKind;
+  double size_confidence = 0.6;  // [0, 1]; the detector alone reaches it only when most views agree (identify.md)
 
   // 2. segment: "hybrid" (the default: `pbr` on per-part materials, the
   //    shipped network where one material covers the whole object with a
@@ -167,6 +192,9 @@ struct G2P_API PipelineResult {
   Model model;
   MaterialTable table;
   std::vector<View> views;
+  Identification identification;      // what the object is (unknown when the identifier could not tell)
+  ObjectKind kind;                    // its entry in the object table; name "" when unknown
+  double size_assumed_m = 0.0;        // > 0: the kind's longest side the run gave a normalised mesh, metres
   std::vector<LabelMap> label_maps;   // per view, from the segmenter
   Projection projection;              // after refinement when it ran
   std::vector<int> projected_labels;  // per face, before refinement (for ablations)
@@ -207,6 +235,8 @@ class G2P_API Pipeline {
   // Backend objects replace the named ones; null goes back to the name.
   // Shared, so a caller (or Python) may keep its own handle.
   void set_renderer(std::shared_ptr<Renderer> renderer);
+  void set_identifier(std::shared_ptr<Identifier> identifier);
+  void set_object_table(ObjectTable table);  // default: ObjectTable::shipped()
   void set_segmenter(std::shared_ptr<Segmenter> segmenter);
   void set_refiner(std::shared_ptr<Refiner> refiner);
   void set_completer(std::shared_ptr<Completer> completer);

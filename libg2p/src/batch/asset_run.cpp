@@ -73,6 +73,16 @@ bool read_run_json(const fs::path& folder, BatchRow& row) {
     row.mass_min_kg = j["object"].value("mass_min_kg", 0.0);
     row.mass_max_kg = j["object"].value("mass_max_kg", 0.0);
   }
+  row.kind.clear();
+  row.kind_confidence = 0.0;
+  row.mass_in_kind_range.clear();
+  if (j.contains("identification") && j["identification"].is_object()) {
+    const nlohmann::json& id = j["identification"];
+    row.kind = id.value("kind", "");
+    row.kind_confidence = id.value("confidence", 0.0);
+    if (id.contains("mass_in_kind_range") && id["mass_in_kind_range"].is_boolean())
+      row.mass_in_kind_range = id["mass_in_kind_range"].get<bool>() ? "yes" : "no";
+  }
   row.stage_seconds.clear();
   if (j.contains("stages") && j["stages"].is_array())
     for (const nlohmann::json& s : j["stages"])

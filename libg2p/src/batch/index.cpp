@@ -70,6 +70,9 @@ nlohmann::json row_json(const BatchRow& r) {
           {"mass_kg", r.mass_kg},
           {"mass_min_kg", r.mass_min_kg},
           {"mass_max_kg", r.mass_max_kg},
+          {"kind", r.kind},
+          {"kind_confidence", r.kind_confidence},
+          {"mass_in_kind_range", r.mass_in_kind_range},
           {"seconds", r.seconds},
           {"stage_seconds", stages},
           {"peak_rss_mib", static_cast<double>(r.peak_rss_bytes) / (1024.0 * 1024.0)},
@@ -91,6 +94,9 @@ BatchRow row_of_json(const nlohmann::json& j) {
   r.mass_kg = j.value("mass_kg", 0.0);
   r.mass_min_kg = j.value("mass_min_kg", 0.0);
   r.mass_max_kg = j.value("mass_max_kg", 0.0);
+  r.kind = j.value("kind", "");
+  r.kind_confidence = j.value("kind_confidence", 0.0);
+  r.mass_in_kind_range = j.value("mass_in_kind_range", "");
   r.seconds = j.value("seconds", 0.0);
   if (j.contains("stage_seconds") && j["stage_seconds"].is_object())
     for (const auto& [stage, seconds] : j["stage_seconds"].items())
@@ -109,7 +115,8 @@ std::string number(double value) {
 
 std::string index_csv(const std::vector<BatchRow>& rows) {
   std::ostringstream out;
-  out << "name,status,error,exit_code,input,parts,materials,mass_kg,mass_min_kg,mass_max_kg,seconds,peak_rss_mib";
+  out << "name,status,error,exit_code,input,parts,materials,mass_kg,mass_min_kg,mass_max_kg,kind,kind_confidence,"
+         "mass_in_kind_range,seconds,peak_rss_mib";
   for (int s = 0; s < kNumStages; ++s) out << ",seconds_" << to_string(static_cast<Stage>(s));
   out << ",output,key,finished_at\n";
   for (const BatchRow& r : rows) {
@@ -117,7 +124,8 @@ std::string index_csv(const std::vector<BatchRow>& rows) {
     for (const std::string& m : r.materials) materials += (materials.empty() ? "" : ";") + m;
     out << csv_field(r.name) << "," << r.status << "," << csv_field(r.error) << "," << r.exit_code << ","
         << csv_field(r.input) << "," << r.parts << "," << csv_field(materials) << "," << number(r.mass_kg) << ","
-        << number(r.mass_min_kg) << "," << number(r.mass_max_kg) << "," << number(r.seconds) << ","
+        << number(r.mass_min_kg) << "," << number(r.mass_max_kg) << "," << csv_field(r.kind) << ","
+        << number(r.kind_confidence) << "," << r.mass_in_kind_range << "," << number(r.seconds) << ","
         << number(static_cast<double>(r.peak_rss_bytes) / (1024.0 * 1024.0));
     for (int s = 0; s < kNumStages; ++s) {
       auto it = r.stage_seconds.find(to_string(static_cast<Stage>(s)));

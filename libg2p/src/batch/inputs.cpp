@@ -169,7 +169,7 @@ bool is_g2p_output(const fs::path& dir) {
 }  // namespace
 
 const std::vector<std::string>& batch_manifest_columns() {
-  static const std::vector<std::string> columns{"name", "unit", "up", "segmenter", "height", "longest_side"};
+  static const std::vector<std::string> columns{"name", "unit", "up", "segmenter", "height", "longest_side", "object"};
   return columns;
 }
 

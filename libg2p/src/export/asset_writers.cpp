@@ -161,6 +161,10 @@ std::string asset_report_json(const PropertiesReport& report, const SimulationAs
         {"visual", {{"triangles", p.visual.num_faces()}, {"file", "meshes/" + p.name + "_visual.obj"}}},
         {"collision", collision}};
   }
+  if (!asset.identification_json.empty()) {
+    const json id = json::parse(asset.identification_json, nullptr, /*allow_exceptions=*/false);
+    if (!id.is_discarded()) doc["identification"] = id;
+  }
   return detail::json_text(doc, 2) + "\n";
 }
 

@@ -299,6 +299,16 @@ std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions
     if (f == "sdf") files.push_back(r.asset.name + ".sdf");
     if (f == "glb") files.push_back(r.asset.name + ".glb");
   }
+  nlohmann::json identification =
+      r.asset.identification_json.empty()
+          ? nlohmann::json(nullptr)
+          : nlohmann::json::parse(r.asset.identification_json, nullptr, /*allow_exceptions=*/false);
+  if (identification.is_object()) {
+    const bool known = !r.kind.name.empty() && m.mass_kg > 0;
+    identification["mass_in_kind_range"] =
+        known ? nlohmann::json(m.mass_kg >= r.kind.mass_kg[0] && m.mass_kg <= r.kind.mass_kg[1])
+              : nlohmann::json(nullptr);
+  }
   const nlohmann::json j = {{"format", "g2p-run"},
                             {"version", 1},
                             {"model", r.model.info.path},
@@ -315,6 +325,7 @@ std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions
                               {"mass_min_kg", r.properties.mass_min_kg},
                               {"mass_max_kg", r.properties.mass_max_kg},
                               {"center_of_mass_m", vec3(m.center_of_mass)}}},
+                            {"identification", identification},
                             {"assets", files},
                             {"overrides", r.overrides_applied},
                             {"warnings", r.warnings}};

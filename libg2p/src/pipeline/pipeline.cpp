@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <new>
@@ -54,6 +55,12 @@ Status prepare_slot(Slot<Interface>& slot, const BackendChoice& choice, const ch
   return Status::Ok();
 }
 
+std::string fixed_mass(double kg) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g kg", kg);
+  return b;
+}
+
 // Warnings a user should not miss in the finished asset: parts left out of
 // it, and an object far larger or heavier (or smaller) than anything
 // household or industrial, which almost always means a file in other units.
@@ -77,6 +84,16 @@ void plausibility_warnings(PipelineResult& r) {
   const double mass = r.asset.total.mass_kg;
   char what[160];
   std::snprintf(what, sizeof what, "%.3g kg and %.3g m long", mass, longest);
+  // The kind's usual mass: the plausibility check once the object is known.
+  if (!r.kind.name.empty() && mass > 0.0 && (mass < r.kind.mass_kg[0] || mass > r.kind.mass_kg[1])) {
+    char range[96];
+    std::snprintf(range, sizeof range, "%.3g-%.3g kg", r.kind.mass_kg[0], r.kind.mass_kg[1]);
+    const bool vowel = std::string("aeiou").find(r.kind.name.front()) != std::string::npos;
+    r.warnings.push_back("mass: the object weighs " + fixed_mass(mass) + ", outside " + (vowel ? "an " : "a ") +
+                         r.kind.name + "'s usual " + range +
+                         " (the object table): check its size (--height, --longest-side), the parts' classes and "
+                         "their structure, or what it is (--object)");
+  }
   if (r.model.info.looks_normalised) return;  // the import warning names the cause and the flags
   if (longest > 30.0 || mass > 50000.0)
     r.warnings.push_back(std::string("the object is ") + what +
@@ -94,6 +111,8 @@ struct Pipeline::Impl {
   PipelineOptions options;
   MaterialTable table = MaterialTable::paper_default();
   Slot<Renderer> renderer;
+  Slot<Identifier> identifier;
+  std::unique_ptr<ObjectTable> objects;  // a caller's; null: ObjectTable::shipped()
   Slot<Segmenter> segmenter;
   Slot<Refiner> refiner;
   Slot<Completer> completer;
@@ -102,6 +121,8 @@ struct Pipeline::Impl {
   Slot<Decomposer> decomposer;
 
   Status run_stages(PipelineResult& r, RunContext& context);
+  Status identify_object(PipelineResult& r, RunContext& context);
+  const ObjectTable& object_table() const { return objects ? *objects : ObjectTable::shipped(); }
 };
 
 Pipeline::Pipeline(PipelineOptions options) : impl_(std::make_unique<Impl>()) { impl_->options = std::move(options); }
@@ -113,6 +134,8 @@ const PipelineOptions& Pipeline::options() const { return impl_->options; }
 PipelineOptions& Pipeline::options() { return impl_->options; }
 
 void Pipeline::set_renderer(std::shared_ptr<Renderer> r) { impl_->renderer.custom = std::move(r); }
+void Pipeline::set_identifier(std::shared_ptr<Identifier> i) { impl_->identifier.custom = std::move(i); }
+void Pipeline::set_object_table(ObjectTable table) { impl_->objects = std::make_unique<ObjectTable>(std::move(table)); }
 void Pipeline::set_segmenter(std::shared_ptr<Segmenter> s) { impl_->segmenter.custom = std::move(s); }
 void Pipeline::set_refiner(std::shared_ptr<Refiner> r) { impl_->refiner.custom = std::move(r); }
 void Pipeline::set_completer(std::shared_ptr<Completer> c) { impl_->completer.custom = std::move(c); }
@@ -131,6 +154,16 @@ Status Pipeline::prepare() {
           Status::InvalidArgument("renderers take no settings (got '" + c.settings.begin()->first + "')"));
     return renderer_registry().create(c.name);
   }));
+  G2P_RETURN_IF_ERROR(prepare_slot(m.identifier, o.identifier, "identify",
+                                   [](const BackendChoice& c) { return make_identifier(c.name, c.settings); }));
+  if (!(o.size_confidence >= 0.0 && o.size_confidence <= 1.0))
+    return Status::InvalidArgument("pipeline: --size-confidence must lie in [0, 1] (PipelineOptions::size_confidence)");
+  if (m.object_table().size() == 0)
+    return Status::Internal("pipeline: the shipped object table did not load (libg2p/data/objects.json)");
+  if (!o.object.empty()) {  // the user's words must name a kind: said before any work
+    Result<std::string> kind = kind_from_text(m.object_table(), o.object);
+    if (!kind.ok()) return kind.status();
+  }
   G2P_RETURN_IF_ERROR(prepare_slot(m.segmenter, o.segmenter, "segment",
                                    [](const BackendChoice& c) { return make_segmenter(c.name, c.settings); }));
   G2P_RETURN_IF_ERROR(prepare_slot(m.refiner, o.refiner, "refine",
@@ -195,6 +228,10 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   }
 
   if (o.last_stage == Stage::kRender) return Status::Ok();
+
+  // What the object is; a normalised mesh may take its kind's size.
+  G2P_RETURN_IF_ERROR(identify_object(r, context));
+  if (o.last_stage == Stage::kIdentify) return Status::Ok();
 
   // 2. segment: a material class per pixel.
   {
@@ -393,11 +430,117 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
         make_asset(name, mesh, r.projection.parts, r.completion, r.properties, r.table, r.collision);
     if (!asset.ok()) return asset.status().with_context("export");
     r.asset = std::move(*asset);
+    r.asset.identification_json = identification_json(r.identification, object_table(), r.size_assumed_m);
     clock.report().notes = r.asset.notes;
     plausibility_warnings(r);
     G2P_RETURN_IF_ERROR(context.report(Stage::kExport, 1.0, r.asset.name));
     finish(clock);
   }
+  return Status::Ok();
+}
+
+namespace {
+
+// Scales a rendered run about the origin: the mesh, and the views' cameras
+// and depths, so that the views stay the views of the scaled mesh.
+void scale_run(PipelineResult& r, double s) {
+  for (Eigen::Vector3f& p : r.model.mesh.positions) p = (p.cast<double>() * s).cast<float>();
+  ImportInfo& info = r.model.info;
+  info.unit_scale_m *= s;
+  info.file_to_model.topLeftCorner<3, 3>() *= s;
+  for (View& v : r.views) {
+    v.camera.position *= s;
+    if (v.camera.orthographic) {
+      v.camera.fx /= s;
+      v.camera.fy /= s;
+    }
+    for (float& d : v.depth.storage())
+      if (std::isfinite(d)) d = static_cast<float>(d * s);
+  }
+}
+
+std::string fixed(double x, const char* format = "%.3g") {
+  char b[32];
+  std::snprintf(b, sizeof b, format, x);
+  return b;
+}
+
+}  // namespace
+
+Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
+  const PipelineOptions& o = options;
+  detail::StageClock clock(Stage::kIdentify, identifier.backend(o.identifier), o.measure_stage_memory);
+  G2P_RETURN_IF_ERROR(context.report(Stage::kIdentify, 0.0, "identifying"));
+  const ObjectTable& objects_in_use = object_table();
+  IdentifyInput in;
+  in.model = &r.model;
+  in.views = &r.views;
+  in.table = &objects_in_use;
+  in.object_text = o.object;
+  in.use_file_name = !o.anonymize_names;
+  Result<Identification> id = identifier.get()->identify(in);
+  StageReport& report = clock.report();
+  if (!id.ok()) {
+    const StatusCode code = id.status().code();
+    if (code == StatusCode::kInvalidArgument || code == StatusCode::kNotFound || code == StatusCode::kCancelled)
+      return id.status().with_context("identify");  // the user's words or settings: theirs to fix
+    report.ok = false;
+    report.error = id.status().to_string();
+    r.warnings.push_back("identify (" + report.backend + ") failed; the object is taken as unknown: " + report.error);
+  } else {
+    r.identification = std::move(*id);
+  }
+  const Identification& ident = r.identification;
+  for (const std::string& w : ident.warnings) r.warnings.push_back("identify: " + w);
+  report.notes = ident.notes;
+  const int k = ident.known() ? objects_in_use.find(ident.kind()) : -1;
+  if (k >= 0) r.kind = objects_in_use.kinds()[static_cast<std::size_t>(k)];
+  const std::string said = ident.known() ? ident.kind() + " (" + ident.source() + ", " +
+                                               fixed(100.0 * ident.confidence(), "%.0f") + " % confident)"
+                                         : std::string("unknown");
+  report.notes.push_back("identified as " + said);
+
+  // A normalised mesh with no size given: the kind's typical longest side,
+  // when the kind is confident enough and the policy allows.
+  ImportInfo& info = r.model.info;
+  if (info.looks_normalised && info.scale_source == "file") {
+    const bool confident = k >= 0 && ident.confidence() >= o.size_confidence;
+    auto normalised_warning = [&info] {
+      return std::find_if(info.warnings.begin(), info.warnings.end(),
+                          [](const std::string& w) { return w.rfind("the model looks normalised", 0) == 0; });
+    };
+    const auto it = normalised_warning();
+    if (o.size_policy == SizePolicy::kKind && confident) {
+      const double longest = bounds(r.model.mesh).sizes().maxCoeff();
+      const double target = r.kind.typical_longest_side_m;
+      if (longest > 0.0 && std::isfinite(longest) && target > 0.0) {
+        scale_run(r, target / longest);
+        info.scale_source = "kind";
+        r.size_assumed_m = target;
+        const std::string text =
+            "the model looks normalised (its longest side was " + fixed(longest) + " m) and is identified as " + said +
+            ": it is scaled to a " + r.kind.name + "'s typical longest side, " + fixed(target) +
+            " m (the object table). Give the real size with --height or --longest-side, or keep the file's with "
+            "--size-from file (PipelineOptions::size_policy)";
+        if (it != info.warnings.end())
+          *it = text;
+        else
+          info.warnings.push_back(text);
+        report.notes.push_back("size assumed: longest side " + fixed(target) + " m, a " + r.kind.name + "'s");
+      }
+    } else if (it != info.warnings.end()) {
+      if (o.size_policy == SizePolicy::kFile)
+        *it += "; its size is kept as the file's (--size-from file)";
+      else if (k >= 0)
+        *it += "; identified as " + said + ", below the " + fixed(100.0 * o.size_confidence, "%.0f") +
+               " % needed to assume its size (--size-confidence)";
+      else
+        *it += "; what the object is could not be told (give it with --object to assume its kind's size)";
+    }
+  }
+  G2P_RETURN_IF_ERROR(context.report(Stage::kIdentify, 1.0, ident.kind()));
+  r.stages.push_back(clock.finish());
+  r.peak_rss_bytes = std::max(r.peak_rss_bytes, r.stages.back().peak_rss_bytes);
   return Status::Ok();
 }
 

@@ -15,6 +15,7 @@ const char* to_string(Stage stage) {
   switch (stage) {
     case Stage::kLoad: return "load";
     case Stage::kRender: return "render";
+    case Stage::kIdentify: return "identify";
     case Stage::kSegment: return "segment";
     case Stage::kProject: return "project";
     case Stage::kRefine: return "refine";
@@ -30,7 +31,7 @@ namespace {
 
 // Share of a typical run's time per stage (measured on the shared assets,
 // docs/performance.md); only shapes the overall progress fraction.
-constexpr double kStageWeight[kNumStages] = {0.08, 0.20, 0.06, 0.10, 0.04, 0.36, 0.06, 0.06, 0.04};
+constexpr double kStageWeight[kNumStages] = {0.08, 0.20, 0.02, 0.06, 0.10, 0.04, 0.36, 0.06, 0.06, 0.04};
 
 }  // namespace
 

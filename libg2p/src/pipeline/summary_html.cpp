@@ -45,6 +45,8 @@ std::string size_source(const ImportInfo& info) {
   if (info.scale_source == "height") return "--height";
   if (info.scale_source == "longest-side") return "--longest-side";
   if (info.scale_source == "unit") return "--unit";
+  if (info.scale_source == "kind")
+    return "the object's kind: the file looked normalised; give --height or --longest-side for the real size";
   return info.looks_normalised ? "the file, which looks normalised: give --height or --longest-side" : "the file";
 }
 
@@ -127,6 +129,29 @@ void views_section(std::ostringstream& h, const PipelineResult& r) {
   h << "</div>\n";
 }
 
+// "a chair", "an oven".
+std::string article(const std::string& noun) {
+  const bool vowel = !noun.empty() && std::string("aeiou").find(noun.front()) != std::string::npos;
+  return (vowel ? "an " : "a ") + noun;
+}
+
+// What the object was taken for, and what that kind usually weighs.
+void object_line(std::ostringstream& h, const PipelineResult& r) {
+  const Identification& id = r.identification;
+  h << "<p id=\"g2p-object\">What it is: ";
+  if (!id.known()) {
+    h << "<b>unknown</b> (give it with <code>g2p run --object</code> to check its mass against its kind)</p>\n";
+    return;
+  }
+  h << "<b>" << escape(id.kind()) << "</b> (from " << escape(id.source()) << ", "
+    << number(100.0 * id.confidence(), "%.0f") << " % confident: " << escape(id.candidates.front().evidence) << ")";
+  if (!r.kind.name.empty())
+    h << "; " << escape(article(r.kind.name)) << " usually weighs " << number(r.kind.mass_kg[0]) << " to "
+      << number(r.kind.mass_kg[1]) << " kg";
+  if (r.size_assumed_m > 0) h << "; size assumed: longest side " << number(r.size_assumed_m) << " m";
+  h << ". Correct it with <code>--object</code>.</p>\n";
+}
+
 // Everything a person should see before using the asset, at the top.
 void warnings_banner(std::ostringstream& h, const PipelineResult& r) {
   std::vector<std::string> items = r.warnings;
@@ -192,6 +217,11 @@ std::string plain_words(const PipelineResult& r, const StageReport& s) {
              plural(r.model.materials.size(), "material", "materials") + " from the file.";
     case Stage::kRender:
       return "Drew the object from " + plural(r.views.size(), "side", "sides") + " (the views above).";
+    case Stage::kIdentify:
+      if (!r.identification.known()) return "Could not tell what the object is; nothing was assumed from its kind.";
+      return "Took the object for " + article(r.identification.kind()) + " (" + r.identification.source() + ")" +
+             (r.size_assumed_m > 0 ? " and gave it that kind's typical size, since the file's looked normalised."
+                                   : ".");
     case Stage::kSegment:
       return "Gave every pixel of every view one of " + std::to_string(r.table.size()) + " material classes.";
     case Stage::kProject: {
@@ -263,6 +293,7 @@ std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
     << number(r.properties.size.extent_m.x()) << " x " << number(r.properties.size.extent_m.y()) << " x "
     << number(r.properties.size.extent_m.z()) << " m (height last; scale from " << escape(size_source(r.model.info))
     << "). Run time " << number(r.seconds, "%.2f") << " s.</p>\n";
+  object_line(h, r);
   warnings_banner(h, r);
   if (!r.overrides_applied.empty()) {
     h << "<div class=\"corrections\" id=\"g2p-corrections\"><h2>Corrections applied</h2><ul>\n";

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/model_files.h"
 #include "g2p/segment.h"
 
 namespace g2p {
@@ -44,9 +45,7 @@ NameScores pbr_name_scores(const Model& model, const MaterialTable& table);
 // the source tree's libg2p/data/models or the installed share/g2p/models), or
 // "" when none is found.
 std::string shipped_model_card();
-// A file shipped beside the network (the region classifier's card and trees),
-// searched in the same folders; empty if none has it.
-std::string shipped_model_file(const std::string& name);
+// shipped_model_file (core/model_files.h): a file beside the network.
 
 // Whether an author set the material's PBR values: read from a format with PBR
 // materials, and not glTF's defaults (a metallic-roughness texture,

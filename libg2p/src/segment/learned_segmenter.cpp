@@ -46,23 +46,6 @@ namespace detail {
 
 std::string shipped_model_card() { return shipped_model_file(kShippedCard); }
 
-std::string shipped_model_file(const std::string& name) {
-  std::vector<std::string> dirs;
-  if (const char* env = std::getenv("G2P_MODEL_DIR"); env != nullptr && *env != '\0') dirs.emplace_back(env);
-#ifdef G2P_SOURCE_MODEL_DIR
-  dirs.emplace_back(G2P_SOURCE_MODEL_DIR);
-#endif
-#ifdef G2P_INSTALL_MODEL_DIR
-  dirs.emplace_back(G2P_INSTALL_MODEL_DIR);
-#endif
-  for (const std::string& d : dirs) {
-    std::error_code ec;
-    const std::filesystem::path file = std::filesystem::path(d) / name;
-    if (std::filesystem::is_regular_file(file, ec)) return file.string();
-  }
-  return {};
-}
-
 bool pbr_authored(const SourceMaterial& mat) {
   return mat.pbr_from_file && (!mat.metallic_roughness_texture.empty() || mat.transmission > 0.f ||
                                mat.metallic < 1.f || mat.roughness < 1.f);

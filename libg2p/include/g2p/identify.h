@@ -1,0 +1,192 @@
+// identify: what the object is (a chair, a car, a refrigerator), from the
+// user's words, the names in the file and the rendered views. Not a stage of
+// the Gen2Physics paper, whose vision-language model sees the object in every
+// prompt; libg2p asks once, after render, so that a mesh without a real size
+// (image-to-3D meshes come normalised to about a metre) can be given its
+// kind's typical size and its mass checked against its kind's usual range
+// (docs/identify.md). Backends are swappable through identifier_registry().
+//
+//   g2p::IdentifyInput in;
+//   in.model = &model;  in.views = &views;  in.object_text = "exercise bike";
+//   g2p::Result<g2p::Identification> id = g2p::identify(in);   // "auto"
+//   if (id.ok() && id->known()) std::printf("%s\n", id->kind().c_str());
+#pragma once
+
+#include <array>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "g2p/model.h"
+#include "g2p/registry.h"
+#include "g2p/render.h"
+#include "g2p/status.h"
+#include "g2p/visibility.h"
+#include "g2p/vlm.h"
+
+namespace g2p {
+
+// ---- The table of everyday object kinds ----------------------------------------
+// libg2p/data/objects.json (format "g2p-object-table", its card objects.md and
+// schema objects.schema.json beside it), built by scripts/objects/build_objects.py
+// from hand-written facts with sources and Debian's WordNet 3.0.
+
+struct KindMaterial {
+  std::string role;            // "frame", "seat", "tyres", ...
+  std::string material_class;  // a class of the paper's table: "Wood", "Metal", ...
+};
+
+// Mass that no surface shows: a refrigerator's compressor, a bike's flywheel.
+struct HiddenContent {
+  std::string what;            // in words
+  double mass_fraction = 0.0;  // of the whole object's mass, [0, 0.9]
+  std::string where;           // "bottom", "centre" or "spread"
+};
+
+struct ObjectKind {
+  std::string name;                                // "chair": what g2p prints and --object takes
+  std::string group;                               // "furniture", "appliance", "vehicle", ...
+  std::vector<std::string> synsets;                // WordNet 3.0 noun senses, "chair.n.01"
+  std::string coco;                                // the COCO class this kind answers for; "" = none
+  std::vector<std::string> terms;                  // lowercase words and phrases that name it (WordNet lemmas and more)
+  std::array<double, 2> height_m{0.0, 0.0};        // usual height, upright, metres [lo, hi]
+  std::array<double, 2> longest_side_m{0.0, 0.0};  // usual longest side, metres [lo, hi]
+  double typical_height_m = 0.0;                   // the size assumed when a mesh has none
+  double typical_longest_side_m = 0.0;
+  std::array<double, 2> mass_kg{0.0, 0.0};  // plausible total mass of a real one, kg [lo, hi]
+  std::string structure;                    // "solid", "hollow" or "shell_with_contents"
+  std::vector<KindMaterial> materials;      // by role, the main one first
+  std::vector<HiddenContent> hidden;
+  std::map<std::string, std::string> sources;  // "size", "mass", "materials", "hidden": where each figure comes from
+};
+
+// One place where a text names a kind.
+struct TextMatch {
+  int kind = -1;     // index into ObjectTable::kinds()
+  std::string term;  // the words that matched ("exercise bike")
+  double score = 0;  // higher is better: longer phrases, earlier clauses, head nouns
+};
+
+class G2P_API ObjectTable {
+ public:
+  // Reads and checks a table; `where` names it in errors (a file path).
+  static Result<ObjectTable> from_json(const std::string& text, const std::string& where = "object table");
+  static Result<ObjectTable> read(const std::string& path);
+  // The table libg2p ships (compiled in).
+  static const ObjectTable& shipped();
+
+  const std::vector<ObjectKind>& kinds() const { return kinds_; }
+  int size() const { return static_cast<int>(kinds_.size()); }
+  const std::string& wordnet() const { return wordnet_; }  // the WordNet the terms came from
+  // The kind named exactly `name` (a kind's name, case-insensitive), or -1.
+  int find(const std::string& name) const;
+  // The kind that answers for a COCO class ("dining table"), or -1.
+  int find_coco(const std::string& coco_class) const;
+  // The kinds a free text names ("a wooden chair with metal legs", a file
+  // name such as "OfficeChair_01"), best first, one match per kind. Words are
+  // split at spaces, punctuation, digits and camelCase, plurals are read as
+  // singulars, and the longest phrase wins where phrases overlap; a match in
+  // the first clause (before "with", "of", "on", ...) and the last noun of a
+  // phrase rank first.
+  std::vector<TextMatch> match(const std::string& text) const;
+  // Kind names nearest to `text` by spelling (edit distance over names and
+  // terms), for an error that offers what the user may have meant.
+  std::vector<std::string> nearest(const std::string& text, int count = 5) const;
+
+ private:
+  std::vector<ObjectKind> kinds_;
+  std::map<std::string, int> term_kind_;  // every term and name -> kind
+  std::string wordnet_;
+};
+
+// ---- Identification -------------------------------------------------------------
+
+// One candidate kind, from one source or several.
+struct KindGuess {
+  std::string kind;         // an ObjectTable kind's name
+  double confidence = 0.0;  // [0, 1]
+  std::string source;       // "object" (the user's words), "names", "detector", "vlm", "override", or joined with '+'
+  std::string evidence;     // in words: "file name 'SheenChair'", "chair in 9 of 11 views"
+};
+
+struct Identification {
+  std::vector<KindGuess> candidates;  // best first; empty or below kKnownConfidence = unknown
+  std::vector<std::string> notes;     // what each source said, conflicts between them
+  std::vector<std::string> warnings;  // sources that could not run (a missing model file), in words
+
+  static constexpr double kKnownConfidence = 0.25;  // below it the object is "unknown"
+  bool known() const { return !candidates.empty() && candidates.front().confidence >= kKnownConfidence; }
+  // The best kind's name, or "unknown".
+  std::string kind() const { return known() ? candidates.front().kind : std::string("unknown"); }
+  double confidence() const { return candidates.empty() ? 0.0 : candidates.front().confidence; }
+  std::string source() const { return known() ? candidates.front().source : std::string(); }
+};
+
+// What an identifier may look at. All must outlive the call; every pointer
+// but `model` and `table` may be null.
+struct IdentifyInput {
+  const Model* model = nullptr;              // its names: meshes, nodes, materials, the file's
+  const std::vector<View>* views = nullptr;  // rendered views (RGB) for detectors and the vlm
+  const ObjectTable* table = nullptr;        // null: ObjectTable::shipped()
+  std::string object_text;                   // the user's words (g2p run --object "exercise bike"); "" = none
+  bool use_file_name = true;                 // false when names were removed (anonymize_names)
+};
+
+class G2P_API Identifier {
+ public:
+  virtual ~Identifier();
+  // Backend settings, key = value; unknown keys are errors. Default: none.
+  virtual Status configure(const BackendSettings& settings);
+  // An unknown object is not an error: it is an Identification with no
+  // candidate. Errors are for input the backend cannot use at all (the
+  // user's words that match no kind: kNotFound naming the nearest kinds).
+  virtual Result<Identification> identify(const IdentifyInput& input) const = 0;
+};
+
+// Backends by name. libg2p registers:
+//   "auto"     (the default) the user's words when given, which win; else the
+//              names and the detector together, conflicts noted;
+//   "object"   the user's words only (IdentifyInput::object_text);
+//   "names"    the file, node, mesh and material names, matched through the
+//              table's WordNet terms;
+//   "detector" NanoDet-g's COCO detector over the rendered views (the shipped
+//              g2p-objects-nanodet.onnx; settings model_card, min_score);
+//   "vlm"      a vision-language model asked to name the object (docs/vlm.md);
+//   "none"     always unknown (the behaviour before identification).
+G2P_API Registry<Identifier>& identifier_registry();
+G2P_API Result<std::unique_ptr<Identifier>> make_identifier(const std::string& name,
+                                                            const BackendSettings& settings = {});
+// The `vlm` identifier with a client of the caller's.
+G2P_API std::unique_ptr<Identifier> make_vlm_identifier(std::shared_ptr<const VlmClient> client);
+
+// Convenience: the "auto" identifier on `input`.
+G2P_API Result<Identification> identify(const IdentifyInput& input);
+
+// The user's words as a kind: the best match, or kNotFound naming the
+// nearest kinds ("--object 'exersize bike' names no kind of the object
+// table; nearest: exercise bike, bicycle, ..."). `flag` names the option.
+G2P_API Result<std::string> kind_from_text(const ObjectTable& table, const std::string& text,
+                                           const std::string& flag = "--object");
+
+// ---- What a kind tells the rest of the run --------------------------------------
+
+// When the pipeline gives a normalised mesh its kind's size.
+enum class SizePolicy {
+  kKind,  // a mesh that looks normalised, with no size given and a confident kind, gets the kind's typical
+          // longest side (the default)
+  kFile,  // always keep the file's size
+};
+G2P_API const char* to_string(SizePolicy policy);                       // "kind", "file"
+G2P_API Result<SizePolicy> parse_size_policy(const std::string& text);  // the flag's words
+
+// The identification as JSON (report.json's and run.json's "identification"):
+// {"kind" ("unknown" when not known), "confidence", "source", "evidence",
+//  "candidates": [{"kind", "confidence", "source", "evidence"}, ...] (at most
+//  5), "notes", "warnings", "group", "structure", "typical_longest_side_m",
+//  "mass_range_kg": [lo, hi] | null, "size_assumed_m": metres | null}.
+// `size_assumed_m` > 0: the longest side the run gave the mesh.
+G2P_API std::string identification_json(const Identification& id, const ObjectTable& table,
+                                        double size_assumed_m = 0.0);
+
+}  // namespace g2p

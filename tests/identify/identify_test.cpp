@@ -1,0 +1,250 @@
+// The identify step: the object table, text matching, the backends, and what
+// the pipeline does with a kind (a normalised mesh's size, the mass check).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "g2p/identify.h"
+#include "g2p/io.h"
+#include "g2p/pipeline.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+using test::asset_path;
+using test::source_path;
+
+std::string kind_of(const std::string& text) {
+  const std::vector<TextMatch> m = ObjectTable::shipped().match(text);
+  return m.empty() ? std::string("-") : ObjectTable::shipped().kinds()[static_cast<std::size_t>(m.front().kind)].name;
+}
+
+TEST(ObjectTable, TheShippedTableLoadsWithEveryCocoClassAndConsistentRanges) {
+  const ObjectTable& t = ObjectTable::shipped();
+  ASSERT_GE(t.size(), 150);
+  std::set<std::string> coco;
+  for (const ObjectKind& k : t.kinds()) {
+    if (!k.coco.empty()) EXPECT_TRUE(coco.insert(k.coco).second) << k.coco << " answered by two kinds";
+    EXPECT_LE(k.mass_kg[0], k.mass_kg[1]) << k.name;
+    EXPECT_GE(k.typical_longest_side_m, k.longest_side_m[0]) << k.name;
+    EXPECT_LE(k.typical_longest_side_m, k.longest_side_m[1]) << k.name;
+    EXPECT_FALSE(k.materials.empty()) << k.name;
+    EXPECT_FALSE(k.sources.empty()) << k.name;
+  }
+  EXPECT_EQ(coco.size(), 80u);
+  // The detector's card names the same 80 classes.
+  std::ifstream card(source_path("libg2p/data/models/g2p-objects-nanodet.json"));
+  if (card) {
+    const nlohmann::json c = nlohmann::json::parse(card);
+    for (const nlohmann::json& name : c["classes"]) EXPECT_GE(t.find_coco(name.get<std::string>()), 0) << name;
+  }
+}
+
+TEST(ObjectTable, TextNamesTheKindItMeans) {
+  EXPECT_EQ(kind_of("a wooden chair with metal legs"), "chair");  // the first clause's noun
+  EXPECT_EQ(kind_of("SheenChair"), "chair");                      // camelCase
+  EXPECT_EQ(kind_of("WaterBottle_01"), "bottle");                 // a WordNet hyponym (water bottle)
+  EXPECT_EQ(kind_of("GlamVelvetSofa"), kind_of("couch"));         // synonyms meet in one kind
+  EXPECT_EQ(kind_of("two benches"), kind_of("bench"));            // plurals
+  EXPECT_EQ(kind_of("sedan"), "car");
+  EXPECT_EQ(kind_of("textured_mesh"), "-");  // generators' words name nothing
+  EXPECT_EQ(kind_of("sample"), "-");
+  EXPECT_EQ(kind_of("refrigerator"), kind_of("fridge"));
+  EXPECT_NE(kind_of("exercise bike"), "-");
+  EXPECT_NE(kind_of("exercise bike"), kind_of("bicycle"));  // the longer phrase wins
+}
+
+TEST(ObjectTable, WordsThatNameNothingAreAnErrorNamingTheNearestKinds) {
+  Result<std::string> k = kind_from_text(ObjectTable::shipped(), "refridgerator");
+  ASSERT_FALSE(k.ok());
+  EXPECT_EQ(k.status().code(), StatusCode::kNotFound);
+  EXPECT_NE(k.status().message().find("--object 'refridgerator'"), std::string::npos) << k.status().message();
+  EXPECT_NE(k.status().message().find("refrigerator"), std::string::npos) << k.status().message();
+}
+
+TEST(ObjectTable, ABadTableNamesTheKindAndTheField) {
+  const std::string good =
+      R"({"format": "g2p-object-table", "version": 1, "kinds": [{"name": "crate", "height_m": [0.2, 0.6],
+          "longest_side_m": [0.3, 1.0], "typical": {"height_m": 0.3, "longest_side_m": 0.5}, "mass_kg": [1, 8],
+          "structure": "hollow", "materials": [{"role": "boards", "class": "Wood"}], "terms": ["crates"]}]})";
+  Result<ObjectTable> t = ObjectTable::from_json(good, "t.json");
+  ASSERT_TRUE(t.ok()) << t.status().to_string();
+  EXPECT_EQ(t->find("Crate"), 0);
+  std::string bad = good;
+  bad.replace(bad.find("\"longest_side_m\": 0.5"), 21, "\"longest_side_m\": 2.5");
+  Result<ObjectTable> b = ObjectTable::from_json(bad, "t.json");
+  ASSERT_FALSE(b.ok());
+  EXPECT_NE(b.status().message().find("t.json: kind 'crate'"), std::string::npos) << b.status().message();
+  std::string v2 = good;
+  v2.replace(v2.find("\"version\": 1"), 12, "\"version\": 2");
+  EXPECT_NE(ObjectTable::from_json(v2, "t.json").status().message().find("'version' must be 1"), std::string::npos);
+  EXPECT_EQ(ObjectTable::from_json("{", "t.json").status().code(), StatusCode::kParseError);
+}
+
+TEST(Identify, NamesIdentifyTheSharedAssetsAndNothingWithoutThem) {
+  struct Case {
+    const char* file;
+    const char* kind;
+  } cases[] = {{"SheenChair", "chair"}, {"WaterBottle", "bottle"}, {"GlamVelvetSofa", nullptr}};
+  for (const Case& c : cases) {
+    Result<Model> model = load_model(asset_path(c.file));
+    ASSERT_TRUE(model.ok()) << model.status().to_string();
+    Result<std::unique_ptr<Identifier>> names = make_identifier("names");
+    ASSERT_TRUE(names.ok());
+    IdentifyInput in;
+    in.model = &*model;
+    Result<Identification> id = (*names)->identify(in);
+    ASSERT_TRUE(id.ok());
+    EXPECT_EQ(id->kind(), c.kind != nullptr ? c.kind : kind_of("sofa")) << c.file;
+    EXPECT_GE(id->confidence(), 0.5) << c.file;
+    anonymize_names(*model);
+    in.use_file_name = false;
+    id = (*names)->identify(in);
+    ASSERT_TRUE(id.ok());
+    EXPECT_FALSE(id->known()) << c.file << " was identified as " << id->kind() << " with its names removed";
+  }
+}
+
+TEST(Identify, TheUsersWordsWinAndTheConflictIsNoted) {
+  Result<Model> model = load_model(asset_path("SheenChair"));
+  ASSERT_TRUE(model.ok());
+  IdentifyInput in;
+  in.model = &*model;
+  in.object_text = "an upholstered sofa";
+  Result<Identification> id = identify(in);
+  ASSERT_TRUE(id.ok());
+  EXPECT_EQ(id->kind(), kind_of("sofa"));
+  EXPECT_EQ(id->source(), "object");
+  EXPECT_DOUBLE_EQ(id->confidence(), 1.0);
+  ASSERT_FALSE(id->notes.empty());
+  EXPECT_NE(id->notes.front().find("the names say chair"), std::string::npos) << id->notes.front();
+  in.object_text = "flux capacitor";
+  EXPECT_EQ(identify(in).status().code(), StatusCode::kNotFound);
+}
+
+TEST(Identify, UnknownSettingsAndBackendsAreRefused) {
+  EXPECT_EQ(make_identifier("detector", {{"min_score", "2"}}).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(make_identifier("auto", {{"colour", "on"}}).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(make_identifier("oracle").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(make_identifier("vlm").status().code(), StatusCode::kInvalidArgument);  // needs model=
+  EXPECT_TRUE(parse_size_policy("kind").ok());
+  EXPECT_FALSE(parse_size_policy("guess").ok());
+}
+
+// The pipeline up to identify on a generated (normalised) mesh.
+Result<PipelineResult> identify_run(PipelineOptions o, const std::string& file) {
+  o.last_stage = Stage::kIdentify;
+  o.views.width = o.views.height = 256;
+  Pipeline p(o);
+  return p.run_file(file);
+}
+
+const std::string kBicycle = "data/generated/models/trellis_bicycle.glb";
+
+TEST(Identify, TheDetectorRecognisesAGeneratedBicycleWithoutNames) {
+  Result<std::unique_ptr<Identifier>> detector = make_identifier("detector");
+  ASSERT_TRUE(detector.ok());
+  PipelineOptions o;
+  o.anonymize_names = true;
+  o.identifier = {"detector", {}};
+  Result<PipelineResult> r = identify_run(o, source_path(kBicycle));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  const Identification& id = r->identification;
+  for (const std::string& w : id.warnings)
+    if (w.find("not available") != std::string::npos) GTEST_SKIP() << w;
+  EXPECT_EQ(id.kind(), "bicycle");
+  EXPECT_EQ(id.source(), "detector");
+  EXPECT_GE(id.confidence(), 0.5);
+}
+
+TEST(Identify, AMissingDetectorModelDegradesWithAWarning) {
+  PipelineOptions o;
+  o.identifier = {"auto", {{"model_card", "/nonexistent/card.json"}}};
+  Result<PipelineResult> r = identify_run(o, asset_path("WaterBottle"));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->identification.kind(), "bottle");  // from the names
+  bool warned = false;
+  for (const std::string& w : r->warnings) warned |= w.find("/nonexistent/card.json") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(Identify, ANormalisedMeshTakesItsKindsSizeOnlyWhenConfidentAndAllowed) {
+  PipelineOptions o;
+  o.object = "bicycle";
+  o.identifier = {"auto", {{"detector", "off"}}};
+  Result<PipelineResult> r = identify_run(o, source_path(kBicycle));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  const ObjectKind& bike =
+      ObjectTable::shipped().kinds()[static_cast<std::size_t>(ObjectTable::shipped().find("bicycle"))];
+  EXPECT_NEAR(bounds(r->model.mesh).sizes().maxCoeff(), bike.typical_longest_side_m, 1e-3);
+  EXPECT_DOUBLE_EQ(r->size_assumed_m, bike.typical_longest_side_m);
+  EXPECT_EQ(r->model.info.scale_source, "kind");
+  bool said = false;
+  for (const std::string& w : r->model.info.warnings) said |= w.find("typical longest side") != std::string::npos;
+  EXPECT_TRUE(said);
+  // The views moved with the mesh: a pixel's depth still lands on the surface.
+  const View& v = r->views[2];
+  const int c = v.camera.width / 2;
+  ASSERT_GE(*v.face_id.pixel(c, c), 0);
+  Eigen::Vector3d o3, d3;
+  v.camera.ray(c + 0.5, c + 0.5, o3, d3);
+  const Eigen::Vector3d hit = o3 + d3 * (*v.depth.pixel(c, c) / d3.dot(v.camera.forward()));
+  const Mesh& m = r->model.mesh;
+  const auto& t = m.triangles[static_cast<std::size_t>(*v.face_id.pixel(c, c))];
+  const Eigen::Vector3d a = m.positions[static_cast<std::size_t>(t[0])].cast<double>();
+  EXPECT_LT((hit - a).norm(), 0.2 * bike.typical_longest_side_m);
+
+  PipelineOptions keep = o;
+  keep.size_policy = SizePolicy::kFile;
+  r = identify_run(keep, source_path(kBicycle));
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(bounds(r->model.mesh).sizes().maxCoeff(), 1.0, 0.03);
+  EXPECT_EQ(r->size_assumed_m, 0.0);
+
+  PipelineOptions strict = o;
+  strict.object.clear();
+  strict.anonymize_names = true;  // nothing names it; the detector is off
+  r = identify_run(strict, source_path(kBicycle));
+  ASSERT_TRUE(r.ok());
+  EXPECT_FALSE(r->identification.known());
+  EXPECT_EQ(r->size_assumed_m, 0.0);
+}
+
+TEST(Identify, WordsThatNameNoKindFailThePipelineBeforeAnyWork) {
+  PipelineOptions o;
+  o.object = "zorblax";
+  Pipeline p(o);
+  const Status s = p.prepare();
+  EXPECT_EQ(s.code(), StatusCode::kNotFound);
+  EXPECT_NE(s.message().find("nearest"), std::string::npos);
+}
+
+TEST(Identify, AKindsMassRangeChecksTheFinishedObject) {
+  PipelineOptions o;
+  o.object = "refrigerator";  // the 1.4 kg hammer is no refrigerator
+  Pipeline p(o);
+  Result<PipelineResult> r = p.run_file(source_path("examples/data/hammer.obj"));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->size_assumed_m, 0.0);  // the hammer's size is not normalised: kept
+  bool warned = false;
+  for (const std::string& w : r->warnings) warned |= w.find("outside a refrigerator's usual") != std::string::npos;
+  EXPECT_TRUE(warned);
+  const nlohmann::json run = nlohmann::json::parse(pipeline_summary_json(*r, o));
+  EXPECT_EQ(run["identification"]["kind"], "refrigerator");
+  EXPECT_EQ(run["identification"]["mass_in_kind_range"], false);
+  EXPECT_NE(summary_html(*r, o).find("What it is: <b>refrigerator</b>"), std::string::npos);
+
+  o.object = "hammer";
+  Pipeline q(o);
+  r = q.run_file(source_path("examples/data/hammer.obj"));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(nlohmann::json::parse(pipeline_summary_json(*r, o))["identification"]["mass_in_kind_range"], true);
+}
+
+}  // namespace
+}  // namespace g2p

@@ -49,10 +49,11 @@ def table_kinds():
     return names, term_kind
 
 
-def accepted(annotation, term_kind):
-    """The table kinds that count as right for a model: its kind and alternatives, as the table names them."""
+def accepted(annotation, names):
+    """The table kinds that count as right for a model: its kind and alternatives that are kinds' names (a word
+    that is only a term of some kind is not enough: WordNet's "still" is also a person's)."""
     words = [annotation["kind"]] + annotation.get("kind_alternatives", [])
-    return {term_kind[w] for w in words if w in term_kind}
+    return {w for w in words if w in names}
 
 
 def run(g2p, path, out, size, extra):
@@ -82,7 +83,7 @@ def main(argv=None):
         manifest = json.load(f)["models"]
     with open(os.path.join(SET, "objects.json")) as f:
         annotations = json.load(f)["models"]
-    _, term_kind = table_kinds()
+    names, _ = table_kinds()
     rows, missing = [], []
     for entry in manifest:
         mid = entry["id"]
@@ -97,7 +98,7 @@ def main(argv=None):
         named = os.path.join(a.out, "inputs", mid, os.path.basename(entry["source"]["path"]))
         os.makedirs(os.path.dirname(named), exist_ok=True)
         shutil.copyfile(path, named)
-        right = accepted(ann, term_kind)
+        right = accepted(ann, names)
         row = {"id": mid, "generator": entry["generator"], "kind": ann["kind"], "in_table": bool(right),
                "range": ann["mass_kg"], "file": os.path.basename(named)}
         for cond in conditions:

@@ -88,6 +88,7 @@ void bind_core(py::module_& m) {
       .value("GEOMETRY", ValueSource::kGeometry)
       .value("VLM", ValueSource::kVlm)
       .value("USER", ValueSource::kUser)
+      .value("KIND", ValueSource::kKind)
       .def("__str__", [](ValueSource s) { return to_string(s); });
   py::enum_<UpAxis>(m, "UpAxis")
       .value("AUTO", UpAxis::kAuto)

@@ -293,6 +293,8 @@ void bind_pipeline(py::module_& m) {
             o.size_policy = *p;
           },
           "'kind' (a normalised mesh takes its identified kind's typical size) or 'file'")
+      .def_readwrite("kind_properties", &PipelineOptions::kind_properties,
+                     "use a known kind's structure and hidden mass in the properties stage")
       .def_readwrite("size_confidence", &PipelineOptions::size_confidence,
                      "the least identification confidence for which a size is assumed")
       .def_readwrite("segmenter", &PipelineOptions::segmenter)

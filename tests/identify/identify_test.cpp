@@ -248,3 +248,119 @@ TEST(Identify, AKindsMassRangeChecksTheFinishedObject) {
 
 }  // namespace
 }  // namespace g2p
+
+namespace g2p {
+namespace {
+
+// A closed x by y by z m box of one material (steel, rubber: its name says), as an OBJ.
+std::string write_steel_box(const std::string& dir, double x = 0.6, double y = 0.6, double z = 1.8,
+                            const std::string& material = "steel") {
+  std::filesystem::create_directories(dir);
+  std::ofstream mtl(dir + "/box.mtl");
+  mtl << "newmtl " << material << "\nKd 0.8 0.8 0.8\n";
+  std::ofstream obj(dir + "/box.obj");
+  obj << "mtllib box.mtl\nusemtl " << material << "\n";
+  for (int i = 0; i < 8; ++i)
+    obj << "v " << (i & 1 ? x : 0) << " " << (i & 2 ? y : 0) << " " << (i & 4 ? z : 0) << "\n";
+  // Outward-facing quads as triangles (vertices 1-based).
+  const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+  for (const auto& q : quads)
+    obj << "f " << q[0] << " " << q[1] << " " << q[2] << "\nf " << q[0] << " " << q[2] << " " << q[3] << "\n";
+  return dir + "/box.obj";
+}
+
+TEST(KindProperties, ARefrigeratorIsAHollowBodyWithItsMachineryAtTheBottom) {
+  const std::string box = write_steel_box(test::scratch_dir("KindPropertiesBox"));
+  PipelineOptions o;
+  o.views.width = o.views.height = 192;  // enough for one material by name
+  o.object = "refrigerator";
+  o.identifier = {"object", {}};
+  o.kind_properties = false;
+  Result<PipelineResult> plain = Pipeline(o).run_file(box);
+  ASSERT_TRUE(plain.ok()) << plain.status().to_string();
+  o.kind_properties = true;
+  Result<PipelineResult> kind = Pipeline(o).run_file(box);
+  ASSERT_TRUE(kind.ok()) << kind.status().to_string();
+  ASSERT_EQ(kind->properties.parts.size(), 1u);
+  const PartReport& body = kind->properties.parts[0];
+  EXPECT_EQ(body.properties.structure, Structure::kHollow);  // a sheet-steel cabinet (the estimator's walls rule)
+  const ObjectKind& fridge = kind->kind;
+  double f = 0;
+  for (const HiddenContent& h : fridge.hidden) f += h.mass_fraction;
+  ASSERT_GT(f, 0.0);
+  // The walls weigh what a 0.6 x 0.6 x 1.8 m shell of the class's wall does; the machinery is f of the total.
+  const double walls = body.mass.mass_kg - body.contents.mass_kg;
+  EXPECT_NEAR(body.contents.mass_kg / body.mass.mass_kg, f, 0.01 * f);
+  EXPECT_NEAR(walls, plain->properties.object.mass_kg, 1e-9 * walls);  // the shell as the estimator weighs it
+  // At the bottom: the centre of mass sinks below the shell's middle (0.9 m).
+  EXPECT_LT(kind->properties.object.center_of_mass.z(), 0.9 - 0.05);
+  bool noted = false;
+  for (const std::string& n : kind->properties.notes) noted |= n.rfind("hidden mass: ", 0) == 0;
+  EXPECT_TRUE(noted);
+
+  // MuJoCo weighs the exported body with its machinery, where it sits.
+  if (!have_mujoco()) GTEST_SKIP() << "built without MuJoCo";
+  const std::string out = test::scratch_dir("KindPropertiesBox") + "/out";
+  std::filesystem::remove_all(out);
+  ASSERT_TRUE(write_pipeline_output(out, *kind, o).ok());
+  Result<EngineCheck> engine = check_in_mujoco(out + "/box.xml");
+  ASSERT_TRUE(engine.ok()) << engine.status().to_string();
+  EXPECT_NEAR(engine->mass_kg, kind->properties.object.mass_kg, 1e-6 * kind->properties.object.mass_kg);
+  EXPECT_LT(engine->center_of_mass.z(), 0.85);
+}
+
+TEST(KindProperties, ASolidKindChangesNothingAndASolidBodyHoldsNoHiddenMass) {
+  PipelineOptions o;
+  o.views.width = o.views.height = 192;  // enough for one material by name
+  o.identifier = {"object", {}};
+  struct Case {
+    const char* object;
+    double side;                                           // m
+  } cases[] = {{"chair", 0.6}, {"electric motor", 0.05}};  // a 5 cm steel cube is weighed solid
+  for (const Case& c : cases) {
+    const std::string box = write_steel_box(test::scratch_dir("KindPropertiesSolid"), c.side, c.side, c.side);
+    o.object = c.object;
+    o.kind_properties = true;
+    Result<PipelineResult> r = Pipeline(o).run_file(box);
+    ASSERT_TRUE(r.ok()) << r.status().to_string();
+    o.kind_properties = false;
+    Result<PipelineResult> plain = Pipeline(o).run_file(box);
+    ASSERT_TRUE(plain.ok());
+    ASSERT_EQ(r->properties.parts.size(), 1u);
+    EXPECT_EQ(r->properties.parts[0].properties.structure, plain->properties.parts[0].properties.structure);
+    EXPECT_DOUBLE_EQ(r->properties.object.mass_kg, plain->properties.object.mass_kg) << c.object;
+    if (r->kind.hidden.empty()) continue;
+    ASSERT_EQ(r->properties.parts[0].properties.structure, Structure::kSolid) << c.object;
+    bool said = false;  // the motor's windings are inside a body already weighed as solid
+    for (const std::string& n : r->properties.notes) said |= n.rfind("hidden mass not added", 0) == 0;
+    EXPECT_TRUE(said) << c.object;
+    for (const std::string& w : r->warnings) EXPECT_EQ(w.find("hidden mass"), std::string::npos) << w;
+  }
+}
+
+TEST(KindProperties, AHollowKindMakesASolidBodyAShell) {
+  // A 20 cm rubber cube is weighed solid by the estimator (rubber has no wall rule); a bucket is a hollow body.
+  const std::string box = write_steel_box(test::scratch_dir("KindPropertiesShell"), 0.2, 0.2, 0.2, "rubber");
+  PipelineOptions o;
+  o.views.width = o.views.height = 192;  // enough for one material by name
+  o.identifier = {"object", {}};
+  o.object = "bucket";
+  o.kind_properties = false;
+  Result<PipelineResult> plain = Pipeline(o).run_file(box);
+  ASSERT_TRUE(plain.ok()) << plain.status().to_string();
+  ASSERT_EQ(plain->properties.parts[0].properties.structure, Structure::kSolid);
+  o.kind_properties = true;
+  Result<PipelineResult> r = Pipeline(o).run_file(box);
+  ASSERT_TRUE(r.ok());
+  ASSERT_EQ(r->kind.structure, "hollow");
+  const PartProperties& p = r->properties.parts[0].properties;
+  EXPECT_EQ(p.structure, Structure::kHollow);
+  EXPECT_EQ(p.structure_source, ValueSource::kKind);
+  // rho A t of the class's wall over the cube's 0.24 m^2, far below the solid cube.
+  const double shell = p.density_kg_m3 * 0.24 * p.wall_thickness_m;
+  EXPECT_NEAR(r->properties.parts[0].mass.mass_kg - r->properties.parts[0].contents.mass_kg, shell, 0.05 * shell);
+  EXPECT_LT(r->properties.object.mass_kg, plain->properties.object.mass_kg / 5);
+}
+
+}  // namespace
+}  // namespace g2p

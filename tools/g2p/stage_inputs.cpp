@@ -1,4 +1,6 @@
 #include "stage_inputs.h"
+
+#include "g2p/identify.h"
 #include "json_out.h"
 
 #include <chrono>
@@ -101,6 +103,7 @@ Result<LabelledObject> load_labels(const std::string& command, const LabelledSou
     if (!faces.ok()) return fail(faces.status(), kExitFailure);
     out.faces = std::move(*faces);
     out.origin = "folder " + args.source;
+    out.kind = manifest.value("object", "");
     return out;
   }
   if (args.truth.empty())
@@ -333,9 +336,15 @@ Result<PropertiesReport> run_estimation(const std::string& command, const Estima
   std::unique_ptr<PropertyEstimator> overriding;
   if (object.overrides.resolved && object.overrides.changes_properties())
     overriding = make_overriding_estimator(**estimator, *object.overrides.resolved);
+  // The kind the run identified weighs the object as g2p run did (its structure, its hidden mass).
+  const ObjectTable& kinds = ObjectTable::shipped();
+  const int kind = object.kind.empty() ? -1 : kinds.find(object.kind);
+  const PropertyEstimator& chosen = overriding ? *overriding : **estimator;
+  const std::vector<View>* seen = views.empty() ? nullptr : &views;
   Result<PropertiesReport> report =
-      estimate_properties(object.model.mesh, object.faces.parts, completion, object.table,
-                          overriding ? *overriding : **estimator, views.empty() ? nullptr : &views);
+      kind >= 0 ? estimate_properties_of_kind(object.model.mesh, object.faces.parts, completion, object.table, chosen,
+                                              kinds.kinds()[static_cast<std::size_t>(kind)], seen)
+                : estimate_properties(object.model.mesh, object.faces.parts, completion, object.table, chosen, seen);
   if (!report.ok()) {
     std::cerr << "g2p " << command << ": error: " << report.status().to_string() << "\n";
     exit_code = kExitFailure;

@@ -35,6 +35,7 @@ struct LabelledObject {
   MaterialTable table;
   FacesFile faces;
   std::string origin;          // "folder DIR" or "ground truth KEY of FILE"
+  std::string kind;            // what the run identified the object as (project.json's "object"); "" = unknown
   AppliedOverrides overrides;  // the folder's overrides.json and --overrides, applied to `faces`
 };
 

@@ -18,7 +18,10 @@
 #include <string>
 #include <vector>
 
+#include "g2p/complete.h"
 #include "g2p/model.h"
+#include "g2p/project.h"
+#include "g2p/properties.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
 #include "g2p/status.h"
@@ -179,6 +182,28 @@ enum class SizePolicy {
 };
 G2P_API const char* to_string(SizePolicy policy);                       // "kind", "file"
 G2P_API Result<SizePolicy> parse_size_policy(const std::string& text);  // the flag's words
+
+// The properties stage for an object of a known kind: estimate_properties
+// with the kind's structure and hidden mass, each said in the report's notes.
+//  - A kind that is a hollow body or a shell with contents ("hollow",
+//    "shell_with_contents": a car, a refrigerator, a sofa) makes its body, the
+//    part with the largest closed volume, hollow with its class's wall where
+//    the estimator made it solid (not where a person set it).
+//  - The kind's hidden mass (a refrigerator's compressor, 15 % of its mass)
+//    is added to the visible mass m as m F / (1 - F), F the kind's hidden
+//    fractions together, as contents of the body's cavity: settled at the
+//    bottom (30 % of the cavity) for "bottom", through all of it otherwise,
+//    at the density that gives that mass (at most 20,000 kg/m^3; a cavity too
+//    small for it keeps what fits, and the note says how much was left out).
+//    The centre of mass and the inertia move with it, in every export.
+// A body weighed as solid counts its inside already, and nothing is added
+// ("hidden mass not added: ..."); with no closed body at all the hidden mass
+// is left out ("hidden mass left out: ...", a warning in the pipeline).
+// Other kinds: estimate_properties as it is.
+G2P_API Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const std::vector<Part>& parts,
+                                                             const Completion& completion, const MaterialTable& table,
+                                                             const PropertyEstimator& estimator, const ObjectKind& kind,
+                                                             const std::vector<View>* views = nullptr);
 
 // The identification as JSON (report.json's and run.json's "identification"):
 // {"kind" ("unknown" when not known), "confidence", "source", "evidence",

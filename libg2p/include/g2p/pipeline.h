@@ -115,6 +115,9 @@ struct PipelineOptions {
   // given, gets its kind's typical longest side when the kind is known with
   // at least `size_confidence`; SizePolicy::kFile keeps the file's size.
   SizePolicy size_policy = SizePolicy::kKind;
+  // The properties stage uses a known kind's structure and hidden mass
+  // (estimate_properties_of_kind); false: the estimator alone, as before.
+  bool kind_properties = true;
   double size_confidence = 0.6;  // [0, 1]; the detector alone reaches it only when most views agree (identify.md)
 
   // 2. segment: "hybrid" (the default: `pbr` on per-part materials, the

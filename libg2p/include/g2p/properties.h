@@ -113,8 +113,9 @@ G2P_API Result<WallMeasurement> measure_walls(const SurfaceRays& object_rays, co
 // ---- Estimating properties ----------------------------------------------------
 
 // Where a value came from.
-enum class ValueSource { kTable, kGeometry, kVlm, kUser };
-G2P_API const char* to_string(ValueSource source);  // "table", "geometry", "vlm", "user"
+// kKind: the object's kind (identify.h's object table).
+enum class ValueSource { kTable, kGeometry, kVlm, kUser, kKind };
+G2P_API const char* to_string(ValueSource source);  // "table", "geometry", "vlm", "user", "kind"
 
 struct PartProperties {
   int label = kUnknownLabel;

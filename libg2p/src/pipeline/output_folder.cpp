@@ -50,6 +50,7 @@ Status write_manifests(const std::string& tmp, const fs::path& final_dir, const 
       {"materials", materials},
       {"anonymize_names", o.anonymize_names},
       {"base_color_only", o.base_color_only},
+      {"object", r.identification.known() ? r.identification.kind() : std::string()},
       {"views", r.views.size()},
       {"vote", o.project.vote.mode == VoteMode::kSoft ? "soft" : "hard"},
       {"weight_angle", o.project.vote.weight_by_angle},

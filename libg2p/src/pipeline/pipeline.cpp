@@ -346,8 +346,11 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     std::unique_ptr<PropertyEstimator> overriding;
     if (resolved && o.overrides.changes_properties())
       overriding = make_overriding_estimator(*estimator.get(), *resolved);
-    Result<PropertiesReport> report = estimate_properties(mesh, r.projection.parts, r.completion, r.table,
-                                                          overriding ? *overriding : *estimator.get(), &r.views);
+    const PropertyEstimator& chosen = overriding ? *overriding : *estimator.get();
+    Result<PropertiesReport> report =
+        o.kind_properties && !r.kind.name.empty()
+            ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, &r.views)
+            : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, &r.views);
     if (!report.ok()) return report.status().with_context("properties");
     r.properties = std::move(*report);
     r.properties.size = object_size(r.model);
@@ -363,8 +366,9 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
             r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12) + left_out);
       }
     clock.report().notes = r.properties.notes;
-    for (const std::string& n : r.properties.notes)  // contents asked for and not given
-      if (n.find(kContentsLeftOut) != std::string::npos) r.warnings.push_back("properties: " + n);
+    for (const std::string& n : r.properties.notes)  // contents asked for and not given; the kind's hidden mass
+      if (n.find(kContentsLeftOut) != std::string::npos || n.rfind("hidden mass left out", 0) == 0)
+        r.warnings.push_back("properties: " + n);
     // The vlm estimator never fails a part: it falls back to the table, which
     // is a degraded optional stage the caller should hear about.
     if (!estimator.custom && o.estimator.name == "vlm") {

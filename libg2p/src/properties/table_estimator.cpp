@@ -50,6 +50,7 @@ const char* to_string(ValueSource source) {
     case ValueSource::kGeometry: return "geometry";
     case ValueSource::kVlm: return "vlm";
     case ValueSource::kUser: return "user";
+    case ValueSource::kKind: return "kind";
   }
   return "unknown";
 }

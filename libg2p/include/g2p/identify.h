@@ -185,10 +185,11 @@ G2P_API Result<SizePolicy> parse_size_policy(const std::string& text);  // the f
 
 // The properties stage for an object of a known kind: estimate_properties
 // with the kind's structure and hidden mass, each said in the report's notes.
-//  - A kind that is a hollow body or a shell with contents ("hollow",
-//    "shell_with_contents": a car, a refrigerator, a sofa) makes its body, the
-//    part with the largest closed volume, hollow with its class's wall where
-//    the estimator made it solid (not where a person set it).
+//  - A kind that is a hollow body ("hollow": a car, a refrigerator, a box)
+//    makes its body, the part with the largest closed volume, hollow with its
+//    class's wall where the estimator made it solid (not where a person set
+//    it). A shell with contents (a sofa, a filled pot) keeps the estimator's
+//    structure: a solid bulk stands for what fills it.
 //  - The kind's hidden mass (a refrigerator's compressor, 15 % of its mass)
 //    is added to the visible mass m as m F / (1 - F), F the kind's hidden
 //    fractions together, as contents of the body's cavity: settled at the

@@ -56,7 +56,8 @@ class KindEstimator final : public PropertyEstimator {
       Result<PartProperties> r = base_.estimate(in);
       if (!r.ok()) return r;
       p = std::move(*r);
-      if (index == body_ && kind_.structure != "solid" && p.structure == Structure::kSolid &&
+      // Only a shell around air: a sofa's or a flower pot's solid bulk already stands for what fills them.
+      if (index == body_ && kind_.structure == "hollow" && p.structure == Structure::kSolid &&
           p.structure_source != ValueSource::kUser && in.completed != nullptr) {
         double wall =
             in.table != nullptr && in.table->valid_label(p.label) ? (*in.table)[p.label].wall_thickness_m : 0.0;
@@ -68,8 +69,7 @@ class KindEstimator final : public PropertyEstimator {
           p.double_walled = false;
           p.structure_source = ValueSource::kKind;
           p.notes.push_back("hollow, " + format("%.3g", wall * 1000.0) + " mm walls: " + article(kind_.name) +
-                            "'s body is a " + (kind_.structure == "hollow" ? "hollow shell" : "shell with contents") +
-                            " (the object table)");
+                            "'s body is a hollow shell (the object table)");
         }
       }
       std::lock_guard<std::mutex> lock(mutex_);

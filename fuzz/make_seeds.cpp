@@ -7,6 +7,7 @@
 //   OUT/faces_csv/  the Avocado's faces.csv, its ground-truth classes as parts
 //   OUT/labels_json/  labels.json and a cameras.json of the default views
 //   OUT/overrides_json/  an overrides file for the fuzzer's grid (fuzz/corpus has more)
+//   OUT/objects_json/  a description of an object (fuzz/corpus has tables)
 // scripts/fuzz.sh adds Debian's assimp-testmodels of each format.
 //
 //   g2p_fuzz_seeds SHARED_ASSETS_DIR OUT_DIR
@@ -128,7 +129,8 @@ std::string glb_to_gltf(const std::string& glb) {
 int main(int argc, char** argv) {
   if (argc != 3) return fail("usage: g2p_fuzz_seeds SHARED_ASSETS_DIR OUT_DIR");
   const fs::path assets = argv[1], out = argv[2];
-  for (const char* d : {"glb", "gltf", "obj", "ply", "stl", "faces_csv", "labels_json", "overrides_json"})
+  for (const char* d :
+       {"glb", "gltf", "obj", "ply", "stl", "faces_csv", "labels_json", "overrides_json", "objects_json"})
     fs::create_directories(out / d);
   std::ifstream labels_in(assets / "labels.json");
   if (!labels_in) return fail((assets / "labels.json").string() + ": cannot open (is ../shared beside the checkout?)");
@@ -204,6 +206,10 @@ int main(int argc, char** argv) {
           R"({"part": 0, "was": {"class": "Wood", "faces": 16}, "class": "Stone", "density_kg_m3": 2600},)"
           R"({"faces": [[16, 19]], "structure": "hollow", "wall_thickness_m": 0.003}]})"
           "\n");
+      !s.ok())
+    return fail(s.message());
+  if (g2p::Status s =
+          g2p::write_text_file((out / "objects_json" / "words.txt").string(), "an exercise bike with a flywheel\n");
       !s.ok())
     return fail(s.message());
   std::printf("g2p_fuzz_seeds: %d seeds from %s in %s\n", written + 1, assets.string().c_str(), out.string().c_str());

@@ -92,7 +92,8 @@ if [ "$run_fuzz" = 1 ]; then
   export build seeds fuzz_seconds
   # Two at a time (two cores); every target runs even when one fails.
   printf '%s\n' "import_glb glb" "import_gltf gltf" "import_obj obj" "import_ply ply" "import_stl stl" \
-                "faces_csv faces_csv" "labels_json labels_json" "overrides_json overrides_json" |
+                "faces_csv faces_csv" "labels_json labels_json" "overrides_json overrides_json" \
+                "objects_json objects_json" |
     xargs -P 2 -L 1 bash -c 'fuzz_one "$0" "$1"'
   stamp "fuzzing passed"
 fi

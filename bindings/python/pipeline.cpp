@@ -295,8 +295,9 @@ void bind_pipeline(py::module_& m) {
           "'kind' (a normalised mesh takes its identified kind's typical size) or 'file'")
       .def_readwrite("kind_properties", &PipelineOptions::kind_properties,
                      "use a known kind's structure and hidden mass in the properties stage")
-      .def_readwrite("size_confidence", &PipelineOptions::size_confidence,
-                     "the least identification confidence for which a size is assumed")
+      .def_readwrite("kind_confidence", &PipelineOptions::kind_confidence,
+                     "the least identification confidence for which the run acts on the kind (size, structure, "
+                     "hidden mass, mass check)")
       .def_readwrite("segmenter", &PipelineOptions::segmenter)
       .def_readwrite("project", &PipelineOptions::project)
       .def_readwrite("refiner", &PipelineOptions::refiner)

@@ -6,8 +6,9 @@ Inputs:
   WordNet 3.0 noun database     Debian package wordnet-base: /usr/share/wordnet/{index,data}.noun
 
 For every kind the script checks that each named synset exists, then generates the kind's
-`terms`: the lemmas of its synsets and of all their hyponyms (transitively; a hyponym's lemma only
-where that lemma's most common sense lies under the kind, so "head" and "black" do not name a person), plus the kind's
+`terms`: the lemmas of its synsets and of all their hyponyms (transitively; a lemma only where its
+most common sense lies under the kind, so "head" and "black" do not name a person nor "steel" a
+sword, unless it is the kind's name or a hand-listed term), plus the kind's
 hand-written `extra_terms`.  A term reached from several kinds goes to the most specific one
 (the kind whose synset is the nearer hypernym of the term's synset); a term that is exactly a
 lemma of a kind's own synset always belongs to that kind.
@@ -198,10 +199,12 @@ def build_terms(kinds, wn):
                 for lemma in wn.words[off]:
                     t = term_of(lemma)
                     s = wn.sense_number(lemma, off)
-                    # A hyponym's word counts only where its most common sense is in this kind: "head"
-                    # (a leader, under person) means a body part first, "black" a colour, "wood" a material.
+                    # A word counts only where its most common sense is in this kind: "head" (a leader,
+                    # under person) means a body part first, "black" a colour, "wood" a material, and a
+                    # sword's own "steel" the alloy; the kind's name and its hand-listed terms stay.
                     first = wn.senses.get(wn.key(lemma), [off])[0]
-                    if d > 0 and first not in closure:
+                    hand = t == kind["name"] or t in [e.lower() for e in kind.get("extra_terms", [])]
+                    if first not in closure and not hand:
                         continue
                     cand = (d, s, ki)
                     if t not in reach or cand < reach[t]:

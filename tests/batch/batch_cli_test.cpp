@@ -80,7 +80,8 @@ TEST(ToolBatch, BadFilesAmongGoodOnesFailWithTheMessagesOfGtoPRun) {
 TEST(ToolBatch, AManifestRunsEachRowWithItsFlagsAndABadRowIsNamed) {
   const std::string dir = test::scratch_dir("ToolBatchManifest");
   hammer_copy(dir, "hammer");
-  test::write_file(dir + "/assets.csv", "path,name,unit\nhammer.obj,in_cm,cm\nhammer.obj,in_m,\n");
+  test::write_file(dir + "/assets.csv",
+                   "path,name,unit,object\nhammer.obj,in_cm,cm,\nhammer.obj,in_m,,a steel refrigerator\n");
   test::ToolRun r = test::run_tool("batch --manifest " + test::quote(dir + "/assets.csv") + " -o " +
                                    test::quote(dir + "/out") + kQuick + " --unit m -j 2");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
@@ -92,6 +93,12 @@ TEST(ToolBatch, AManifestRunsEachRowWithItsFlagsAndABadRowIsNamed) {
   // The row's --unit cm replaced the batch's --unit m: a hundredth of the size, a millionth of the mass.
   const double ratio = row(index, "in_m")["mass_kg"].get<double>() / row(index, "in_cm")["mass_kg"].get<double>();
   EXPECT_GT(ratio, 1e4) << ratio;
+  // The object column: the row's words win over the file's name, and its mass is checked against the kind's.
+  EXPECT_EQ(row(index, "in_cm")["kind"], "hammer");  // its names
+  EXPECT_EQ(row(index, "in_m")["kind"], "refrigerator");
+  EXPECT_EQ(row(index, "in_m")["kind_confidence"], 1.0);
+  EXPECT_EQ(row(index, "in_m")["mass_in_kind_range"], "no");  // a 1.4 kg refrigerator
+  EXPECT_NE(test::read_file(dir + "/out/index.csv").find(",refrigerator,1,no,"), std::string::npos);
 
   test::write_file(dir + "/bad.jsonl",
                    "{\"path\": \"hammer.obj\"}\n{\"path\": \"hammer.obj\", \"height\": \"tall\"}\n");

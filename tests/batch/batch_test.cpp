@@ -90,12 +90,14 @@ TEST(BatchManifest, CsvAndJsonLinesGiveAssetsWithTheirOwnFlags) {
   EXPECT_EQ((*csv)[1].run_args, (std::vector<std::string>{"--height", "0.3"}));
 
   test::write_file(dir + "/assets.jsonl",
-                   "{\"path\": \"x.ply\", \"segmenter\": \"learned\", \"longest_side\": 0.5}\n{\"path\": \"y.stl\"}\n");
+                   "{\"path\": \"x.ply\", \"segmenter\": \"learned\", \"longest_side\": 0.5}\n"
+                   "{\"path\": \"y.stl\", \"object\": \"exercise bike\"}\n");
   Result<std::vector<BatchAsset>> jsonl = read_batch_manifest(dir + "/assets.jsonl");
   ASSERT_TRUE(jsonl.ok()) << jsonl.status().to_string();
   ASSERT_EQ(jsonl->size(), 2u);
   EXPECT_EQ((*jsonl)[0].run_args, (std::vector<std::string>{"--longest-side", "0.5", "--segmenter", "learned"}));
   EXPECT_EQ((*jsonl)[1].origin, dir + "/assets.jsonl:2");
+  EXPECT_EQ((*jsonl)[1].run_args, (std::vector<std::string>{"--object", "exercise bike"}));
 }
 
 TEST(BatchManifest, ABadRowIsAnErrorNamingFileAndLine) {

@@ -312,6 +312,7 @@ TEST(KindProperties, ARefrigeratorIsAHollowBodyWithItsMachineryAtTheBottom) {
 TEST(KindProperties, ASolidKindChangesNothingAndASolidBodyHoldsNoHiddenMass) {
   PipelineOptions o;
   o.views.width = o.views.height = 192;  // enough for one material by name
+  o.last_stage = Stage::kProperties;     // no hulls or files needed
   o.identifier = {"object", {}};
   struct Case {
     const char* object;
@@ -343,6 +344,7 @@ TEST(KindProperties, AHollowKindMakesASolidBodyAShell) {
   const std::string box = write_steel_box(test::scratch_dir("KindPropertiesShell"), 0.2, 0.2, 0.2, "rubber");
   PipelineOptions o;
   o.views.width = o.views.height = 192;  // enough for one material by name
+  o.last_stage = Stage::kProperties;     // no hulls or files needed
   o.identifier = {"object", {}};
   o.object = "bucket";
   o.kind_properties = false;

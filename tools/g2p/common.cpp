@@ -152,8 +152,9 @@ void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
                   "size when identified confidently) or file (keep the file's size)")
       ->check(CLI::IsMember({"kind", "file"}))
       ->capture_default_str();
-  cmd->add_option("--size-confidence", args.size_confidence,
-                  "The least identification confidence for which --size-from kind assumes a size")
+  cmd->add_option("--kind-confidence", args.kind_confidence,
+                  "The least identification confidence for which the run acts on the kind: assumes its size "
+                  "(--size-from kind), weighs its structure and hidden mass, checks the mass against its range")
       ->check(finite_number(0.0, 1.0))
       ->capture_default_str();
 }

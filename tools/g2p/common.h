@@ -68,13 +68,13 @@ Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& comman
                                                        int& exit_code);
 
 // What the object is, and the size its kind may give it: --object,
-// --identifier, --identify-set, --size-from, --size-confidence.
+// --identifier, --identify-set, --size-from, --kind-confidence.
 struct IdentifyArgs {
   std::string object;  // the user's words; "" = none
   std::string name = PipelineOptions{}.identifier.name;
   std::vector<std::string> settings;
   std::string size_from = to_string(PipelineOptions{}.size_policy);
-  double size_confidence = PipelineOptions{}.size_confidence;
+  double kind_confidence = PipelineOptions{}.kind_confidence;
 };
 
 void add_identify_flags(CLI::App* cmd, IdentifyArgs& args);

@@ -69,7 +69,7 @@ int run_identify(const IdentifyCommandArgs& args) {
   Result<SizePolicy> policy = parse_size_policy(args.identify.size_from);
   if (!policy.ok()) return usage(policy.status().message());
   o.size_policy = *policy;
-  o.size_confidence = args.identify.size_confidence;
+  o.kind_confidence = args.identify.kind_confidence;
   o.last_stage = Stage::kIdentify;
   Pipeline pipeline(o);
   Result<PipelineResult> r = pipeline.run_file(args.model);

@@ -98,6 +98,7 @@ class G2P_API ObjectTable {
   std::vector<std::string> nearest(const std::string& text, int count = 5) const;
 
  private:
+  static Result<ObjectTable> parse_table(const std::string& text, const std::string& where);
   std::vector<ObjectKind> kinds_;
   std::map<std::string, int> term_kind_;  // every term and name -> kind
   std::string wordnet_;
@@ -131,9 +132,12 @@ struct Identification {
 struct IdentifyInput {
   const Model* model = nullptr;              // its names: meshes, nodes, materials, the file's
   const std::vector<View>* views = nullptr;  // rendered views (RGB) for detectors and the vlm
-  const ObjectTable* table = nullptr;        // null: ObjectTable::shipped()
-  std::string object_text;                   // the user's words (g2p run --object "exercise bike"); "" = none
-  bool use_file_name = true;                 // false when names were removed (anonymize_names)
+  // The model's renderer, set_model(*model) done: backends that see better in
+  // views of their own (the detector's eye-level turntable) render them.
+  const Renderer* renderer = nullptr;
+  const ObjectTable* table = nullptr;  // null: ObjectTable::shipped()
+  std::string object_text;             // the user's words (g2p run --object "exercise bike"); "" = none
+  bool use_file_name = true;           // false when names were removed (anonymize_names)
 };
 
 class G2P_API Identifier {
@@ -153,8 +157,10 @@ class G2P_API Identifier {
 //   "object"   the user's words only (IdentifyInput::object_text);
 //   "names"    the file, node, mesh and material names, matched through the
 //              table's WordNet terms;
-//   "detector" NanoDet-g's COCO detector over the rendered views (the shipped
-//              g2p-objects-nanodet.onnx; settings model_card, min_score);
+//   "detector" NanoDet-g's COCO detector over views of the object (the shipped
+//              g2p-objects-nanodet.onnx; settings model_card, min_score,
+//              min_iou, views = turntable (its own eye-level views, with a
+//              renderer) or given (IdentifyInput::views));
 //   "vlm"      a vision-language model asked to name the object (docs/vlm.md);
 //   "none"     always unknown (the behaviour before identification).
 G2P_API Registry<Identifier>& identifier_registry();

@@ -13,8 +13,11 @@
 // object pixels (face IDs) of at least min_iou (0.3), so that a detector that
 // sees a "person" in a poster on a wardrobe door does not name the wardrobe.
 //
-// The views' background is repainted the grey the card recommends (128: the
-// detector reads plain light backgrounds as sky, and sees birds and kites).
+// Which views: by default (views=turntable) 8 of its own, rendered at the
+// network's input size from 15 degrees above the object's middle, around it,
+// on the grey the card recommends (128: the detector reads plain light
+// backgrounds as sky, and sees birds and kites); views=given, or without a
+// renderer, the views it is given, their background repainted that grey.
 // The vote over views: per view and class, the best such detection's score
 // (0 without one); a class's confidence is the mean over the best half of the
 // views (a chair seen from straight above or below is not recognisable, and
@@ -70,10 +73,10 @@ Result<DetectorCard> read_card(const std::string& path) {
   const json doc = json::parse(ss.str(), nullptr, /*allow_exceptions=*/false);
   auto bad = [&](const std::string& what) { return Status::ParseError(path + ": " + what); };
   if (doc.is_discarded() || !doc.is_object()) return bad("not valid JSON");
-  if (doc.value("format", std::string()) != "g2p-onnx-detector-card" || doc.value("version", 0) != 1)
-    return bad("'format' must be \"g2p-onnx-detector-card\", 'version' 1");
   DetectorCard c;
   try {
+    if (doc.value("format", std::string()) != "g2p-onnx-detector-card" || doc.value("version", 0) != 1)
+      return bad("'format' must be \"g2p-onnx-detector-card\", 'version' 1");
     const json& input = doc.at("input");
     c.input_name = input.at("name").get<std::string>();
     c.width = input.at("width").get<int>();
@@ -137,9 +140,12 @@ class DetectorIdentifier final : public Identifier {
         min_score_ = v;
       } else if (key == "min_iou" && detail::parse_double(value, v) && v >= 0 && v <= 1) {
         min_iou_ = v;
+      } else if (key == "views" && (value == "turntable" || value == "given")) {
+        turntable_ = value == "turntable";
       } else {
-        return Status::InvalidArgument("detector: bad setting " + key + "=" + value +
-                                       " (known: model_card=CARD.json, min_score in [0, 1], min_iou in [0, 1])");
+        return Status::InvalidArgument(
+            "detector: bad setting " + key + "=" + value +
+            " (known: model_card=CARD.json, min_score in [0, 1], min_iou in [0, 1], views=turntable|given)");
       }
     }
     loaded_ = false;
@@ -148,7 +154,8 @@ class DetectorIdentifier final : public Identifier {
 
   Result<Identification> identify(const IdentifyInput& in) const override {
     Identification id;
-    if (in.views == nullptr || in.views->empty()) {
+    const bool can_render = turntable_ && in.renderer != nullptr && in.model != nullptr;
+    if (!can_render && (in.views == nullptr || in.views->empty())) {
       id.notes.push_back("detector: no rendered views");
       return id;
     }
@@ -160,8 +167,15 @@ class DetectorIdentifier final : public Identifier {
     }
     const ObjectTable& table = in.table != nullptr ? *in.table : ObjectTable::shipped();
     const std::size_t k = card_.classes.size();
+    std::vector<View> own;
+    if (can_render) {
+      Result<std::vector<View>> rendered = turntable_views(*in.renderer, in.model->mesh);
+      if (!rendered.ok()) return rendered.status();
+      own = std::move(*rendered);
+    }
+    const std::vector<View>& views = own.empty() ? *in.views : own;
     std::vector<std::vector<double>> best;  // [view][class]
-    for (const View& view : *in.views) {
+    for (const View& view : views) {
       Result<std::vector<double>> scores = view_scores(view);
       if (!scores.ok()) return scores.status();
       if (!scores->empty()) best.push_back(std::move(*scores));
@@ -178,10 +192,10 @@ class DetectorIdentifier final : public Identifier {
       std::sort(s.begin(), s.end(), std::greater<double>());
       double sum = 0;
       for (std::size_t i = 0; i < half; ++i) sum += s[i];
-      int views = 0;
-      for (double x : s) views += x >= min_score_ ? 1 : 0;
+      int seen_in = 0;
+      for (double x : s) seen_in += x >= min_score_ ? 1 : 0;
       const double confidence = sum / double(half);
-      if (confidence >= min_score_) ranked.emplace_back(confidence, c * 1000 + static_cast<std::size_t>(views));
+      if (confidence >= min_score_) ranked.emplace_back(confidence, c * 1000 + static_cast<std::size_t>(seen_in));
     }
     std::sort(ranked.begin(), ranked.end(), std::greater<>());
     for (const auto& [confidence, code] : ranked) {
@@ -225,6 +239,27 @@ class DetectorIdentifier final : public Identifier {
     }
     if (net_.empty()) load_status_ = Status::IoError(card_.model_path + ": OpenCV could not load it");
     return load_status_;
+  }
+
+  // Eye-level views around the object at the network's input size, on the
+  // card's grey: photographs of objects are taken from about there, and the
+  // detector reads views from straight above or below poorly.
+  Result<std::vector<View>> turntable_views(const Renderer& renderer, const Mesh& mesh) const {
+    ViewOptions o;
+    o.num_views = kTurntableViews;
+    o.layout = ViewLayout::kTurntable;
+    o.elevation_deg = kTurntableElevationDeg;
+    o.width = card_.width;
+    o.height = card_.height;
+    Result<std::vector<Camera>> cameras = make_views(mesh, o);
+    if (!cameras.ok()) return cameras.status().with_context("detector");
+    RenderOptions r;
+    r.material_buffers = r.geometry_buffers = false;
+    if (card_.background >= 0) r.background.fill(static_cast<std::uint8_t>(card_.background));
+    std::vector<View> views(cameras->size());
+    for (std::size_t i = 0; i < views.size(); ++i)
+      G2P_RETURN_IF_ERROR(renderer.render_into((*cameras)[i], r, views[i]).with_context("detector: view"));
+    return views;
   }
 
   // Per class, the best score of a detection covering the object in this
@@ -320,7 +355,11 @@ class DetectorIdentifier final : public Identifier {
     return best;
   }
 
+  static constexpr int kTurntableViews = 8;
+  static constexpr double kTurntableElevationDeg = 15.0;
+
   std::string card_path_;
+  bool turntable_ = true;
   double min_score_ = 0.3;
   double min_iou_ = 0.3;
   mutable bool loaded_ = false;

@@ -130,10 +130,11 @@ class AutoIdentifier final : public Identifier {
       if (k == "detector") {
         if (v != "on" && v != "off") return Status::InvalidArgument("auto: detector needs on or off, got '" + v + "'");
         use_detector_ = v == "on";
-      } else if (k == "model_card" || k == "min_score") {
+      } else if (k == "model_card" || k == "min_score" || k == "min_iou" || k == "views") {
         detector[k] = v;
       } else {
-        return Status::InvalidArgument("auto: unknown setting '" + k + "' (known: detector, model_card, min_score)");
+        return Status::InvalidArgument("auto: unknown setting '" + k +
+                                       "' (known: detector, model_card, min_score, min_iou, views)");
       }
     }
     return detector_->configure(detector);
@@ -166,7 +167,7 @@ class AutoIdentifier final : public Identifier {
       id.warnings.insert(id.warnings.end(), part.warnings.begin(), part.warnings.end());
     };
     join(*by_names);
-    if (use_detector_ && in.views != nullptr && !in.views->empty()) {
+    if (use_detector_ && ((in.views != nullptr && !in.views->empty()) || in.renderer != nullptr)) {
       Result<Identification> seen = detector_->identify(in);
       if (!seen.ok()) {
         id.warnings.push_back("the detector failed (" + seen.status().message() + "); identified from names only");

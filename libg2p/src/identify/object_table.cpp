@@ -126,6 +126,16 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 }  // namespace
 
 Result<ObjectTable> ObjectTable::from_json(const std::string& text, const std::string& where) {
+  // A field of the wrong JSON type (a number where a text belongs) throws
+  // from nlohmann's value(); it is a parse error like any other.
+  try {
+    return parse_table(text, where);
+  } catch (const json::exception&) {
+    return Status::ParseError(where + ": a field holds the wrong kind of value (a number for a text, say)");
+  }
+}
+
+Result<ObjectTable> ObjectTable::parse_table(const std::string& text, const std::string& where) {
   json doc;
   try {
     doc = json::parse(text);

@@ -88,13 +88,14 @@ std::vector<std::string> singular_forms(const std::string& w) {
     const std::string suffix(s);
     return w.size() > suffix.size() + 1 && w.compare(w.size() - suffix.size(), suffix.size(), suffix) == 0;
   };
+  // The plain plural first: "panes" is a pane before it is a pan.
+  if (ends("s") && !ends("ss")) forms.push_back(w.substr(0, w.size() - 1));
   if (ends("ies")) forms.push_back(w.substr(0, w.size() - 3) + "y");
   if (ends("ves")) {
     forms.push_back(w.substr(0, w.size() - 3) + "f");
     forms.push_back(w.substr(0, w.size() - 3) + "fe");
   }
   if (ends("es")) forms.push_back(w.substr(0, w.size() - 2));
-  if (ends("s") && !ends("ss")) forms.push_back(w.substr(0, w.size() - 1));
   return forms;
 }
 

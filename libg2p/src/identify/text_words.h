@@ -19,7 +19,8 @@ std::string normalise_phrase(const std::string& text);
 std::vector<Clause> split_clauses(const std::string& text);
 // Words that name no object in a file ("mesh", "model", "material", "sample").
 bool is_generic_word(const std::string& word);
-// The word itself, then its singular readings ("benches" -> bench, benche).
+// The word itself, then its singular readings, the plain plural first
+// ("panes" -> pane, pan; "benches" -> benche, bench; "knives" -> knife).
 std::vector<std::string> singular_forms(const std::string& word);
 
 }  // namespace g2p::detail

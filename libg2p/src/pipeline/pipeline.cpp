@@ -156,8 +156,8 @@ Status Pipeline::prepare() {
   }));
   G2P_RETURN_IF_ERROR(prepare_slot(m.identifier, o.identifier, "identify",
                                    [](const BackendChoice& c) { return make_identifier(c.name, c.settings); }));
-  if (!(o.size_confidence >= 0.0 && o.size_confidence <= 1.0))
-    return Status::InvalidArgument("pipeline: --size-confidence must lie in [0, 1] (PipelineOptions::size_confidence)");
+  if (!(o.kind_confidence >= 0.0 && o.kind_confidence <= 1.0))
+    return Status::InvalidArgument("pipeline: --kind-confidence must lie in [0, 1] (PipelineOptions::kind_confidence)");
   if (m.object_table().size() == 0)
     return Status::Internal("pipeline: the shipped object table did not load (libg2p/data/objects.json)");
   if (!o.object.empty()) {  // the user's words must name a kind: said before any work
@@ -479,6 +479,7 @@ Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
   IdentifyInput in;
   in.model = &r.model;
   in.views = &r.views;
+  in.renderer = renderer.get();  // its model is r.model, as rendered
   in.table = &objects_in_use;
   in.object_text = o.object;
   in.use_file_name = !o.anonymize_names;
@@ -497,7 +498,8 @@ Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
   const Identification& ident = r.identification;
   for (const std::string& w : ident.warnings) r.warnings.push_back("identify: " + w);
   report.notes = ident.notes;
-  const int k = ident.known() ? objects_in_use.find(ident.kind()) : -1;
+  // The run acts on the kind only when it is confident enough.
+  const int k = ident.known() && ident.confidence() >= o.kind_confidence ? objects_in_use.find(ident.kind()) : -1;
   if (k >= 0) r.kind = objects_in_use.kinds()[static_cast<std::size_t>(k)];
   const std::string said = ident.known() ? ident.kind() + " (" + ident.source() + ", " +
                                                fixed(100.0 * ident.confidence(), "%.0f") + " % confident)"
@@ -508,7 +510,7 @@ Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
   // when the kind is confident enough and the policy allows.
   ImportInfo& info = r.model.info;
   if (info.looks_normalised && info.scale_source == "file") {
-    const bool confident = k >= 0 && ident.confidence() >= o.size_confidence;
+    const bool confident = k >= 0;
     auto normalised_warning = [&info] {
       return std::find_if(info.warnings.begin(), info.warnings.end(),
                           [](const std::string& w) { return w.rfind("the model looks normalised", 0) == 0; });
@@ -535,9 +537,9 @@ Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
     } else if (it != info.warnings.end()) {
       if (o.size_policy == SizePolicy::kFile)
         *it += "; its size is kept as the file's (--size-from file)";
-      else if (k >= 0)
-        *it += "; identified as " + said + ", below the " + fixed(100.0 * o.size_confidence, "%.0f") +
-               " % needed to assume its size (--size-confidence)";
+      else if (ident.known())
+        *it += "; identified as " + said + ", below the " + fixed(100.0 * o.kind_confidence, "%.0f") +
+               " % needed to assume its size (--kind-confidence)";
       else
         *it += "; what the object is could not be told (give it with --object to assume its kind's size)";
     }

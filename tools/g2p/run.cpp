@@ -214,7 +214,10 @@ int run_pipeline(const RunArgs& args) {
   const Identification& id = r.identification;
   if (id.known())
     std::printf("  object: %s (%s, %.0f %% confident)%s\n", id.kind().c_str(), id.source().c_str(),
-                100.0 * id.confidence(), r.size_assumed_m > 0 ? ", its typical size assumed" : "");
+                100.0 * id.confidence(),
+                r.kind.name.empty()    ? ", below --kind-confidence: nothing assumed from it"
+                : r.size_assumed_m > 0 ? ", its typical size assumed"
+                                       : "");
   else
     std::printf("  object: unknown (give it with --object)\n");
   for (const StageReport& s : r.stages)

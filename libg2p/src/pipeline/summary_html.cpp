@@ -136,7 +136,7 @@ std::string article(const std::string& noun) {
 }
 
 // What the object was taken for, and what that kind usually weighs.
-void object_line(std::ostringstream& h, const PipelineResult& r) {
+void object_line(std::ostringstream& h, const PipelineResult& r, double kind_confidence) {
   const Identification& id = r.identification;
   h << "<p id=\"g2p-object\">What it is: ";
   if (!id.known()) {
@@ -148,6 +148,9 @@ void object_line(std::ostringstream& h, const PipelineResult& r) {
   if (!r.kind.name.empty())
     h << "; " << escape(article(r.kind.name)) << " usually weighs " << number(r.kind.mass_kg[0]) << " to "
       << number(r.kind.mass_kg[1]) << " kg";
+  else
+    h << "; below the " << number(100.0 * kind_confidence, "%.0f")
+      << " % the run needs to act on it, so nothing was assumed from it";
   if (r.size_assumed_m > 0) h << "; size assumed: longest side " << number(r.size_assumed_m) << " m";
   h << ". Correct it with <code>--object</code>.</p>\n";
 }
@@ -293,7 +296,7 @@ std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
     << number(r.properties.size.extent_m.x()) << " x " << number(r.properties.size.extent_m.y()) << " x "
     << number(r.properties.size.extent_m.z()) << " m (height last; scale from " << escape(size_source(r.model.info))
     << "). Run time " << number(r.seconds, "%.2f") << " s.</p>\n";
-  object_line(h, r);
+  object_line(h, r, o.kind_confidence);
   warnings_banner(h, r);
   if (!r.overrides_applied.empty()) {
     h << "<div class=\"corrections\" id=\"g2p-corrections\"><h2>Corrections applied</h2><ul>\n";

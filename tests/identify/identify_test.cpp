@@ -272,7 +272,7 @@ std::string write_steel_box(const std::string& dir, double x = 0.6, double y = 0
 TEST(KindProperties, ARefrigeratorIsAHollowBodyWithItsMachineryAtTheBottom) {
   const std::string box = write_steel_box(test::scratch_dir("KindPropertiesBox"));
   PipelineOptions o;
-  o.views.width = o.views.height = 192;  // enough for one material by name
+  o.views.width = o.views.height = 192;                 // enough for one material by name
   o.completer = {"partition", {{"resolution", "32"}}};  // a box needs no finer grid (10 times faster)
   o.object = "refrigerator";
   o.identifier = {"object", {}};
@@ -312,9 +312,9 @@ TEST(KindProperties, ARefrigeratorIsAHollowBodyWithItsMachineryAtTheBottom) {
 
 TEST(KindProperties, ASolidKindChangesNothingAndASolidBodyHoldsNoHiddenMass) {
   PipelineOptions o;
-  o.views.width = o.views.height = 192;  // enough for one material by name
+  o.views.width = o.views.height = 192;                 // enough for one material by name
   o.completer = {"partition", {{"resolution", "32"}}};  // a box needs no finer grid (10 times faster)
-  o.last_stage = Stage::kProperties;     // no hulls or files needed
+  o.last_stage = Stage::kProperties;                    // no hulls or files needed
   o.identifier = {"object", {}};
   struct Case {
     const char* object;
@@ -345,9 +345,9 @@ TEST(KindProperties, AHollowKindMakesASolidBodyAShell) {
   // A 20 cm rubber cube is weighed solid by the estimator (rubber has no wall rule); a bucket is a hollow body.
   const std::string box = write_steel_box(test::scratch_dir("KindPropertiesShell"), 0.2, 0.2, 0.2, "rubber");
   PipelineOptions o;
-  o.views.width = o.views.height = 192;  // enough for one material by name
+  o.views.width = o.views.height = 192;                 // enough for one material by name
   o.completer = {"partition", {{"resolution", "32"}}};  // a box needs no finer grid (10 times faster)
-  o.last_stage = Stage::kProperties;     // no hulls or files needed
+  o.last_stage = Stage::kProperties;                    // no hulls or files needed
   o.identifier = {"object", {}};
   o.object = "bucket";
   o.kind_properties = false;

@@ -298,6 +298,9 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("kind_confidence", &PipelineOptions::kind_confidence,
                      "the least identification confidence for which the run acts on the kind (size, structure, "
                      "hidden mass, mass check)")
+      .def_readwrite("kind_prior", &PipelineOptions::kind_prior,
+                     "weight, against 1, of the classes a confident kind does not list, on the classes read from the "
+                     "image; 1 = the kind's materials are not used")
       .def_readwrite("segmenter", &PipelineOptions::segmenter)
       .def_readwrite("project", &PipelineOptions::project)
       .def_readwrite("refiner", &PipelineOptions::refiner)

@@ -292,19 +292,46 @@ function start(section, model) {
   const list = side.querySelector('.g2p-parts');
   const fixesBox = side.querySelector('.g2p-fixes');
   const fixes = [];  // overrides entries, in the order they were made
+  let objectFix = '';  // what the object is, when the person corrects it ("object" of the overrides file)
+  let objectInput = null;
   let pinned = -1;
   let hovered = -1;
   function overridesFile() {
     return {
-      format: 'g2p-overrides', version: 1, model: model.model || undefined, faces_total: model.triangles,
-      overrides: fixes,
+      format: 'g2p-overrides', version: 1, model: model.model || undefined, object: objectFix || undefined,
+      faces_total: model.triangles, overrides: fixes,
     };
+  }
+  // What the object is: the identification, and a field to correct it with a kind of the object table.
+  if (model.object) {
+    const row = text('label', 'What it is: ', 'g2p-object-fix');
+    const input = document.createElement('input');
+    objectInput = input;
+    input.setAttribute('list', 'g2p-kinds');
+    input.value = model.object.kind === 'unknown' ? '' : model.object.kind;
+    input.placeholder = 'unknown';
+    const kinds = document.createElement('datalist');
+    kinds.id = 'g2p-kinds';
+    for (const k of model.object.kinds || []) kinds.append(new Option(k));
+    input.addEventListener('change', () => {
+      const v = input.value.trim().toLowerCase();
+      const fix = v && v !== model.object.kind && (model.object.kinds || []).includes(v) ? v : '';
+      input.setCustomValidity(v && !(model.object.kinds || []).includes(v) ? 'not a kind of the object table' : '');
+      // Only a new value redraws the list: a second change event (on blur, as the person clicks the
+      // download button) must not replace the button under the click.
+      if (fix === objectFix) return;
+      objectFix = fix;
+      showFixes();
+    });
+    row.append(input, kinds);
+    controlsBox.parentNode.insertBefore(row, controlsBox);
   }
   function showFixes() {
     fixesBox.replaceChildren();
-    if (!fixes.length) return;
-    fixesBox.append(text('b', `Corrections (${fixes.length})`));
+    if (!fixes.length && !objectFix) return;
+    fixesBox.append(text('b', `Corrections (${fixes.length + (objectFix ? 1 : 0)})`));
     const ol = document.createElement('ol');
+    if (objectFix) ol.append(text('li', `the object is a ${objectFix} (was ${model.object.kind})`));
     for (const f of fixes) {
       const what = ['class', 'structure', 'wall_thickness_m', 'density_kg_m3', 'contents'].filter((k) => k in f)
         .map((k) => (k === 'wall_thickness_m' ? `wall ${fmt(f[k] * 1e3, 3)} mm` : k === 'density_kg_m3'
@@ -328,6 +355,8 @@ function start(section, model) {
     clear.type = 'button';
     clear.addEventListener('click', () => {
       fixes.length = 0;
+      objectFix = '';
+      if (objectInput) objectInput.value = model.object.kind === 'unknown' ? '' : model.object.kind;
       parts.forEach((p, k) => {
         p.classMaterial.color.set(p.data.color);
         list.children[k].querySelector('.sw').style.background = p.data.color;

@@ -187,6 +187,12 @@ class HammerPipelineTest(unittest.TestCase):
         self.assertEqual(len(summary["parts"]), 2)
         self.assertEqual(r.asset_name, "hammer")
 
+    def test_kind_prior_is_an_option_checked_before_work(self):
+        o = quick_options(object="hammer", kind_prior=0.2)
+        self.assertAlmostEqual(o.kind_prior, 0.2)
+        with self.assertRaisesRegex(g2p.Error, "--kind-prior"):
+            g2p.Pipeline(quick_options(kind_prior=0.0)).run_file(HAMMER)
+
     def test_write_output(self):
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "hammer_out")

@@ -410,7 +410,11 @@ TEST(ToolRun, HybridDecomposesAGeneratedLookingMesh) {
   std::set<std::string> materials;
   for (const auto& part : j["parts"]) materials.insert(part["material"].get<std::string>());
   EXPECT_GE(materials.size(), 2u) << j["parts"].dump();
-  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+  // Nothing degraded. The one warning allowed is the chair's mass check: the
+  // file's name makes it a chair, whose usual 2.5-12 kg this merged fixture,
+  // weighed at quick settings, may leave (13 kg at the run's defaults).
+  for (const auto& w : j["warnings"])
+    EXPECT_EQ(w.get<std::string>().rfind("mass: the object weighs", 0), 0u) << j["warnings"].dump();
 }
 
 // `--base-color-only` runs a curated asset as a generator would emit it: the

@@ -53,9 +53,9 @@ TEST(SummaryBrowser, The3DViewDrawsTheHammerAndEveryControlChangesThePicture) {
 }
 
 // The correction round trip: a person picks the hammer's handle in the page,
-// makes it hollow plastic of 1100 kg/m^3, 30 % full of water, and downloads the
-// overrides; `g2p export` applies them to the run's folder, and report.json
-// says so.
+// makes it hollow plastic of 1100 kg/m^3, 30 % full of water, says the object
+// is a screwdriver, and downloads the overrides; `g2p export` applies them to
+// the run's folder, and report.json says so.
 TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   const std::string& page = hammer_page();
   if (!has_viewer(page))
@@ -64,12 +64,13 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   const std::string dir = test::scratch_dir("SummaryBrowserCorrection");
   const nlohmann::json before = nlohmann::json::parse(test::read_file(run + "/run.json"));
   ASSERT_EQ(before["parts"][0]["material"], "Wood");
-  const test::ValidatorRun v =
-      test::run_summary_browser(page, "--correct 0:Plastic:1100:30 --download " + test::quote(dir + "/overrides.json"));
+  const test::ValidatorRun v = test::run_summary_browser(
+      page, "--correct 0:Plastic:1100:30 --object screwdriver --download " + test::quote(dir + "/overrides.json"));
   SKIP_WITHOUT_BROWSER(v);
   ASSERT_EQ(v.run.exit_code, 0) << v.run.out << v.run.err;
   const nlohmann::json fix = nlohmann::json::parse(test::read_file(dir + "/overrides.json"));
   EXPECT_EQ(fix["format"], "g2p-overrides");
+  EXPECT_EQ(fix["object"], "screwdriver") << fix.dump();
   ASSERT_EQ(fix["overrides"].size(), 1u) << fix.dump();
   EXPECT_EQ(fix["overrides"][0]["part"], 0);
   EXPECT_EQ(fix["overrides"][0]["was"]["class"], "Wood");
@@ -78,6 +79,7 @@ TEST(SummaryBrowser, ACorrectionMadeInThePageIsAppliedByTheCli) {
   const test::ToolRun r = test::run_tool("export " + test::quote(run) + " --overrides " +
                                          test::quote(dir + "/overrides.json") + " -o " + test::quote(dir + "/fixed"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("'screwdriver'"), std::string::npos) << r.out;  // the correction of what it is, said
   const nlohmann::json report = nlohmann::json::parse(test::read_file(dir + "/fixed/report.json"));
   const nlohmann::json* handle = nullptr;
   for (const nlohmann::json& p : report["parts"])

@@ -29,7 +29,7 @@ const { chromium } = require('playwright-core');
 
 const args = process.argv.slice(2);
 const page_path = args.find((a, i) => !a.startsWith('--') &&
-  !/^--(screenshot|correct|download)/.test(args[i - 1] || ''));
+  !/^--(screenshot|correct|download|object)/.test(args[i - 1] || ''));
 const option = (name) => (args.includes(name) ? args[args.indexOf(name) + 1] : null);
 const shot = option('--screenshot');
 const top_shot = option('--screenshot-top');
@@ -37,6 +37,7 @@ const no_webgl = args.includes('--no-webgl');
 const draw_only = args.includes('--draw-only');
 const correct = option('--correct');
 const download_to = option('--download');
+const object_kind = option('--object');  // with --correct: also correct what the object is
 if (!page_path) {
   console.error('usage: node summary_browser.js PAGE.html [--screenshot OUT.png] [--screenshot-top OUT.png] [--no-webgl | --draw-only]');
   process.exit(2);
@@ -224,6 +225,16 @@ async function main() {
         if (filled) {
           check(listed[0].includes(`${filled} % full (1000 kg/m\u00b3)`), `the corrections list shows ` +
             `${JSON.stringify(listed)}, not ${filled} % full of water`);
+        }
+        if (object_kind) {  // What it is: another kind of the object table joins the corrections
+          const field = section.locator('.g2p-object-fix input');
+          check(await field.count() === 1, 'the page has no "What it is" field (.g2p-object-fix)');
+          await field.fill(object_kind);
+          await field.dispatchEvent('change');
+          const now = await section.locator('.g2p-fixes li').allInnerTexts();
+          check(now.length === 2 && now[0].includes(`the object is a ${object_kind}`),
+            `after correcting what the object is, the corrections list shows ${JSON.stringify(now)}`);
+          result.checks.push('a correction of what the object is is listed');
         }
         const [download] = await Promise.all([
           page.waitForEvent('download', { timeout: 10000 }),

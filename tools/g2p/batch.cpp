@@ -34,6 +34,8 @@ const PassThrough kPassThrough[] = {
     {"--object", "What every object is, in words (a manifest's object column gives it per model)", true, false},
     {"--identifier", "Identifier backend (default auto)", true, false},
     {"--size-from", "kind or file: may a normalised mesh take its kind's size (default kind)", true, false},
+    {"--kind-confidence", "The least identification confidence the run acts on", true, false},
+    {"--kind-prior", "Weight of the classes an identified kind does not list (1 = not used)", true, false},
     {"--segmenter", "Segmenter backend (default hybrid)", true, false},
     {"--set", "Segmenter setting KEY=VALUE (repeatable)", true, true},
     {"--refiner", "Refiner backend (default smooth)", true, false},

@@ -157,6 +157,11 @@ void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
                   "(--size-from kind), weighs its structure and hidden mass, checks the mass against its range")
       ->check(finite_number(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_option("--kind-prior", args.kind_prior,
+                  "Weight, against 1, of the material classes a confidently identified kind does not list, on the "
+                  "classes read from the image (1 = the kind's materials are not used)")
+      ->check(finite_number(0.0, 1.0, true))
+      ->capture_default_str();
 }
 
 Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,

@@ -75,6 +75,7 @@ struct IdentifyArgs {
   std::vector<std::string> settings;
   std::string size_from = to_string(PipelineOptions{}.size_policy);
   double kind_confidence = PipelineOptions{}.kind_confidence;
+  double kind_prior = PipelineOptions{}.kind_prior;
 };
 
 void add_identify_flags(CLI::App* cmd, IdentifyArgs& args);

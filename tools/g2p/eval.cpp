@@ -15,7 +15,9 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/eval.h"
+#include "g2p/identify.h"
 #include "g2p/io.h"
+#include "g2p/pipeline.h"
 #include "g2p/project.h"
 #include "g2p/regions.h"
 #include "g2p/segment.h"
@@ -39,6 +41,11 @@ struct EvalArgs {
   bool soft = false;            // soft votes (the segmenter's probabilities) instead of one vote per pixel
   RefineArgs refine;            // the refine stage after voting (default none: the project stage alone)
   std::string region_features;  // CSV of every region's features and true class (training the region classifier)
+  // What the object is, as `g2p run` finds it, and what its kind's materials weigh.
+  std::string identifier = "none";
+  bool object_from_names = false;  // the names identifier on the model as given stands for the user's --object
+  double kind_confidence = PipelineOptions{}.kind_confidence;
+  double kind_prior = PipelineOptions{}.kind_prior;
 };
 
 // The regions of one model with their features (regions.h) and their true
@@ -114,6 +121,23 @@ int run_eval_seg(const EvalArgs& args) {
   if (!predictor.ok()) return exit_code;
   Result<std::unique_ptr<Refiner>> refiner = make_refiner_flag("eval seg", args.refine, exit_code);
   if (!refiner.ok()) return exit_code;
+  const ObjectTable& objects = ObjectTable::shipped();
+  std::unique_ptr<Identifier> identifier, names_identifier;
+  for (auto [name, slot] : {std::pair<std::string, std::unique_ptr<Identifier>*>{args.identifier, &identifier},
+                            {args.object_from_names ? "names" : "none", &names_identifier}}) {
+    if (name == "none") continue;
+    Result<std::unique_ptr<Identifier>> made = make_identifier(name);
+    if (!made.ok()) {
+      std::cerr << "g2p eval seg: error: --identifier " << name << ": " << made.status().message() << "\n";
+      return kExitUsage;
+    }
+    *slot = std::move(*made);
+  }
+  if (args.object_from_names && identifier == nullptr) {
+    std::cerr << "g2p eval seg: error: --object-from-names needs an --identifier that reads the user's words (auto "
+                 "or object)\n";
+    return kExitUsage;
+  }
   std::ofstream region_rows;
   if (!args.region_features.empty()) {
     region_rows.open(args.region_features, std::ios::binary | std::ios::trunc);
@@ -151,6 +175,14 @@ int run_eval_seg(const EvalArgs& args) {
       std::cerr << "g2p eval seg: error: " << s.to_string() << "\n";
       return kExitFailure;
     }
+    // The user's words, as the model's own names give them (before they are removed).
+    std::string object_text;
+    if (args.object_from_names) {
+      IdentifyInput names_in;
+      names_in.model = &*model;
+      Result<Identification> named = names_identifier->identify(names_in);
+      if (named.ok() && named->known()) object_text = named->kind();
+    }
     if (args.anonymize) anonymize_names(*model);  // after the oracle: it reads indices, not names
     if (args.base_color_only) reduce_to_base_color(*model);
     Result<std::vector<View>> views = render_with_flags("eval seg", *model, args.views, exit_code);
@@ -158,6 +190,30 @@ int run_eval_seg(const EvalArgs& args) {
     if (s = (*predictor)->set_model(*model, *table); !s.ok()) {
       std::cerr << "g2p eval seg: error: " << key << ": " << s.to_string() << "\n";
       return kExitFailure;
+    }
+    const std::vector<std::uint8_t> image_decided = (*predictor)->image_decided_faces();
+    // What the object is, as g2p run identifies it; a confident kind's
+    // materials weigh the classes read from the image.
+    std::string kind = "unknown";
+    std::vector<float> class_prior;
+    if (identifier != nullptr) {
+      IdentifyInput id_in;
+      id_in.model = &*model;
+      id_in.views = &*views;
+      id_in.object_text = object_text;
+      id_in.use_file_name = !args.anonymize;
+      Result<std::unique_ptr<Renderer>> turntable = renderer_registry().create("embree");
+      if (turntable.ok() && (*turntable)->set_model(*model).ok()) id_in.renderer = turntable->get();
+      Result<Identification> id = identifier->identify(id_in);
+      if (!id.ok()) {
+        std::cerr << "g2p eval seg: error: " << key << ": " << id.status().to_string() << "\n";
+        return kExitFailure;
+      }
+      const int k = id->known() && id->confidence() >= args.kind_confidence ? objects.find(id->kind()) : -1;
+      if (k >= 0) {
+        kind = id->kind();
+        class_prior = kind_class_prior(objects.kinds()[static_cast<std::size_t>(k)], *table, args.kind_prior);
+      }
     }
     // A backend that degraded says why, once: its scores are not its own.
     for (const std::string& w : (*predictor)->warnings())
@@ -171,6 +227,7 @@ int run_eval_seg(const EvalArgs& args) {
     for (const View& v : *views) {
       s = (*oracle)->segment_into(v, truth);
       if (s.ok()) s = (*predictor)->segment_into(v, predicted);
+      if (s.ok() && !class_prior.empty()) s = apply_class_prior(class_prior, image_decided, v, predicted).status();
       if (s.ok()) s = matrix.add(truth.labels, predicted.labels);
       if (s.ok() && !predicted.probabilities.empty())
         s = calibration.add(truth.labels, predicted.labels, predicted.probabilities);
@@ -207,10 +264,9 @@ int run_eval_seg(const EvalArgs& args) {
         return kExitFailure;
       }
     nlohmann::json refine_report;  // kept in the JSON, not printed: the table stays one line per model
-    const std::vector<std::uint8_t> image_decided = (*predictor)->image_decided_faces();
-    if (const int code =
-            apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
-                          project_options.partition, *projection, refine_report, /*print_notes=*/false, &image_decided);
+    if (const int code = apply_refiner("eval seg", args.refine.name, refiner->get(), *model, *views, *table,
+                                       project_options.partition, *projection, refine_report, /*print_notes=*/false,
+                                       &image_decided, &class_prior);
         code != kExitOk)
       return code;
     ConfusionMatrix matrix_3d(table->size());
@@ -227,7 +283,9 @@ int run_eval_seg(const EvalArgs& args) {
         key.c_str(), matrix.total(), 100.0 * matrix.accuracy(), 100.0 * matrix.mean_iou(), matrix_3d.total(),
         100.0 * matrix_3d.accuracy(), 100.0 * matrix_3d.mean_iou());
     per_model[key] = {{"2d", nlohmann::json::parse(matrix.to_json(*table))},
-                      {"3d", nlohmann::json::parse(matrix_3d.to_json(*table))}};
+                      {"3d", nlohmann::json::parse(matrix_3d.to_json(*table))},
+                      {"kind", kind},
+                      {"kind_prior_applied", !class_prior.empty()}};
     if (refiner->get() != nullptr) {
       refine_report.erase("changes_first_1000");  // per face: too long for a score file
       per_model[key]["refine"] = refine_report;
@@ -496,6 +554,20 @@ void add_eval_command(CLI::App& app, Command& run) {
   add_segmenter_flags(seg, args->segmenter);
   seg->add_flag("--soft", args->soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
   add_refiner_flags(seg, args->refine, "none");
+  seg->add_option("--identifier", args->identifier,
+                  "Identify each object as g2p run does (auto, names, detector, ...); a confident kind's materials "
+                  "weigh the classes read from the image (--kind-prior). none: not identified")
+      ->capture_default_str();
+  seg->add_flag("--object-from-names", args->object_from_names,
+                "Give each object's kind as the model's own names say it, before --anonymize-names removes them, "
+                "as a user's --object would (the kind known, the names still removed for segmenting)");
+  seg->add_option("--kind-confidence", args->kind_confidence, "The least identification confidence acted on")
+      ->check(finite_number(0.0, 1.0))
+      ->capture_default_str();
+  seg->add_option("--kind-prior", args->kind_prior,
+                  "Weight of the classes a confident kind does not list (1 = its materials are not used)")
+      ->check(finite_number(0.0, 1.0, true))
+      ->capture_default_str();
   seg->add_option("--region-features", args->region_features,
                   "Also write every region's features and true class to this CSV (training the region classifier, "
                   "docs/regions.md)");

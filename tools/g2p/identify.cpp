@@ -70,6 +70,7 @@ int run_identify(const IdentifyCommandArgs& args) {
   if (!policy.ok()) return usage(policy.status().message());
   o.size_policy = *policy;
   o.kind_confidence = args.identify.kind_confidence;
+  o.kind_prior = args.identify.kind_prior;
   o.last_stage = Stage::kIdentify;
   Pipeline pipeline(o);
   Result<PipelineResult> r = pipeline.run_file(args.model);

@@ -137,6 +137,7 @@ int run_pipeline(const RunArgs& args) {
   if (!size_policy.ok()) return usage(size_policy.status().message());
   o.size_policy = *size_policy;
   o.kind_confidence = args.identify.kind_confidence;
+  o.kind_prior = args.identify.kind_prior;
   o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
   o.decompose = args.decomposer.options;
   if (!(args.memory_limit_gib >= 0)) return usage("--memory-limit must be 0 (the machine's memory) or more GiB");

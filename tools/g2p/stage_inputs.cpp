@@ -59,6 +59,10 @@ Result<LabelledObject> load_labelled_source(const std::string& command, const La
     G2P_RETURN_IF_ERROR(
         apply_overrides_file(command, f, out->model.mesh, out->table, out->faces, out->overrides, exit_code, carried));
   finish_overrides(out->model.mesh.num_faces(), out->faces.parts, out->faces.labels, out->table, out->overrides);
+  if (!out->overrides.combined.object.empty()) {  // a correction of what the object is (checked when read)
+    Result<std::string> kind = kind_from_text(ObjectTable::shipped(), out->overrides.combined.object);
+    if (kind.ok()) out->kind = *kind;
+  }
   for (const std::string& n : out->overrides.notes) std::cout << "correction: " << n << "\n";
   return out;
 }

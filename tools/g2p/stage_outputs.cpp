@@ -49,10 +49,11 @@ Result<std::unique_ptr<Refiner>> make_refiner_flag(const std::string& command, c
 int apply_refiner(const std::string& command, const std::string& name, const Refiner* refiner, const Model& model,
                   const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition_options,
                   Projection& projection, nlohmann::json& report, bool print_notes,
-                  const std::vector<std::uint8_t>* image_decided) {
+                  const std::vector<std::uint8_t>* image_decided, const std::vector<float>* class_prior) {
   report = {{"refiner", name}};
   if (refiner == nullptr) return kExitOk;
-  RefineInput in{&model.mesh, &projection.graph, &projection.votes, &projection.labels, &views, &table, image_decided};
+  RefineInput in{&model.mesh, &projection.graph, &projection.votes, &projection.labels, &views,
+                 &table,      image_decided,     class_prior};
   Result<RefineResult> refined = refiner->refine(in);
   if (!refined.ok() &&
       (refined.status().code() == StatusCode::kInvalidArgument || refined.status().code() == StatusCode::kNotFound)) {

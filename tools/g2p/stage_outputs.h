@@ -32,7 +32,8 @@ Result<std::unique_ptr<Refiner>> make_refiner_flag(const std::string& command, c
 int apply_refiner(const std::string& command, const std::string& name, const Refiner* refiner, const Model& model,
                   const std::vector<View>& views, const MaterialTable& table, const PartitionOptions& partition,
                   Projection& projection, nlohmann::json& report, bool print_notes,
-                  const std::vector<std::uint8_t>* image_decided = nullptr);
+                  const std::vector<std::uint8_t>* image_decided = nullptr,
+                  const std::vector<float>* class_prior = nullptr);
 
 // Runs the refiner on the projection and re-partitions with its labels. A
 // refiner failure keeps the projected labels (a warning; the report says

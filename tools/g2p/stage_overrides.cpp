@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "g2p/identify.h"
 
 namespace g2p::cli {
 
@@ -34,6 +35,10 @@ Status apply_file(const std::string& command, const std::string& path, bool carr
   if (!std::filesystem::is_regular_file(path)) return fail(Status::NotFound(path + ": no such file"));
   Result<Overrides> parsed = read_overrides(path, table);
   if (!parsed.ok()) return fail(parsed.status());
+  if (!parsed->object.empty()) {  // what the object is: a kind of the object table, checked before anything changes
+    Result<std::string> kind = kind_from_text(ObjectTable::shipped(), parsed->object, "\"object\"");
+    if (!kind.ok()) return fail(kind.status());
+  }
   Result<ResolvedOverrides> resolved = resolve_overrides(*parsed, num_faces, parts, labels, table);
   if (!resolved.ok()) return fail(resolved.status());
   const std::vector<int> before = labels;
@@ -45,6 +50,10 @@ Status apply_file(const std::string& command, const std::string& path, bool carr
   Overrides faces = as_face_selections(*resolved);
   applied.combined.faces_total = faces.faces_total;
   if (applied.combined.model.empty()) applied.combined.model = faces.model;
+  if (!faces.object.empty()) {
+    applied.combined.object = faces.object;
+    applied.notes.push_back(path + ": the object is taken for what \"object\" says, '" + faces.object + "'");
+  }
   for (Override& o : faces.entries) applied.combined.entries.push_back(std::move(o));
   return Status::Ok();
 }

@@ -212,6 +212,18 @@ G2P_API Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object,
                                                              const PropertyEstimator& estimator, const ObjectKind& kind,
                                                              const std::vector<View>* views = nullptr);
 
+// The kind's materials by role as evidence for the image's classes (issue
+// #48): a weight per class of `table`, 1 for each class the kind lists
+// (ObjectKind::materials) and `other_weight` (in (0, 1]) for every other.
+// The pipeline multiplies the probabilities of the classes decided from the
+// image alone (the network's pixels, the region classifier's regions) by
+// these weights and renormalises (apply_class_prior, segment.h): the kind
+// shifts a close call, the image still decides. Empty (no prior) when
+// other_weight >= 1 or the kind names no class of `table`. `listed` (when not
+// null) receives the listed classes' names, for the report.
+G2P_API std::vector<float> kind_class_prior(const ObjectKind& kind, const MaterialTable& table, double other_weight,
+                                            std::vector<std::string>* listed = nullptr);
+
 // The identification as JSON (report.json's and run.json's "identification"):
 // {"kind" ("unknown" when not known), "confidence", "source", "evidence",
 //  "candidates": [{"kind", "confidence", "source", "evidence"}, ...] (at most

@@ -14,7 +14,9 @@
 // structure, wall thickness, density and contents (a fill of a hollow part's
 // cavity: {"part": 0, "contents": {"fill": 0.8, "density_kg_m3": 1000}}). Classes change before the complete
 // stage (the parts are re-formed from the new labels); the other values
-// replace the estimator's for the parts that hold the selected faces.
+// replace the estimator's for the parts that hold the selected faces. A
+// top-level "object": "chair" corrects what the object is (identify.h): the
+// run takes it as the user's words, as `--object` would be.
 #pragma once
 
 #include <array>
@@ -64,9 +66,13 @@ struct Overrides {
   std::vector<Override> entries;  // in file order; where two select the same face, each value (class;
                                   // structure with wall; density; contents) comes from the later entry that sets it
   std::string model;              // the model the run was made from (for people; not checked)
-  int faces_total = -1;           // the input's face count; checked when >= 0
+  // What the object is, in words ("object": "exercise bike"), as --object
+  // takes them: it corrects the identification (identify.h); a run given
+  // --object as well keeps --object. "" = what the identify step finds.
+  std::string object;
+  int faces_total = -1;  // the input's face count; checked when >= 0
 
-  bool empty() const { return entries.empty(); }
+  bool empty() const { return entries.empty() && object.empty(); }
   bool changes_labels() const {
     for (const Override& o : entries)
       if (o.label != kUnknownLabel) return true;

@@ -34,6 +34,10 @@ struct RefineInput {
   // (Segmenter::image_decided_faces); null or empty: the refiner may not tell
   // image evidence from names, and treats every face alike.
   const std::vector<std::uint8_t>* image_decided = nullptr;
+  // A weight per class for the classes decided from the image (the object's
+  // kind's materials: kind_class_prior in identify.h); null or empty: none.
+  // The `regions` refiner multiplies its regions' probabilities by it.
+  const std::vector<float>* class_prior = nullptr;
 };
 
 // One face whose label the refiner changed, and why.

@@ -69,6 +69,22 @@ G2P_API Registry<Segmenter>& segmenter_registry();
 G2P_API Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& name,
                                                           const BackendSettings& settings = {});
 
+// ---- A prior over classes ----------------------------------------------------
+
+// Weighs the pixels of `map` whose faces were decided from the image
+// (`image_decided`, per face of the view's mesh: Segmenter::image_decided_faces)
+// by a prior over classes (`weight`, one per class, for example the object's
+// kind's materials: kind_class_prior in identify.h): each such pixel's
+// probabilities are multiplied by the weights and renormalised, and its label
+// becomes the most probable class. Other pixels, and a map without
+// probabilities (a backend that gives labels only), are left as they are; so
+// is everything when `weight` is empty. Returns how many labels changed.
+// Fails when `weight` does not have one entry per channel of the map's
+// probabilities or holds a weight that is not positive and finite.
+G2P_API Result<std::size_t> apply_class_prior(const std::vector<float>& weight,
+                                              const std::vector<std::uint8_t>& image_decided, const View& view,
+                                              LabelMap& map);
+
 // ---- Ground truth -----------------------------------------------------------
 
 // Class label of every source material of `model` from a labels.json-style
@@ -84,6 +100,13 @@ G2P_API Result<std::vector<int>> material_labels_from_json(const std::string& js
 // `pbr` backend (docs/segment.md); also the labelling rule of the training
 // data (docs/training.md).
 G2P_API std::vector<float> material_name_evidence(std::string_view name, const MaterialTable& table);
+
+// Whether a name says nothing: every word of it is one that exporters,
+// modelling tools and image-to-3D pipelines give when nobody named anything
+// ("Material.001", "Plane.003", "pCubeShape1", "mesh_3", "geometry_0"), or it
+// is empty or all digits. A curated asset's own words ("potty", "Wood_oak")
+// are not. The `hybrid` segmenter and the `names` identifier skip such names.
+G2P_API bool is_placeholder_name(std::string_view name);
 
 // ---- Output -----------------------------------------------------------------
 

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "g2p/identify.h"
+#include "g2p/segment.h"
 #include "identify/backends.h"
 
 namespace g2p {
@@ -71,7 +72,9 @@ class ObjectIdentifier final : public Identifier {
 
 // The names a file carries: its own name (unless names were removed), its
 // nodes and meshes (material names are left out: they name materials and
-// colours, "oak", "black velvet", not the object). Each name votes for the
+// colours, "oak", "black velvet", not the object) and placeholders
+// (is_placeholder_name: Blender's "Plane.003" is no airplane, "Cube" no
+// puzzle cube) are left out. Each name votes for the
 // kind it names best: the file name 1, each node or mesh name 0.5 (at most
 // 1.5 a kind); a kind's confidence is its votes over all votes plus 0.5, at
 // most 0.9 (names are often stale).
@@ -94,24 +97,31 @@ class NamesIdentifier final : public Identifier {
       v.*slot += weight;
       if (v.why.size() < 3) v.why.push_back(std::string(what) + " '" + name + "'");
     };
-    if (in.use_file_name && !in.model->info.path.empty())
-      vote(std::filesystem::path(in.model->info.path).stem().string(), 1.0, &Vote::file, "file name");
+    const std::string stem = std::filesystem::path(in.model->info.path).stem().string();
+    if (in.use_file_name && !stem.empty() && !is_placeholder_name(stem)) vote(stem, 1.0, &Vote::file, "file name");
     std::set<std::string> names;
     for (const SourcePrimitive& p : in.model->primitives) {
       if (!p.node_name.empty()) names.insert(p.node_name);
       if (!p.mesh_name.empty()) names.insert(p.mesh_name);
     }
-    for (const std::string& n : names) vote(n, 0.5, &Vote::nodes, "node or mesh name");
+    for (const std::string& n : names)  // Blender's "Plane.003" names no airplane
+      if (!is_placeholder_name(n)) vote(n, 0.5, &Vote::nodes, "node or mesh name");
     double all = 0;
     for (const auto& [kind, v] : votes) all += v.total();
-    for (const auto& [kind, v] : votes) {
+    // Most votes first; on a tie the kind the file's own name gives (its
+    // "sofa2" over the "Cushion" parts it is made of).
+    std::vector<std::pair<int, const Vote*>> ranked;
+    for (const auto& [kind, v] : votes) ranked.emplace_back(kind, &v);
+    std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+      return a.second->total() != b.second->total() ? a.second->total() > b.second->total()
+                                                    : a.second->file > b.second->file;
+    });
+    for (const auto& [kind, v] : ranked) {
       std::string why;
-      for (const std::string& w : v.why) why += (why.empty() ? "" : ", ") + w;
+      for (const std::string& w : v->why) why += (why.empty() ? "" : ", ") + w;
       id.candidates.push_back(
-          {table.kinds()[static_cast<std::size_t>(kind)].name, std::min(0.9, v.total() / (all + 0.5)), "names", why});
+          {table.kinds()[static_cast<std::size_t>(kind)].name, std::min(0.9, v->total() / (all + 0.5)), "names", why});
     }
-    std::stable_sort(id.candidates.begin(), id.candidates.end(),
-                     [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });
     if (id.candidates.empty()) id.notes.push_back("names: no name in the file names a kind of the object table");
     return id;
   }

@@ -95,7 +95,10 @@ std::vector<std::string> singular_forms(const std::string& w) {
     forms.push_back(w.substr(0, w.size() - 3) + "f");
     forms.push_back(w.substr(0, w.size() - 3) + "fe");
   }
-  if (ends("es")) forms.push_back(w.substr(0, w.size() - 2));
+  // "-es" only after a hiss or an o (boxes, glasses, benches, dishes,
+  // tomatoes): "panes" is no pan.
+  if (ends("es") && (ends("ses") || ends("xes") || ends("zes") || ends("ches") || ends("shes") || ends("oes")))
+    forms.push_back(w.substr(0, w.size() - 2));
   return forms;
 }
 

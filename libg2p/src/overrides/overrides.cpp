@@ -177,15 +177,20 @@ Result<Overrides> parse_overrides(const std::string& text, const MaterialTable& 
   if (j["version"].get<long long>() != kOverridesVersion)
     return Status::InvalidArgument(origin + ": overrides version " + j["version"].dump() +
                                    ", but this g2p reads version " + std::to_string(kOverridesVersion));
-  static const std::set<std::string> kKeys = {"format", "version", "model", "faces_total", "overrides"};
+  static const std::set<std::string> kKeys = {"format", "version", "model", "object", "faces_total", "overrides"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!kKeys.count(it.key()))
       return Status::InvalidArgument(origin + ": unknown key '" + it.key() +
-                                     "' (format, version, model, faces_total, overrides)");
+                                     "' (format, version, model, object, faces_total, overrides)");
   Overrides out;
   if (j.contains("model")) {
     if (!j["model"].is_string()) return Status::InvalidArgument(origin + ": \"model\" must be a file name");
     out.model = j["model"].get<std::string>();
+  }
+  if (j.contains("object")) {
+    if (!j["object"].is_string() || j["object"].get<std::string>().find_first_not_of(" \t") == std::string::npos)
+      return Status::InvalidArgument(origin + ": \"object\" must be what the object is, in words (\"chair\")");
+    out.object = j["object"].get<std::string>();
   }
   if (j.contains("faces_total")) {
     const json& n = j["faces_total"];
@@ -243,6 +248,7 @@ std::string overrides_json(const Overrides& overrides, const MaterialTable& tabl
   }
   std::string head = "{\n  \"format\": \"g2p-overrides\",\n  \"version\": " + std::to_string(kOverridesVersion) + ",\n";
   if (!overrides.model.empty()) head += "  \"model\": " + json(overrides.model).dump() + ",\n";
+  if (!overrides.object.empty()) head += "  \"object\": " + json(overrides.object).dump() + ",\n";
   if (overrides.faces_total >= 0) head += "  \"faces_total\": " + std::to_string(overrides.faces_total) + ",\n";
   return head + "  \"overrides\": [" + entries + (entries.empty() ? "]" : "\n  ]") + "\n}\n";
 }
@@ -319,6 +325,7 @@ Result<ResolvedOverrides> resolve_overrides(const Overrides& overrides, int num_
 Overrides as_face_selections(const ResolvedOverrides& resolved) {
   Overrides out;
   out.model = resolved.overrides.model;
+  out.object = resolved.overrides.object;
   out.faces_total = static_cast<int>(resolved.class_entry.size());
   // Runs of consecutive faces whose winning entry is `e` in `winner`.
   auto ranges = [](const std::vector<int>& winner, int e) {

@@ -55,6 +55,12 @@ Status prepare_slot(Slot<Interface>& slot, const BackendChoice& choice, const ch
   return Status::Ok();
 }
 
+std::string fixed(double x, const char* format = "%.3g") {
+  char b[32];
+  std::snprintf(b, sizeof b, format, x);
+  return b;
+}
+
 std::string fixed_mass(double kg) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g kg", kg);
@@ -156,12 +162,18 @@ Status Pipeline::prepare() {
   }));
   G2P_RETURN_IF_ERROR(prepare_slot(m.identifier, o.identifier, "identify",
                                    [](const BackendChoice& c) { return make_identifier(c.name, c.settings); }));
+  if (!(o.kind_prior > 0.0 && o.kind_prior <= 1.0))
+    return Status::InvalidArgument("pipeline: --kind-prior must lie in (0, 1] (PipelineOptions::kind_prior)");
   if (!(o.kind_confidence >= 0.0 && o.kind_confidence <= 1.0))
     return Status::InvalidArgument("pipeline: --kind-confidence must lie in [0, 1] (PipelineOptions::kind_confidence)");
   if (m.object_table().size() == 0)
     return Status::Internal("pipeline: the shipped object table did not load (libg2p/data/objects.json)");
   if (!o.object.empty()) {  // the user's words must name a kind: said before any work
     Result<std::string> kind = kind_from_text(m.object_table(), o.object);
+    if (!kind.ok()) return kind.status();
+  }
+  if (!o.overrides.object.empty()) {
+    Result<std::string> kind = kind_from_text(m.object_table(), o.overrides.object, "the overrides' \"object\"");
     if (!kind.ok()) return kind.status();
   }
   G2P_RETURN_IF_ERROR(prepare_slot(m.segmenter, o.segmenter, "segment",
@@ -207,6 +219,9 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   // Per face, whether the segmenter's labels came from the image alone (the
   // `regions` refiner decides only those).
   std::vector<std::uint8_t> image_decided;
+  // The object's kind's materials as a prior over the classes the image
+  // decides (kind_class_prior); empty: none.
+  std::vector<float> class_prior;
 
   // 1. render: the views, each with its face-ID and material buffers.
   {
@@ -240,14 +255,31 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
     // A backend that degraded (`hybrid` falls back to `pbr` without its network) says why.
     for (const std::string& w : segmenter.get()->warnings()) r.warnings.push_back("segment: " + w);
     image_decided = segmenter.get()->image_decided_faces();
+    // The kind's materials weigh the classes the image decides.
+    std::vector<std::string> listed;
+    if (!r.kind.name.empty()) class_prior = kind_class_prior(r.kind, r.table, o.kind_prior, &listed);
+    std::size_t prior_changed = 0;
     const std::size_t n = r.views.size();
     r.label_maps.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       G2P_RETURN_IF_ERROR(segmenter.get()
                               ->segment_into(r.views[i], r.label_maps[i])
                               .with_context("segment: view " + std::to_string(i)));
+      if (!class_prior.empty()) {
+        Result<std::size_t> changed = apply_class_prior(class_prior, image_decided, r.views[i], r.label_maps[i]);
+        if (!changed.ok()) return changed.status().with_context("segment: view " + std::to_string(i));
+        prior_changed += *changed;
+      }
       G2P_RETURN_IF_ERROR(context.report(Stage::kSegment, double(i + 1) / double(n),
                                          "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
+    }
+    if (!class_prior.empty()) {
+      std::string classes;
+      for (const std::string& c : listed) classes += (classes.empty() ? "" : ", ") + c;
+      clock.report().notes.push_back("the " + r.kind.name + "'s usual materials (" + classes +
+                                     ") weigh the classes read from the image, every other class x" +
+                                     fixed(o.kind_prior) + " (--kind-prior): " + std::to_string(prior_changed) +
+                                     " pixels changed class");
     }
     finish(clock);
   }
@@ -275,7 +307,7 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
   if (refiner.custom || o.refiner.name != "none") {
     detail::StageClock clock(Stage::kRefine, refiner.backend(o.refiner), reset);
     RefineInput in{&mesh,    &r.projection.graph, &r.projection.votes, &r.projection.labels, &r.views,
-                   &r.table, &image_decided};
+                   &r.table, &image_decided,      &class_prior};
     Result<RefineResult> refined = refiner.get()->refine(in);
     const StatusCode code = refined.ok() ? StatusCode::kOk : refined.status().code();
     if (code == StatusCode::kInvalidArgument || code == StatusCode::kNotFound)
@@ -463,12 +495,6 @@ void scale_run(PipelineResult& r, double s) {
   }
 }
 
-std::string fixed(double x, const char* format = "%.3g") {
-  char b[32];
-  std::snprintf(b, sizeof b, format, x);
-  return b;
-}
-
 }  // namespace
 
 Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
@@ -481,9 +507,20 @@ Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
   in.views = &r.views;
   in.renderer = renderer.get();  // its model is r.model, as rendered
   in.table = &objects_in_use;
-  in.object_text = o.object;
+  // The user's words: --object, else a correction's "object" (overrides.json).
+  const bool corrected = o.object.empty() && !o.overrides.object.empty();
+  in.object_text = corrected ? o.overrides.object : o.object;
   in.use_file_name = !o.anonymize_names;
   Result<Identification> id = identifier.get()->identify(in);
+  if (id.ok() && corrected)
+    for (KindGuess& g : id->candidates)
+      if (g.source == "object") {
+        g.source = "override";
+        g.evidence = "overrides \"object\": '" + o.overrides.object + "'";
+      }
+  if (id.ok() && !o.object.empty() && !o.overrides.object.empty())
+    id->notes.push_back("the overrides' \"object\" ('" + o.overrides.object + "') is not used: --object ('" + o.object +
+                        "') wins");
   StageReport& report = clock.report();
   if (!id.ok()) {
     const StatusCode code = id.status().code();

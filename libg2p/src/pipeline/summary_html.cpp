@@ -74,7 +74,8 @@ const char* kStyle =
     "border-bottom:1px solid #ddd}.g2p-parts li{padding:1px 2px}.g2p-parts li span:last-child{cursor:pointer}"
     ".g2p-parts li.sel{background:#e8eefc}.g2p-info table{margin:.3em 0}.g2p-info th{text-align:left}"
     ".g2p-fix{border:1px solid #bcd;background:#f4f8fd;padding:.3em .5em;margin:.4em 0}.g2p-fix label{display:block;"
-    "margin:.15em 0}.g2p-fix input{width:6em}.g2p-fixes ol{padding-left:1.4em;margin:.3em 0}"
+    "margin:.15em 0}.g2p-fix input{width:6em}.g2p-fixes ol{padding-left:1.4em;margin:.3em "
+    "0}.g2p-object-fix{display:block;margin:.3em 0}.g2p-object-fix input{width:11em}"
     ".g2p-fixes code{font-size:.85em;word-break:break-all}";
 
 // Where the object lies in a view: a square around the pixels that show it

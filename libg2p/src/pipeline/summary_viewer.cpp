@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "g2p/identify.h"
 #include "g2p/vlm.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/view_decimate.h"
@@ -103,9 +104,13 @@ nlohmann::json viewer_json(const PipelineResult& r, std::size_t max_triangles, s
     classes.push_back({{"name", r.table[c].name}, {"color", css_color(r.table[c].color)}});
   const std::string model =
       r.model.info.path.empty() ? std::string() : std::filesystem::path(r.model.info.path).filename().string();
+  // For the "What it is" correction: the identification and the kinds it may take.
+  nlohmann::json kinds = nlohmann::json::array();
+  for (const ObjectKind& k : ObjectTable::shipped().kinds()) kinds.push_back(k.name);
   return {{"format", "g2p-summary-view"},
           {"version", 1},
           {"model", model},
+          {"object", {{"kind", r.identification.kind()}, {"kinds", std::move(kinds)}}},
           {"classes", std::move(classes)},
           {"triangles", total},
           {"triangles_drawn", drawn},

@@ -16,6 +16,8 @@
 // scope (image | all, default image), rest (smooth | keep, default smooth),
 // crease (degrees, default 40), colour (linear RGB step, default 0.1),
 // min_area (area share, default 0.002), min_probability (default 0).
+// RefineInput::class_prior (the object's kind's materials), when given,
+// weighs each decided region's probabilities before its class is chosen.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -134,6 +136,7 @@ class RegionsRefiner final : public Refiner {
     std::vector<int> reason_of(faces, -1);
     std::vector<int> labels = rest.labels;
     const int k = (*classifier)->num_classes();
+    const bool prior = in.class_prior != nullptr && static_cast<int>(in.class_prior->size()) == k;
     int decided = 0, unsure = 0, outside = 0;
     for (int r = 0; r < rows; ++r) {
       const Region& region = regions->regions[static_cast<std::size_t>(r)];
@@ -152,7 +155,13 @@ class RegionsRefiner final : public Refiner {
           continue;
         }
       }
-      const float* p = probabilities->data() + static_cast<std::size_t>(r) * k;
+      float* p = probabilities->data() + static_cast<std::size_t>(r) * k;
+      if (prior) {  // the kind's materials weigh the classifier's votes
+        double total = 0;
+        for (int c = 0; c < k; ++c) total += p[c] * (*in.class_prior)[static_cast<std::size_t>(c)];
+        for (int c = 0; c < k && total > 0; ++c)
+          p[c] = static_cast<float>(p[c] * (*in.class_prior)[static_cast<std::size_t>(c)] / total);
+      }
       int best = 0;
       for (int c = 1; c < k; ++c)
         if (p[c] > p[best]) best = c;

@@ -220,4 +220,6 @@ std::vector<float> material_name_evidence(std::string_view name, const MaterialT
   return detail::name_evidence(name, table);
 }
 
+bool is_placeholder_name(std::string_view name) { return detail::is_placeholder_name(name); }
+
 }  // namespace g2p

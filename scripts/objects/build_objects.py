@@ -6,7 +6,8 @@ Inputs:
   WordNet 3.0 noun database     Debian package wordnet-base: /usr/share/wordnet/{index,data}.noun
 
 For every kind the script checks that each named synset exists, then generates the kind's
-`terms`: the lemmas of its synsets and of all their hyponyms (transitively; a lemma only where its
+`terms`: the lemmas of its synsets and of all their hyponyms (transitively, unless the kind says
+`"hyponyms": false`; a lemma only where its
 most common sense lies under the kind, so "head" and "black" do not name a person nor "steel" a
 sword, unless it is the kind's name or a hand-listed term), plus the kind's
 hand-written `extra_terms`.  A term reached from several kinds goes to the most specific one
@@ -194,7 +195,9 @@ def build_terms(kinds, wn):
     for ki, kind in enumerate(kinds):
         for name in kind["synsets"]:
             root = wn.resolve(name)
-            closure = wn.closure(root)
+            # "hyponyms": false keeps a kind to its own synsets' lemmas: WordNet's thousands of kinds
+            # of person ("white", "ruler", "guard", "passenger") are what node names say of parts.
+            closure = wn.closure(root) if kind.get("hyponyms", True) else {root: 0}
             for off, d in closure.items():
                 for lemma in wn.words[off]:
                     t = term_of(lemma)
@@ -294,6 +297,8 @@ def validate_kind(k, errors):
             errors.append("%s: typical height exceeds typical longest side" % w)
         if k["height_m"][1] > k["longest_side_m"][1] + 1e-9:
             errors.append("%s: height_m hi exceeds longest_side_m hi" % w)
+    if "hyponyms" in k and not isinstance(k["hyponyms"], bool):
+        errors.append("%s: hyponyms must be true or false" % w)
     if k.get("structure") not in STRUCTURES:
         errors.append("%s: structure must be one of %s" % (w, STRUCTURES))
     mats = k.get("materials")

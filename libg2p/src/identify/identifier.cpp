@@ -76,8 +76,8 @@ class ObjectIdentifier final : public Identifier {
 // (is_placeholder_name: Blender's "Plane.003" is no airplane, "Cube" no
 // puzzle cube) are left out. Each name votes for the
 // kind it names best: the file name 1, each node or mesh name 0.5 (at most
-// 1.5 a kind); a kind's confidence is its votes over all votes plus 0.5, at
-// most 0.9 (names are often stale).
+// 1 a kind, so the file's own name wins a tie with its parts' names); a kind's confidence is its votes over all votes
+// plus 0.5, at most 0.9 (names are often stale).
 class NamesIdentifier final : public Identifier {
  public:
   Result<Identification> identify(const IdentifyInput& in) const override {
@@ -87,7 +87,7 @@ class NamesIdentifier final : public Identifier {
     struct Vote {
       double file = 0, nodes = 0;
       std::vector<std::string> why;
-      double total() const { return file + std::min(nodes, 1.5); }
+      double total() const { return file + std::min(nodes, 1.0); }
     };
     std::map<int, Vote> votes;
     auto vote = [&](const std::string& name, double weight, double Vote::*slot, const char* what) {

@@ -142,6 +142,22 @@ TEST(ToolEval, ReproducesAHandComputedMeanIoU) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json refined = nlohmann::json::parse(test::read_file(assets + "/refined.json"));
   EXPECT_EQ(refined["total_3d"], j["total_3d"]);
+
+  // Identified as a run identifies it: the file's name, read before the names
+  // are removed, makes the object a box; its kind's materials weigh only what
+  // the image decides, and the oracle's labels are not the image's: the same
+  // scores, with the kind recorded.
+  r = run_tool("eval seg --assets " + quote(assets) +
+               " --views 3 --resolution 40 --segmenter oracle --set labels=" + quote(assets + "/predicted.json") +
+               " --set key=Boxes --anonymize-names --identifier auto --object-from-names --json " +
+               quote(assets + "/identified.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json identified = nlohmann::json::parse(test::read_file(assets + "/identified.json"));
+  EXPECT_EQ(identified["models"]["Boxes"]["kind"], "box") << identified["models"]["Boxes"].dump();
+  EXPECT_EQ(identified["models"]["Boxes"]["kind_prior_applied"], true);
+  EXPECT_EQ(identified["total_3d"], j["total_3d"]);
+  EXPECT_EQ(run_tool("eval seg --assets " + quote(assets) + " --identifier none --object-from-names").exit_code, 2);
+  EXPECT_EQ(run_tool("eval seg --assets " + quote(assets) + " --kind-prior 0").exit_code, 2);
   EXPECT_EQ(run_tool("eval seg --assets " + quote(assets) + " --refiner magic").exit_code, 2);
   EXPECT_EQ(run_tool("eval seg --assets " + quote(assets) + " --refine-set lambda=2").exit_code, 2);
 }

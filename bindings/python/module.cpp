@@ -114,6 +114,8 @@ std::vector<int> int_vector_from_numpy(const py::handle& object, const std::stri
   return std::vector<int>(array.data(), array.data() + array.size());
 }
 
+void bind_eval(py::module_& m);  // eval.cpp: ConfusionMatrix, evaluate_segmentation, mass errors
+
 }  // namespace g2p::python
 
 PYBIND11_MODULE(g2p, m) {
@@ -144,6 +146,7 @@ PYBIND11_MODULE(g2p, m) {
   bind_decompose(m);
   bind_pipeline(m);
   bind_batch(m);
+  bind_eval(m);
 
 #if defined(G2P_PYTHON_WITH_CGAL)
   // The GPL component is linked into this module: its completers ("alpha-wrap",

@@ -498,15 +498,30 @@ void bind_pipeline(py::module_& m) {
                 p, [&](RunContext* ctx) { return p.pipeline.run_file(path, ctx); }, progress, context);
           },
           py::arg("path"), py::arg("progress") = py::none(), py::arg("context") = py::none(),
-          "Loads the file with options.import_options, then runs.");
+          "Loads the file with options.import_options, then runs.")
+      .def(
+          "resume",
+          [](PyPipeline& p, const std::string& folder, Stage first, Stage last, const py::object& progress,
+             const py::object& context) {
+            return run_pipeline(
+                p, [&](RunContext* ctx) { return p.pipeline.resume(folder, first, last, ctx); }, progress, context);
+          },
+          py::arg("folder"), py::arg("first"), py::arg("last") = Stage::kExport, py::arg("progress") = py::none(),
+          py::arg("context") = py::none(),
+          "Reads an output folder (write_output's) and runs the stages from first to last on it, as g2p refine, "
+          "complete, properties and export do; the result holds the folder's earlier stages.");
 
   m.def(
       "write_output",
       [](const std::string& dir, const PyPipelineResult& result, const PipelineOptions* options, bool overwrite,
          bool intermediates) {
         const PipelineOptions& o = options_or(result, options);
+        OutputOptions output;
+        output.written_by = "g2p (Python)";
+        output.overwrite = overwrite;
+        output.intermediates = intermediates;
         py::gil_scoped_release release;
-        throw_if_error(write_pipeline_output(dir, result, o, OutputOptions{overwrite, intermediates}));
+        throw_if_error(write_pipeline_output(dir, result, o, output));
       },
       py::arg("dir"), py::arg("result"), py::arg("options") = static_cast<const PipelineOptions*>(nullptr),
       py::arg("overwrite") = false, py::arg("intermediates") = false,

@@ -147,6 +147,23 @@ TEST(Pipeline, AThrowingProgressCallbackCancelsWithoutAnException) {
   EXPECT_NE(r.status().message().find("the UI went away"), std::string::npos) << r.status().message();
 }
 
+TEST(Pipeline, CompletionReportsProgressInsideTheStageAndCanBeStoppedThere) {
+  RunContext* self = nullptr;
+  std::vector<Progress> inside;
+  RunContext context([&](const Progress& p) {
+    if (p.stage == Stage::kComplete && p.stage_fraction > 0.0 && p.stage_fraction < 1.0) {
+      inside.push_back(p);
+      self->cancel();  // a user's Cancel button in the middle of closing the parts
+    }
+  });
+  self = &context;
+  Result<PipelineResult> r = Pipeline(quick_options()).run_file(hammer(), &context);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled) << r.status().to_string();
+  ASSERT_EQ(inside.size(), 1u);  // stopped at the first check after the button
+  EXPECT_EQ(inside.front().message, "distances");
+}
+
 TEST(Pipeline, StopsAfterTheLastStageAskedFor) {
   PipelineOptions o = quick_options();
   o.last_stage = Stage::kRefine;
@@ -155,7 +172,19 @@ TEST(Pipeline, StopsAfterTheLastStageAskedFor) {
   EXPECT_EQ(r->stages.back().stage, Stage::kRefine);
   EXPECT_EQ(r->projection.parts.size(), 2u);
   EXPECT_TRUE(r->completion.parts.empty());
-  EXPECT_FALSE(write_pipeline_output(test::scratch_dir("PipelineStops") + "/out", *r, o).ok());
+  EXPECT_EQ(r->last_stage, Stage::kRefine);
+  // A result that stopped early is written as far as it went (g2p project's folder), and no further.
+  const std::string dir = test::scratch_dir("PipelineStops");
+  ASSERT_TRUE(write_pipeline_output(dir + "/out", *r, o).ok());
+  EXPECT_TRUE(fs::exists(dir + "/out/faces.csv"));
+  EXPECT_FALSE(fs::exists(dir + "/out/report.json"));
+  EXPECT_NE(test::read_file(dir + "/out/manifest.json").find("\"stage\": \"refine\""), std::string::npos);
+  // One that stopped before the labels were on the faces has nothing to write.
+  o.last_stage = Stage::kSegment;
+  Result<PipelineResult> segmented = Pipeline(o).run_file(hammer());
+  ASSERT_TRUE(segmented.ok());
+  EXPECT_FALSE(write_pipeline_output(dir + "/segmented", *segmented, o).ok());
+  EXPECT_FALSE(fs::exists(dir + "/segmented"));
 }
 
 // A user's segmenter: every surface pixel is plastic.
@@ -267,26 +296,11 @@ TEST(PipelineOutput, WritesEverythingAtOnceAndNeverHalfway) {
   OutputOptions out;
   out.intermediates = true;
   ASSERT_TRUE(write_pipeline_output(dir, *r, pipeline.options(), out).ok());
-  for (const char* f : {"faces.csv",
-                        "labelled.ply",
-                        "parts.json",
-                        "refine.json",
-                        "report.json",
-                        "run.json",
-                        "summary.html",
-                        "project.json",
-                        "properties.json",
-                        "hammer.xml",
-                        "hammer.urdf",
-                        "hammer.sdf",
-                        "hammer.glb",
-                        "views/contact_sheet.png",
-                        "segmented/contact_sheet.png",
-                        "projected/contact_sheet.png",
-                        "completed/completion.json",
-                        "intermediates/votes.csv",
-                        "views/view_00_depth.npy",
-                        "segmented/view_00_probs.npy"})
+  for (const char* f :
+       {"faces.csv", "labelled.ply", "parts.json", "refine.json", "report.json", "run.json", "summary.html",
+        "manifest.json", "hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb", "views/contact_sheet.png",
+        "segmented/contact_sheet.png", "projected/contact_sheet.png", "completed/completion.json",
+        "intermediates/votes.csv", "views/view_00_depth.npy", "segmented/view_00_probs.npy"})
     EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/intermediates/patches"), fs::directory_iterator{}), 2);
 

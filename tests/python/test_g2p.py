@@ -209,6 +209,19 @@ class HammerPipelineTest(unittest.TestCase):
             self.assertTrue(os.path.isfile(os.path.join(out, "hammer.xml")))
             self.assertFalse(os.path.exists(os.path.join(out, "hammer.urdf")))
 
+    def test_resume_a_folder_gives_what_the_run_gave(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "hammer_out")
+            g2p.write_output(out, self.result)
+            # From the folder's labels: complete, properties, decompose and export again.
+            resumed = g2p.Pipeline(quick_options()).resume(out, g2p.Stage.COMPLETE, g2p.Stage.EXPORT)
+            self.assertEqual([s["stage"] for s in resumed.stages],
+                             ["complete", "properties", "decompose", "export"])
+            self.assertEqual(resumed.mass_kg, self.result.mass_kg)
+            self.assertEqual(resumed.kind, "hammer")
+            with self.assertRaisesRegex(g2p.Error, "manifest.json"):
+                g2p.Pipeline(quick_options()).resume(tmp, g2p.Stage.COMPLETE)
+
 
 class PythonBackendsTest(unittest.TestCase):
     def test_python_segmenter_runs_inside_the_pipeline(self):

@@ -26,7 +26,7 @@ TEST(ToolComplete, FromAProjectFolder) {
   ASSERT_EQ(p.exit_code, 0) << p.err;
   ToolRun r = run_tool("complete " + quote(dir + "/p") + " --format obj,stl");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("completed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("closed"), std::string::npos) << r.out;
   const nlohmann::json j = read_json(dir + "/p/completed/completion.json");
   ASSERT_GE(j["parts"].size(), 1u);
   for (const auto& part : j["parts"]) {
@@ -45,7 +45,7 @@ TEST(ToolComplete, FromAModelWithGroundTruth) {
   ToolRun r =
       run_tool("complete " + quote(hammer) + " --truth " + quote(dir + "/labels.json") + " -o " + quote(dir + "/out"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  const nlohmann::json j = read_json(dir + "/out/completion.json");
+  const nlohmann::json j = read_json(dir + "/out/completed/completion.json");
   ASSERT_EQ(j["parts"].size(), 2u);
   std::vector<std::string> labels;
   for (const auto& part : j["parts"]) labels.push_back(part["label"]);
@@ -57,7 +57,7 @@ TEST(ToolComplete, FromAModelWithGroundTruth) {
     io.z_up = false;
     io.unit_scale = 1.0;
     io.up_axis = UpAxis::kZ;
-    Result<Model> m = load_model(dir + "/out/" + part["files"]["obj"].get<std::string>(), io);
+    Result<Model> m = load_model(dir + "/out/completed/" + part["files"]["obj"].get<std::string>(), io);
     ASSERT_TRUE(m.ok()) << m.status().to_string();
     const MassProperties mp = *solid_mass_properties(m->mesh, 1.0);
     EXPECT_NEAR(mp.volume_m3, part["checks"]["volume_m3"].get<double>(), 1e-6 * mp.volume_m3 + 1e-12);
@@ -70,7 +70,7 @@ TEST(ToolComplete, BadInputFailsWithAMessage) {
   const std::string dir = test::scratch_dir("ToolCompleteBad");
   ToolRun r = run_tool("complete " + quote(dir));  // an empty folder
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("project.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
   const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
   r = run_tool("complete " + hammer + " -o " + quote(dir + "/out"));
   EXPECT_EQ(r.exit_code, 2);

@@ -51,8 +51,10 @@ TEST(ToolExport, StartsFromAPropertiesOutput) {
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   r = run_tool("export " + quote(dir + "/props") + " --format mjcf,urdf,sdf,glb -o " + quote(dir + "/assets"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("using the closed parts and properties of"), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("completed "), std::string::npos) << "stage 5 ran again: " << r.out;
+  // The folder's closed parts and properties are used as they are: only decompose and export run.
+  EXPECT_NE(r.out.find("decompose "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("complete "), std::string::npos) << "stage 5 ran again: " << r.out;
+  EXPECT_EQ(r.out.find("properties "), std::string::npos) << "stage 6 ran again: " << r.out;
   for (const char* f : {"hammer.xml", "hammer.urdf", "hammer.sdf", "hammer.glb"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/assets/" + f)) << f;
   const auto mass = [](const std::string& report) {

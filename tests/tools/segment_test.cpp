@@ -312,9 +312,9 @@ TEST(ToolProject, WritesFacesPartsAndRefines) {
   test::ToolRun r = run_tool("project " + hammer + " -o " + quote(out) +
                              " --views 6 --resolution 64 --refiner smooth --refine-set lambda=0.5");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("smooth: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("refine     smooth"), std::string::npos) << r.out;
   for (const char* f : {"faces.csv", "labelled.ply", "parts.json", "refine.json", "projected/view_00_labels.png",
-                        "segmented/view_00_labels_index.png", "view_00_rgb.png"})
+                        "segmented/view_00_labels_index.png", "views/view_00_rgb.png", "manifest.json"})
     EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
   const std::string csv = test::read_file(out + "/faces.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 105);  // header + 104 faces
@@ -336,8 +336,14 @@ TEST(ToolProject, WritesFacesPartsAndRefines) {
     ++checked;
   }
   EXPECT_EQ(checked, 104);
-  EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner oracle-vlm").exit_code, 2);
-  EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --refiner smooth --refine-set x").exit_code, 2);
+  EXPECT_EQ(run_tool("project " + hammer + " -o " + quote(out) + " --overwrite --refiner oracle-vlm").exit_code, 2);
+  EXPECT_EQ(
+      run_tool("project " + hammer + " -o " + quote(out) + " --overwrite --refiner smooth --refine-set x").exit_code,
+      2);
+  // An existing folder is replaced only with --overwrite.
+  r = run_tool("project " + hammer + " -o " + quote(out) + " --views 2 --resolution 64");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
 }
 
 // The label columns of a faces.csv (label onwards).
@@ -358,11 +364,11 @@ TEST(ToolRefine, RefinesAProjectFolderLikeProjectDoes) {
   const std::string flags = " --views 4 --resolution 64 --segmenter pbr --set names=off";
   ASSERT_EQ(run_tool("project " + hammer + " -o " + quote(dir + "/a") + flags).exit_code, 0);
   ASSERT_EQ(run_tool("project " + hammer + " -o " + quote(dir + "/b") + flags + " --refiner smooth").exit_code, 0);
-  test::ToolRun r = run_tool("refine " + quote(dir + "/a"));
+  test::ToolRun r = run_tool("refine " + quote(dir + "/a") + " -o " + quote(dir + "/refined"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("refined with 'smooth'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("refine     smooth"), std::string::npos) << r.out;
   // Rebuilt from the folder, the refinement equals the one done inside g2p project.
-  EXPECT_EQ(label_columns(test::read_file(dir + "/a/refined/faces.csv")),
+  EXPECT_EQ(label_columns(test::read_file(dir + "/refined/faces.csv")),
             label_columns(test::read_file(dir + "/b/faces.csv")));
   // An unreachable VLM loses nothing: the labels stand and the report says why.
   r = run_tool("refine " + quote(dir + "/a") + " -o " + quote(dir + "/vlm") +
@@ -370,13 +376,14 @@ TEST(ToolRefine, RefinesAProjectFolderLikeProjectDoes) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(label_columns(test::read_file(dir + "/vlm/faces.csv")),
             label_columns(test::read_file(dir + "/a/faces.csv")));
-  EXPECT_NE(test::read_file(dir + "/vlm/refine.json").find("labels stand"), std::string::npos);
+  EXPECT_NE(r.err.find("labels stand"), std::string::npos) << r.err;
+  EXPECT_NE(test::read_file(dir + "/vlm/refine.json").find("\"error\""), std::string::npos);
   // A vlm without a model name is a usage error.
   EXPECT_EQ(run_tool("refine " + quote(dir + "/a") + " -o " + quote(dir + "/x") + " --refiner vlm").exit_code, 2);
   // Not a project folder.
   r = run_tool("refine " + quote(dir));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("project.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -26,7 +26,8 @@ void add_project_command(CLI::App& app, Command& run);
 void add_refine_command(CLI::App& app, Command& run);
 void add_complete_command(CLI::App& app, Command& run);
 void add_properties_command(CLI::App& app, Command& run);
-void add_export_command(CLI::App& app, Command& run);    // export and validate
+void add_export_command(CLI::App& app, Command& run);  // export, and validate with it
+void add_validate_command(CLI::App& app, Command& run);
 void add_run_command(CLI::App& app, Command& run);       // the whole pipeline
 void add_batch_command(CLI::App& app, Command& run);     // many models, one process each
 void add_identify_command(CLI::App& app, Command& run);  // what the object is

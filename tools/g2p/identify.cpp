@@ -7,7 +7,7 @@
 #include "common.h"
 #include "g2p/pipeline.h"
 #include "json_out.h"
-#include "stage_inputs.h"
+#include "stage_flags.h"
 
 namespace g2p::cli {
 namespace {

@@ -12,31 +12,15 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/pipeline.h"
-#include "stage_inputs.h"
-#include "stage_outputs.h"
-#if defined(G2P_CLI_WITH_CGAL)
-#include "g2p/complete_cgal.h"
-#endif
+#include "stage_flags.h"
 
 namespace g2p::cli {
 namespace {
 
 struct RunArgs {
-  std::string model, out, materials, name, overrides;
-  ImportArgs import;
-  ViewArgs views;
-  IdentifyArgs identify;
-  SegmenterArgs segmenter;
-  RefineArgs refiner;
-  CompleterArgs completer;
-  EstimatorArgs estimator;
-  DecomposerArgs decomposer;
-  std::string vlm_url, vlm_model;
-  std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
-  bool soft = false;  // soft votes in the project stage
-  bool fixed = false, anonymize = false, base_color_only = false, overwrite = false, intermediates = false,
-       json = false, quiet = false;
-  double memory_limit_gib = 0.0;
+  std::string model, out;
+  PipelineArgs pipeline;
+  bool overwrite = false, intermediates = false, json = false, quiet = false;
 };
 
 // The run's context, reachable from the SIGINT and SIGTERM handler (cancel()
@@ -83,87 +67,23 @@ int usage(const std::string& message) {
 
 int run_pipeline(const RunArgs& args) {
   namespace fs = std::filesystem;
-#if defined(G2P_CLI_WITH_CGAL)
-  (void)register_cgal_completers();
-#endif
   if (fs::exists(args.out) && fs::is_directory(args.out) && !args.overwrite)
     return usage(args.out + " exists; choose another folder or pass --overwrite (replaced only once the run succeeds)");
   OutputOptions folder;
   folder.overwrite = args.overwrite;
   folder.input_path = args.model;
   if (Status s = check_output_folder(args.out, folder); !s.ok()) return usage("-o " + s.message());
-
-  PipelineOptions o;
-  Result<ImportOptions> import = import_options(args.import);
-  if (!import.ok()) return usage(import.status().message());
-  o.import = *import;
-  o.anonymize_names = args.anonymize;
-  o.base_color_only = args.base_color_only;
-  if (args.soft) o.project.vote.mode = VoteMode::kSoft;
-  Result<ViewOptions> views = view_options(args.views);
-  if (!views.ok()) return usage(views.status().message());
-  o.views = *views;
-  o.renderer.name = args.views.renderer;
-  struct StageFlags {
-    BackendChoice* choice;
-    const std::string* name;
-    const std::vector<std::string>* settings;
-    const char* flag;
-  };
-  const StageFlags stages[] = {{&o.identifier, &args.identify.name, &args.identify.settings, "--identify-set"},
-                               {&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
-                               {&o.refiner, &args.refiner.name, &args.refiner.settings, "--refine-set"},
-                               {&o.completer, &args.completer.name, &args.completer.settings, "--complete-set"},
-                               {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"},
-                               {&o.decomposer, &args.decomposer.name, &args.decomposer.settings, "--decompose-set"}};
-  for (const StageFlags& s : stages) {
-    Result<BackendSettings> settings = parse_settings(*s.settings);
-    if (!settings.ok()) return usage(std::string(s.flag) + ": " + settings.status().message());
-    *s.choice = BackendChoice{*s.name, *settings};
-  }
-  // --vlm-url/--vlm-model go to every stage that asks a vision-language model.
-  if (!args.vlm_url.empty() || !args.vlm_model.empty()) {
-    bool used = false;
-    for (BackendChoice* c : {&o.identifier, &o.refiner, &o.estimator}) {
-      if (c->name != "vlm") continue;
-      used = true;
-      if (!args.vlm_url.empty()) c->settings.emplace("url", args.vlm_url);
-      if (!args.vlm_model.empty()) c->settings.emplace("model", args.vlm_model);
-    }
-    if (!used) return usage("--vlm-url and --vlm-model need --identifier vlm, --refiner vlm or --estimator vlm");
-  }
-  o.object = args.identify.object;
-  Result<SizePolicy> size_policy = parse_size_policy(args.identify.size_from);
-  if (!size_policy.ok()) return usage(size_policy.status().message());
-  o.size_policy = *size_policy;
-  o.kind_confidence = args.identify.kind_confidence;
-  o.kind_prior = args.identify.kind_prior;
-  o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
-  o.decompose = args.decomposer.options;
-  if (!(args.memory_limit_gib >= 0)) return usage("--memory-limit must be 0 (the machine's memory) or more GiB");
-  o.memory_limit_bytes = static_cast<std::size_t>(args.memory_limit_gib * 1024.0 * 1024.0 * 1024.0);
-  if (Status valid = validate(o.decompose); !valid.ok()) return usage(valid.message());
-  o.formats = args.formats;
-  o.name = args.name;
-  o.export_options.free_joint = !args.fixed;
-
-  Pipeline pipeline(o);
-  if (!args.materials.empty()) {
-    Result<MaterialTable> table = MaterialTable::load(args.materials);
-    if (!table.ok()) return usage(table.status().to_string());
-    pipeline.set_material_table(std::move(*table));
-  }
-  if (!args.overrides.empty()) {
-    const MaterialTable& table = pipeline.material_table();
-    Result<Overrides> overrides = read_overrides(args.overrides, table);
-    if (!overrides.ok()) return usage("--overrides " + overrides.status().message() + "; nothing was written");
-    pipeline.options().overrides = std::move(*overrides);
-  }
-  if (Status s = pipeline.prepare(); !s.ok()) {
-    if (s.code() == StatusCode::kInvalidArgument || s.code() == StatusCode::kNotFound) return usage(s.message());
+  Result<Pipeline> made = make_pipeline(args.pipeline);
+  if (!made.ok()) {
+    const Status& s = made.status();
+    if (s.code() == StatusCode::kInvalidArgument || s.code() == StatusCode::kNotFound ||
+        s.code() == StatusCode::kParseError)
+      return usage(s.message() + (args.pipeline.overrides.empty() ? "" : "; nothing was written"));
     std::cerr << "g2p run: error: " << s.to_string() << "\n";
     return kExitFailure;
   }
+  Pipeline& pipeline = *made;
+  const PipelineOptions& o = pipeline.options();
 
   ProgressPrinter printer(args.quiet);
   RunContext context([&printer](const Progress& p) { printer(p); });
@@ -176,6 +96,7 @@ int run_pipeline(const RunArgs& args) {
     OutputOptions out;
     out.overwrite = args.overwrite;
     out.intermediates = args.intermediates;
+    out.written_by = "g2p run";
     written = write_pipeline_output(args.out, *result, o, out);
   }
   std::signal(SIGINT, previous);
@@ -195,8 +116,9 @@ int run_pipeline(const RunArgs& args) {
     const std::string& m = written.message();
     std::size_t at = m.find(": overrides entry ");
     if (at == std::string::npos) at = m.find(": overrides: ");
-    if (!args.overrides.empty() && written.code() == StatusCode::kInvalidArgument && at != std::string::npos) {
-      std::cerr << "g2p run: --overrides " << args.overrides << ": " << m.substr(at + 2) << "; nothing was written\n";
+    if (!args.pipeline.overrides.empty() && written.code() == StatusCode::kInvalidArgument && at != std::string::npos) {
+      std::cerr << "g2p run: --overrides " << args.pipeline.overrides << ": " << m.substr(at + 2)
+                << "; nothing was written\n";
       return kExitUsage;
     }
     std::cerr << "g2p run: error: " << written.to_string() << "\n";
@@ -236,39 +158,34 @@ void add_run_command(CLI::App& app, Command& run) {
       "run", "The whole pipeline: render, segment, project, refine, complete, properties and export in one call");
   cmd->add_option("model", args->model, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, ...)")->required();
   cmd->add_option("-o,--output", args->out, "Output folder (must not exist unless --overwrite)")->required();
-  cmd->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
-  cmd->add_option("--overrides", args->overrides,
-                  "Corrections to apply (JSON from summary.html's 3D view, docs/pipeline.md#overrides): classes, "
-                  "solid/hollow, wall thickness, density, contents per part or face");
-  cmd->add_option("--name", args->name, "Asset name (default: the model file's stem)");
-  cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
-  cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
-  cmd->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one first");
-  cmd->add_flag("--base-color-only", args->base_color_only,
+  PipelineArgs& p = args->pipeline;
+  cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
+  add_overrides_flag(cmd, p.overrides);
+  add_export_flags(cmd, p.export_args);
+  cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
+  cmd->add_flag("--base-color-only", p.base_color_only,
                 "Keep only base colour: metallic and roughness at glTF's default of 1, no metallic-roughness texture "
                 "or transmission (what image-to-3D generators emit; for measuring)");
-  cmd->add_flag("--soft", args->soft,
+  cmd->add_flag("--soft", p.soft,
                 "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
                 "the learned and onnx segmenters)");
-  cmd->add_option("--vlm-url", args->vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
-  cmd->add_option("--vlm-model", args->vlm_model, "Model name for the vlm refiner/estimator");
+  cmd->add_option("--vlm-url", p.vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
+  cmd->add_option("--vlm-model", p.vlm_model, "Model name for the vlm refiner/estimator");
   cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output folder (after the run succeeded)");
   cmd->add_flag("--save-intermediates", args->intermediates,
                 "Also write every view's buffers, per-view probabilities, per-face votes and part patches");
   cmd->add_flag("--json", args->json, "Print the run's summary (run.json) on stdout instead of text");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
-  cmd->add_option("--memory-limit", args->memory_limit_gib,
+  cmd->add_option("--memory-limit", p.memory_limit_gib,
                   "Refuse a run whose views and mesh would need more memory, in GiB (default 0: the machine's)");
-  add_import_flags(cmd, args->import);
-  add_view_flags(cmd, args->views);
-  add_identify_flags(cmd, args->identify);
-  add_segmenter_flags(cmd, args->segmenter);
-  add_refiner_flags(cmd, args->refiner, "smooth");
-  add_completer_flags(cmd, args->completer);
-  add_estimator_flags(cmd, args->estimator);
-  add_decomposer_flags(cmd, args->decomposer);
+  add_import_flags(cmd, p.import);
+  add_view_flags(cmd, p.views);
+  add_identify_flags(cmd, p.identify);
+  add_segmenter_flags(cmd, p.segmenter);
+  add_refiner_flags(cmd, p.refiner, "smooth");
+  add_completer_flags(cmd, p.completer);
+  add_estimator_flags(cmd, p.estimator);
+  add_decomposer_flags(cmd, p.decomposer);
   cmd->footer(
       "Exit codes: 0 success, 1 the run failed (bad input file, a stage error), 2 bad command line, 130 cancelled "
       "(Ctrl-C), 143 terminated (SIGTERM). Nothing is written unless the run succeeds.");

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,17 +17,30 @@
 #include "g2p/mesh.h"
 #include "g2p/project.h"
 #include "g2p/registry.h"
-#include "g2p/segment.h"
 #include "g2p/status.h"
 #include "g2p/visibility.h"
 
 namespace g2p {
 
 // The object and its parts; all must outlive the call.
+// Progress inside a stage, and whether to go on: `fraction` of the stage's
+// work in [0, 1], `message` in words ("distances", "part 3/12"). A status
+// other than OK (kCancelled from a RunContext) stops the work, which returns
+// it. Empty: no one is listening. The pipeline passes one that reports to
+// its RunContext.
+using StageProgress = std::function<Status(double fraction, const std::string& message)>;
+
 struct CompletionInput {
   const Mesh* mesh = nullptr;                // the whole object's surface (metres)
   const std::vector<Part>* parts = nullptr;  // from the project stage; Part::faces index mesh->triangles
   const MaterialTable* table = nullptr;      // optional: class names in messages and files
+  // Optional: checked between the steps of a backend and between parts; a
+  // status other than OK (cancellation) ends complete() with it.
+  StageProgress progress;
+
+  Status report(double fraction, const std::string& message) const {
+    return progress ? progress(fraction, message) : Status::Ok();
+  }
 };
 
 // The validation record of one closed mesh.

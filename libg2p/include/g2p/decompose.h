@@ -21,6 +21,7 @@
 
 #include "g2p/complete.h"
 #include "g2p/mesh.h"
+#include "g2p/project.h"
 #include "g2p/registry.h"
 #include "g2p/status.h"
 #include "g2p/visibility.h"

@@ -5,6 +5,9 @@
 // only). docs/formats.md shows what each file holds.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
 #include <string>
 #include <vector>
 

@@ -6,6 +6,7 @@
 #include "g2p/decompose.h"
 #include "g2p/eval.h"
 #include "g2p/export.h"
+#include "g2p/folder.h"
 #include "g2p/identify.h"
 #include "g2p/image.h"
 #include "g2p/io.h"

@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "g2p/complete.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
 #include "g2p/model.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"

@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <string>
 
+#include "g2p/image.h"
+#include "g2p/mesh.h"
 #include "g2p/model.h"
 #include "g2p/status.h"
 #include "g2p/visibility.h"

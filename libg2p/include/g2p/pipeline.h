@@ -14,10 +14,12 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "g2p/complete.h"
@@ -31,6 +33,7 @@
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/refine.h"
+#include "g2p/registry.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
@@ -65,8 +68,9 @@ struct Progress {
 
 // One object for a run's progress reports and its cooperative cancellation.
 // cancel() may be called from any thread (a UI's button, a signal handler);
-// the run checks between stages and between views, and returns // StatusCode::kCancelled at the next check, having
-// written nothing.
+// the run checks between stages, between views and inside the complete stage
+// (between its steps and parts: CompletionInput::progress), and returns
+// StatusCode::kCancelled at the next check, having written nothing.
 class G2P_API RunContext {
  public:
   using ProgressCallback = std::function<void(const Progress&)>;
@@ -221,9 +225,12 @@ struct G2P_API PipelineResult {
   std::vector<StageReport> stages;             // in run order
   std::vector<std::string> warnings;           // degraded optional stages, in words
   std::vector<std::string> overrides_applied;  // what PipelineOptions::overrides changed, one line per entry
-  Overrides overrides;             // the overrides applied, as face selections (as_face_selections; overrides.json)
-  double seconds = 0.0;            // whole run
-  std::size_t peak_rss_bytes = 0;  // largest stage peak
+  Overrides overrides;  // the overrides applied, as face selections (as_face_selections; overrides.json)
+  std::vector<std::uint8_t> image_decided;  // per face, 1 where the segmenter decided from the image alone
+  double kind_scale = 1.0;                  // the factor that gave the mesh its kind's size (size_assumed_m)
+  Stage last_stage = Stage::kLoad;          // the last stage the result holds
+  double seconds = 0.0;                     // whole run
+  std::size_t peak_rss_bytes = 0;           // largest stage peak
 
   const StageReport* stage(Stage s) const;  // null if it did not run
 };
@@ -269,6 +276,18 @@ class G2P_API Pipeline {
   // Loads the file with options().import, then runs.
   Result<PipelineResult> run_file(const std::string& path, RunContext* context = nullptr);
 
+  // Runs the stages from `first` to `last` on a state that holds everything
+  // before `first` (read_pipeline_folder, labelled_from_truth in folder.h):
+  // the same code as run(), so a folder advanced stage by stage holds what one
+  // run() to `last` holds. `first` is kRefine ... kExport; corrections
+  // (options().overrides, after the state's own PipelineResult::overrides)
+  // that change classes resume at complete at the latest, ones that change
+  // properties or what the object is at properties.
+  Result<PipelineResult> resume(PipelineResult state, Stage first, Stage last, RunContext* context = nullptr);
+  // Reads `folder` (read_pipeline_folder) and resumes it; its notes (a stage
+  // run again because the folder lacks its input) join the result's warnings.
+  Result<PipelineResult> resume(const std::string& folder, Stage first, Stage last, RunContext* context = nullptr);
+
  private:
   Result<PipelineResult> run_unguarded(Model model, RunContext* context);
   struct Impl;
@@ -278,24 +297,27 @@ class G2P_API Pipeline {
 // ---- The output folder --------------------------------------------------------
 
 struct OutputOptions {
-  bool overwrite = false;      // replace an existing folder (only once the new one is complete)
-  bool intermediates = false;  // also every view's buffers, per-view probabilities, votes and part patches
+  std::string written_by = "libg2p";  // the command or program, recorded in manifest.json
+  bool overwrite = false;             // replace an existing folder (only once the new one is complete)
+  bool intermediates = false;         // also every view's buffers, per-view probabilities, votes and part patches
+  std::vector<std::string> mesh_formats{"obj"};  // the closed parts' formats in completed/: obj, ply, stl
   // The model being run ("": not checked). An existing folder that holds it
   // is never replaced, with or without `overwrite` (write_pipeline_output
   // fills it from the result).
   std::string input_path;
 };
 
-// Writes the run into `dir`: views/ (renders, face IDs, contact sheet),
-// segmented/ and projected/ (label maps, contact sheets), faces.csv,
-// labelled.ply, parts.json, refine.json, completed/ (closed parts), the
-// simulation asset (NAME.xml, NAME.urdf, NAME.sdf, NAME.glb, meshes/),
-// report.json, run.json and summary.html (and overrides.json when the run
-// applied overrides); project.json and properties.json
-// make the folder a valid source for `g2p refine/complete/export`. Everything
-// is written to a temporary folder beside `dir` and renamed into place at the
-// end: `dir` never holds a half-written run, and an existing `dir` is only
-// replaced when options.overwrite is set.
+// Writes the run into `dir`, as far as it went (PipelineResult::last_stage,
+// project at least): manifest.json (folder.h), views/ (renders, face IDs,
+// contact sheet), segmented/ and projected/ (label maps, contact sheets),
+// faces.csv, labelled.ply, parts.json, refine.json; after complete
+// completed/ (closed parts; for a whole run only with intermediates); after
+// properties report.json; after export the simulation asset (NAME.xml,
+// NAME.urdf, NAME.sdf, NAME.glb, meshes/), run.json and summary.html; and
+// overrides.json when corrections were applied. Everything is written to a
+// temporary folder beside `dir` and renamed into place at the end: `dir` never
+// holds a half-written run or a file of an earlier one, and an existing `dir`
+// is only replaced when output.overwrite is set.
 G2P_API Status write_pipeline_output(const std::string& dir, const PipelineResult& result,
                                      const PipelineOptions& options = {}, const OutputOptions& output = {});
 

@@ -6,11 +6,13 @@
 // then split into connected same-material parts.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "g2p/materials.h"
+#include "g2p/mesh.h"
 #include "g2p/model.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
@@ -160,7 +162,7 @@ G2P_API Status write_labelled_ply(const std::string& path, const Mesh& mesh, con
 
 // The project stage's folder: DIR/faces.csv, DIR/labelled.ply, DIR/parts.json
 // and DIR/projected/ (the face labels seen through every view, the input of
-// the refine stage and of a person checking the result).
+// the refine stage and of a person checking the result; none without views).
 G2P_API Status write_projection(const std::string& dir, const Model& model, const std::vector<View>& views,
                                 const Projection& projection, const MaterialTable& table);
 

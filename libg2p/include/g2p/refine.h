@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,6 @@
 #include "g2p/project.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
-#include "g2p/segment.h"
 #include "g2p/status.h"
 #include "g2p/visibility.h"
 #include "g2p/vlm.h"

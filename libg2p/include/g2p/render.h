@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "g2p/image.h"
+#include "g2p/mesh.h"
 #include "g2p/model.h"
 #include "g2p/registry.h"
 #include "g2p/status.h"

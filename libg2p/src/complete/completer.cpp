@@ -38,6 +38,7 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
   if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
   const std::size_t np = input.parts->size();
   Result<Completion> first = completer.complete(input);
+  if (!first.ok() && first.status().code() == StatusCode::kCancelled) return first.status();
   Completion out;
   if (first.ok()) {
     out = std::move(*first);
@@ -57,6 +58,7 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
   for (const CompletedPart& p : out.parts) any_failed |= !p.ok;
   if (any_failed && fallback != nullptr) {
     Result<Completion> second = fallback->complete(input);
+    if (!second.ok() && second.status().code() == StatusCode::kCancelled) return second.status();
     if (!second.ok()) {
       out.notes.push_back("the fallback failed too: " + second.status().message());
     } else {
@@ -100,6 +102,8 @@ Result<Completion> complete_each_part(const CompletionInput& input, const std::s
       closed = Status::Internal(backend + ": failed: " + e.what());
     }
     if (!closed.ok()) out.notes.push_back(closed.message());
+    G2P_RETURN_IF_ERROR(input.report(static_cast<double>(p + 1) / static_cast<double>(input.parts->size()),
+                                     "part " + std::to_string(p + 1) + "/" + std::to_string(input.parts->size())));
     if (out.mesh.num_faces() == 0) continue;
     out.checks = check_closed_mesh(out.mesh, &patch);
     const bool near = out.checks.relative_distance <= max_relative_distance;

@@ -22,6 +22,109 @@ int find_root(std::vector<int>& parent, int x) {
   return x;
 }
 
+// Directed edges, sorted, each with its face: closed and consistently
+// oriented iff every directed edge occurs once and its reverse once.
+class DirectedEdges {
+ public:
+  explicit DirectedEdges(const Mesh& mesh) {
+    edges_.reserve(static_cast<std::size_t>(mesh.num_faces()) * 3);
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
+      for (int e = 0; e < 3; ++e) edges_.emplace_back(edge_key(t[e], t[(e + 1) % 3]), f);
+    }
+    std::sort(edges_.begin(), edges_.end());
+  }
+
+  // The face with the directed edge `key`: -1 if none, -2 if two have it.
+  int face_of(std::uint64_t key) const {
+    auto it = std::lower_bound(edges_.begin(), edges_.end(), std::make_pair(key, -1));
+    if (it == edges_.end() || it->first != key) return -1;
+    auto next = it + 1;
+    if (next != edges_.end() && next->first == key) return -2;  // the same directed edge twice
+    return it->second;
+  }
+
+  const std::vector<std::pair<std::uint64_t, int>>& edges() const { return edges_; }
+
+ private:
+  std::vector<std::pair<std::uint64_t, int>> edges_;
+};
+
+// Whether every directed edge occurs once and its reverse once; counts the
+// edge-connected pieces (over the edges that do) in `num_components`.
+bool closed_and_oriented(int nf, const DirectedEdges& edges, int& num_components) {
+  bool closed = true;
+  std::vector<int> parent(static_cast<std::size_t>(nf));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& [key, f] : edges.edges()) {
+    const int from = static_cast<int>(key >> 32), to = static_cast<int>(key & 0xffffffffu);
+    const int g = edges.face_of(edge_key(to, from));
+    if (g < 0 || edges.face_of(key) < 0) {
+      closed = false;
+      continue;
+    }
+    parent[static_cast<std::size_t>(find_root(parent, f))] = find_root(parent, g);
+  }
+  for (int f = 0; f < nf; ++f) num_components += find_root(parent, f) == f;
+  return closed;
+}
+
+// Vertex manifoldness of a closed mesh: walking across edges around each
+// vertex visits all of its triangles in one cycle.
+bool vertex_manifold(const Mesh& mesh, const DirectedEdges& edges) {
+  std::vector<int> incident(mesh.positions.size(), 0);
+  for (const auto& t : mesh.triangles)
+    for (int e = 0; e < 3; ++e) ++incident[static_cast<std::size_t>(t[e])];
+  std::vector<char> done(mesh.positions.size(), 0);
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3i& t0 = mesh.triangles[static_cast<std::size_t>(f)];
+    for (int corner = 0; corner < 3; ++corner) {
+      const int v = t0[corner];
+      if (done[static_cast<std::size_t>(v)]) continue;
+      done[static_cast<std::size_t>(v)] = 1;
+      int face = f, steps = 0;
+      do {
+        const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(face)];
+        const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        const int a = t[(k + 1) % 3];
+        face = edges.face_of(edge_key(a, v));  // the neighbour across edge (v, a)
+        ++steps;
+      } while (face >= 0 && face != f && steps <= incident[static_cast<std::size_t>(v)]);
+      if (face != f || steps != incident[static_cast<std::size_t>(v)]) return false;
+    }
+  }
+  return true;
+}
+
+// Enclosed volume (divergence theorem, about the centroid for precision).
+double enclosed_volume(const Mesh& mesh) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : mesh.positions) centre += p.cast<double>();
+  centre /= static_cast<double>(std::max<std::size_t>(1, mesh.positions.size()));
+  double six_v = 0.0;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(t[0])].cast<double>() - centre;
+    const Eigen::Vector3d b = mesh.positions[static_cast<std::size_t>(t[1])].cast<double>() - centre;
+    const Eigen::Vector3d d = mesh.positions[static_cast<std::size_t>(t[2])].cast<double>() - centre;
+    six_v += a.dot(b.cross(d));
+  }
+  return six_v / 6.0;
+}
+
+// The largest distance from a vertex of `mesh` to `patch`. Only distances
+// above the running maximum matter: each search stops at the first triangle
+// closer than that. Large meshes are sampled: at most `max_samples` vertices,
+// evenly spread over the vertex order.
+double max_distance_to_patch(const Mesh& mesh, const Mesh& patch, int max_samples) {
+  const detail::TriangleBins bins(patch);
+  double worst = 0.0;
+  const std::size_t n = mesh.positions.size();
+  const std::size_t step = std::max<std::size_t>(1, n / static_cast<std::size_t>(std::max(1, max_samples)));
+  for (std::size_t v = 0; v < n; v += step)
+    worst = std::max(worst, bins.distance(mesh.positions[v].cast<double>(), worst));
+  return worst;
+}
+
 }  // namespace
 
 bool MeshChecks::watertight() const {
@@ -34,77 +137,11 @@ MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshChec
   if (nf == 0 || !validate(mesh).ok()) return c;
   c.area_m2 = surface_area(mesh);
 
-  // Directed edges, sorted, each with its face: closed and consistently
-  // oriented iff every directed edge occurs once and its reverse once.
-  std::vector<std::pair<std::uint64_t, int>> edges;
-  edges.reserve(static_cast<std::size_t>(nf) * 3);
-  for (int f = 0; f < nf; ++f) {
-    const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
-    for (int e = 0; e < 3; ++e) edges.emplace_back(edge_key(t[e], t[(e + 1) % 3]), f);
-  }
-  std::sort(edges.begin(), edges.end());
-  auto face_of = [&](std::uint64_t key) -> int {
-    auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, -1));
-    if (it == edges.end() || it->first != key) return -1;
-    auto next = it + 1;
-    if (next != edges.end() && next->first == key) return -2;  // the same directed edge twice
-    return it->second;
-  };
-  bool closed = true;
-  std::vector<int> parent(static_cast<std::size_t>(nf));
-  std::iota(parent.begin(), parent.end(), 0);
-  for (const auto& [key, f] : edges) {
-    const int from = static_cast<int>(key >> 32), to = static_cast<int>(key & 0xffffffffu);
-    const int g = face_of(edge_key(to, from));
-    if (g < 0 || face_of(key) < 0) {
-      closed = false;
-      continue;
-    }
-    parent[static_cast<std::size_t>(find_root(parent, f))] = find_root(parent, g);
-  }
-  c.closed = closed;
-  for (int f = 0; f < nf; ++f) c.num_components += find_root(parent, f) == f;
+  const DirectedEdges edges(mesh);
+  c.closed = closed_and_oriented(nf, edges, c.num_components);
+  if (c.closed) c.manifold = vertex_manifold(mesh, edges);
 
-  // Vertex manifoldness: walking across edges around each vertex visits all of
-  // its triangles in one cycle.
-  if (closed) {
-    std::vector<int> incident(mesh.positions.size(), 0);
-    for (const auto& t : mesh.triangles)
-      for (int e = 0; e < 3; ++e) ++incident[static_cast<std::size_t>(t[e])];
-    std::vector<char> done(mesh.positions.size(), 0);
-    bool manifold = true;
-    for (int f = 0; f < nf && manifold; ++f) {
-      const Eigen::Vector3i& t0 = mesh.triangles[static_cast<std::size_t>(f)];
-      for (int corner = 0; corner < 3 && manifold; ++corner) {
-        const int v = t0[corner];
-        if (done[static_cast<std::size_t>(v)]) continue;
-        done[static_cast<std::size_t>(v)] = 1;
-        int face = f, steps = 0;
-        do {
-          const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(face)];
-          const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-          const int a = t[(k + 1) % 3];
-          face = face_of(edge_key(a, v));  // the neighbour across edge (v, a)
-          ++steps;
-        } while (face >= 0 && face != f && steps <= incident[static_cast<std::size_t>(v)]);
-        manifold = face == f && steps == incident[static_cast<std::size_t>(v)];
-      }
-    }
-    c.manifold = manifold;
-  }
-
-  // Enclosed volume (divergence theorem, about the centroid for precision).
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& p : mesh.positions) centre += p.cast<double>();
-  centre /= static_cast<double>(std::max<std::size_t>(1, mesh.positions.size()));
-  double six_v = 0.0;
-  for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(t[0])].cast<double>() - centre;
-    const Eigen::Vector3d b = mesh.positions[static_cast<std::size_t>(t[1])].cast<double>() - centre;
-    const Eigen::Vector3d d = mesh.positions[static_cast<std::size_t>(t[2])].cast<double>() - centre;
-    six_v += a.dot(b.cross(d));
-  }
-  c.volume_m3 = six_v / 6.0;
+  c.volume_m3 = enclosed_volume(mesh);
   const double diagonal = bounds(mesh).diagonal().norm();
   c.outward = c.closed && c.volume_m3 > 1e-12 * diagonal * diagonal * diagonal;
 
@@ -117,19 +154,9 @@ MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshChec
   }
 
   if (patch != nullptr && patch->num_faces() > 0) {
-    const detail::TriangleBins bins(*patch);
-    double worst = 0.0;
-    // Only distances above the running maximum matter: each search stops at
-    // the first triangle closer than that. Large meshes are sampled: at most
-    // `max_distance_samples` vertices, evenly spread over the vertex order.
-    const std::size_t n = mesh.positions.size();
-    const std::size_t step =
-        std::max<std::size_t>(1, n / static_cast<std::size_t>(std::max(1, options.max_distance_samples)));
-    for (std::size_t v = 0; v < n; v += step)
-      worst = std::max(worst, bins.distance(mesh.positions[v].cast<double>(), worst));
-    c.max_distance_m = worst;
+    c.max_distance_m = max_distance_to_patch(mesh, *patch, options.max_distance_samples);
     const double diag = bounds(*patch).diagonal().norm();
-    c.relative_distance = diag > 0 ? worst / diag : 0.0;
+    c.relative_distance = diag > 0 ? c.max_distance_m / diag : 0.0;
   }
   return c;
 }

@@ -34,9 +34,9 @@
 
 #include "complete/backends.h"
 #include "complete/geometry.h"
-#include "complete/segment_tester.h"
-#include "complete/simplify.h"
+#include "core/segment_tester.h"
 #include "core/settings.h"
+#include "core/simplify.h"
 
 namespace g2p {
 namespace {
@@ -52,6 +52,15 @@ struct Grid {
     return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * (j + static_cast<std::size_t>(ny) * k);
   }
   Eigen::Vector3d point(int i, int j, int k) const { return origin + h * Eigen::Vector3d(i, j, k); }
+  Eigen::Vector3i coords(std::size_t a) const {  // the inverse of at()
+    return Eigen::Vector3i(static_cast<int>(a % static_cast<std::size_t>(nx)),
+                           static_cast<int>((a / static_cast<std::size_t>(nx)) % static_cast<std::size_t>(ny)),
+                           static_cast<int>(a / (static_cast<std::size_t>(nx) * ny)));
+  }
+  int dim(int axis) const { return axis == 0 ? nx : axis == 1 ? ny : nz; }
+  std::size_t stride(int axis) const {  // from a point to its neighbour along `axis`
+    return axis == 0 ? 1 : axis == 1 ? static_cast<std::size_t>(nx) : static_cast<std::size_t>(nx) * ny;
+  }
 };
 
 // Squared distances along one line: d[q] = min_p (q - p)^2 + f[p] over the
@@ -213,6 +222,296 @@ double signed_volume(const Mesh& mesh) {
   return six_v / 6.0;
 }
 
+// Where a grid point lies (step 2).
+enum PointState : std::uint8_t {
+  kInside = 0,
+  kOutside = 1,
+  kSlab = 2,  // kept as a slab of an open sheet
+};
+
+// The part of every face (-1 for none); an error names a face that is out of
+// range or in two parts.
+Result<std::vector<int>> face_parts(const Mesh& mesh, const std::vector<Part>& parts) {
+  const int nf = mesh.num_faces(), np = static_cast<int>(parts.size());
+  if (nf == 0) return Status::InvalidArgument("partition: the mesh has no triangles");
+  if (np == 0) return Status::InvalidArgument("partition: no parts to complete");
+  std::vector<int> face_part(static_cast<std::size_t>(nf), -1);
+  for (int p = 0; p < np; ++p)
+    for (int f : parts[static_cast<std::size_t>(p)].faces) {
+      if (f < 0 || f >= nf)
+        return Status::InvalidArgument("partition: part " + std::to_string(p) + " lists face " + std::to_string(f) +
+                                       ", but the mesh has " + std::to_string(nf));
+      int& fp = face_part[static_cast<std::size_t>(f)];
+      if (fp >= 0 && fp != p)
+        return Status::InvalidArgument("partition: face " + std::to_string(f) + " is in parts " + std::to_string(fp) +
+                                       " and " + std::to_string(p));
+      fp = p;
+    }
+  return face_part;
+}
+
+// The grid the object is closed on.
+struct GridChoice {
+  Grid grid;
+  // The cell size every step measures in, metres. It is grid.h except when
+  // max_cells could not be met in 64 attempts: then grid.h (and the point
+  // counts) are the last attempt's and this the next, larger one.
+  double h = 1.0;
+  int thin_part = -1;  // the part that refined the grid, -1 if none did
+};
+
+std::string grid_note(const GridChoice& choice) {
+  const Grid& g = choice.grid;
+  std::ostringstream note;
+  note.precision(3);
+  note << "grid " << g.nx << "x" << g.ny << "x" << g.nz << " points, cell " << choice.h * 1000 << " mm";
+  if (choice.thin_part >= 0) note << " (refined for thin part " << choice.thin_part << ")";
+  return note.str();
+}
+
+// Exact distances near the surface: for every triangle, the grid
+// points in its bounding box grown by one cell get the exact distance to it;
+// each point within one cell keeps the nearest.
+struct SurfaceBand {
+  std::vector<float> dist2;  // squared distance, cells^2; infinity farther than a cell
+  std::vector<int> nearest;  // the nearest triangle; -1 farther than a cell
+};
+
+SurfaceBand exact_distances_near_surface(const Mesh& mesh, const Grid& g, double h) {
+  const std::size_t n = g.size();
+  // Squared distance (its float bits, which order like the floats) over the
+  // triangle, so one atomic minimum keeps both and ties go to the lower index.
+  std::vector<std::uint64_t> best(n, ~std::uint64_t{0});
+  tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_faces(), 2048), [&](const tbb::blocked_range<int>& r) {
+    for (int t = r.begin(); t != r.end(); ++t) {
+      const Eigen::Vector3i& tri = mesh.triangles[static_cast<std::size_t>(t)];
+      const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(tri[0])].cast<double>();
+      const Eigen::Vector3d b = mesh.positions[static_cast<std::size_t>(tri[1])].cast<double>();
+      const Eigen::Vector3d c = mesh.positions[static_cast<std::size_t>(tri[2])].cast<double>();
+      const Eigen::Vector3d lo = (a.cwiseMin(b).cwiseMin(c) - g.origin) / h - Eigen::Vector3d::Ones();
+      const Eigen::Vector3d hi = (a.cwiseMax(b).cwiseMax(c) - g.origin) / h + Eigen::Vector3d::Ones();
+      const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x()))),
+                i1 = std::min(g.nx - 1, static_cast<int>(hi.x()));
+      const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y()))),
+                j1 = std::min(g.ny - 1, static_cast<int>(hi.y()));
+      const int k0 = std::max(0, static_cast<int>(std::ceil(lo.z()))),
+                k1 = std::min(g.nz - 1, static_cast<int>(hi.z()));
+      for (int k = k0; k <= k1; ++k)
+        for (int j = j0; j <= j1; ++j)
+          for (int i = i0; i <= i1; ++i) {
+            const Eigen::Vector3d p = g.point(i, j, k);
+            const float d2 =
+                static_cast<float>((detail::closest_point_on_triangle(p, a, b, c) - p).squaredNorm() / (h * h));
+            if (d2 > 1.0f) continue;
+            std::uint32_t bits;
+            std::memcpy(&bits, &d2, sizeof bits);
+            atomic_min(&best[g.at(i, j, k)], (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(t));
+          }
+    }
+  });
+  SurfaceBand band{std::vector<float>(n, kInf), std::vector<int>(n, -1)};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (best[i] == ~std::uint64_t{0}) continue;
+    const auto bits = static_cast<std::uint32_t>(best[i] >> 32);
+    std::memcpy(&band.dist2[i], &bits, sizeof bits);
+    band.nearest[i] = static_cast<int>(best[i] & 0xffffffffu);
+  }
+  return band;
+}
+
+// The flood of the closing: 0 at every point reached from the grid's border through
+// points whose squared distance `dist2` exceeds `core_d2`, infinity elsewhere.
+std::vector<float> flood_from_border(const Grid& g, const std::vector<float>& dist2, float core_d2) {
+  std::vector<float> to_core(g.size(), kInf);
+  std::vector<std::size_t> queue;
+  auto push = [&](std::size_t i) {
+    if (to_core[i] == 0.0f || !(dist2[i] > core_d2)) return;
+    to_core[i] = 0.0f;
+    queue.push_back(i);
+  };
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i)
+        if (i == 0 || j == 0 || k == 0 || i == g.nx - 1 || j == g.ny - 1 || k == g.nz - 1) push(g.at(i, j, k));
+  const std::size_t sx = 1, sy = static_cast<std::size_t>(g.nx), sz = sy * g.ny;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t i = queue[head];
+    const std::size_t x = i % sy, y = (i / sy) % static_cast<std::size_t>(g.ny), z = i / sz;
+    if (x > 0) push(i - sx);
+    if (x + 1 < sy) push(i + sx);
+    if (y > 0) push(i - sy);
+    if (y + 1 < static_cast<std::size_t>(g.ny)) push(i + sy);
+    if (z > 0) push(i - sz);
+    if (z + 1 < static_cast<std::size_t>(g.nz)) push(i + sz);
+  }
+  return to_core;
+}
+
+// Inside and outside by closing: the outside flooded from the border
+// through points farther than `gap` cells from the surface, then grown back by
+// `gap` cells (a morphological closing with a ball). `dist2` is the squared
+// distance to the surface everywhere, cells^2. Every point is kInside or kOutside.
+std::vector<std::uint8_t> inside_outside_by_closing(const Grid& g, const std::vector<float>& dist2, int gap) {
+  const float core_d2 = static_cast<float>(gap) * gap;
+  std::vector<float> to_core = flood_from_border(g, dist2, core_d2);
+  distance_transform(g, to_core, nullptr);  // grow the flooded core back by `gap` cells
+  std::vector<std::uint8_t> state(g.size(), kInside);
+  for (std::size_t i = 0; i < state.size(); ++i) state[i] = to_core[i] <= core_d2 + 1e-3f ? kOutside : kInside;
+  return state;
+}
+
+// The grid points within one cell of the surface, in index order.
+std::vector<std::size_t> near_surface_points(const std::vector<int>& nearest) {
+  std::vector<std::size_t> near_surface;
+  for (std::size_t i = 0; i < nearest.size(); ++i)
+    if (nearest[i] >= 0) near_surface.push_back(i);
+  return near_surface;
+}
+
+// Near-surface correction: the closing leaves a thin layer of outside
+// points next to the surface marked inside where its ball, centred on grid
+// points, cannot reach (up to about half a cell on curved or slanted faces). A
+// point within a cell of the surface that sees an outside neighbour without
+// crossing the surface is outside too; two rounds, so the fix stays next to
+// where the closing decided and cannot leak through the gaps it sealed.
+void correct_near_surface(const Grid& g, double h, const detail::SegmentTester& segments,
+                          const std::vector<std::size_t>& near_surface, std::vector<std::uint8_t>& state) {
+  for (int round = 0; round < 2; ++round) {
+    std::vector<std::uint8_t> flip(near_surface.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, near_surface.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t x = r.begin(); x != r.end(); ++x) {
+                          const std::size_t a = near_surface[x];
+                          if (state[a] != kInside) continue;
+                          const Eigen::Vector3i c = g.coords(a);
+                          const Eigen::Vector3d pa = g.point(c.x(), c.y(), c.z());
+                          for (int axis = 0; axis < 3 && !flip[x]; ++axis)
+                            for (int side : {-1, 1}) {
+                              if (c[axis] + side < 0 || c[axis] + side >= g.dim(axis)) continue;
+                              const std::size_t b = side > 0 ? a + g.stride(axis) : a - g.stride(axis);
+                              if (state[b] != kOutside) continue;
+                              if (!segments.crosses(pa, pa + side * h * Eigen::Vector3d::Unit(axis))) {
+                                flip[x] = 1;
+                                break;
+                              }
+                            }
+                        }
+                      });
+    for (std::size_t x = 0; x < near_surface.size(); ++x)
+      if (flip[x]) state[near_surface[x]] = kOutside;
+  }
+}
+
+// Open sheets: the closing cannot see a sheet with outside on both
+// sides (a grid edge crosses the surface but both its ends are outside); the
+// nearer end of each such edge is kept as a slab. Returns how many points.
+int keep_open_sheets(const Grid& g, double h, const detail::SegmentTester& segments,
+                     const std::vector<std::size_t>& near_surface, const std::vector<float>& dist2,
+                     const std::vector<int>& nearest, std::vector<std::uint8_t>& state) {
+  int sheet_points = 0;
+  for (std::size_t a : near_surface) {
+    if (state[a] == kInside) continue;
+    const Eigen::Vector3i c = g.coords(a);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (c[axis] + 1 >= g.dim(axis)) continue;
+      const std::size_t b = a + g.stride(axis);
+      if (state[b] == kInside || nearest[b] < 0) continue;
+      const Eigen::Vector3d pa = g.point(c.x(), c.y(), c.z());
+      if (!segments.crosses(pa, pa + h * Eigen::Vector3d::Unit(axis))) continue;
+      const std::size_t keep = dist2[a] <= dist2[b] ? a : b;
+      if (state[keep] != kSlab) ++sheet_points;
+      state[keep] = kSlab;
+    }
+  }
+  return sheet_points;
+}
+
+// Interior labels from the skin: the interior goes to the part of the
+// nearest surface on the object's skin, the grid points within a cell of the
+// surface where inside meets outside. Surfaces with inside on both sides (the
+// coincident faces of two touching boxes, hidden inner walls) do not claim
+// volume. Returns every grid point's part (-1 for none).
+std::vector<int> interior_labels_from_skin(const Grid& g, const std::vector<std::uint8_t>& state,
+                                           const SurfaceBand& band, const std::vector<int>& face_part) {
+  std::vector<float> seed(g.size(), kInf);
+  std::vector<int> label(g.size(), -1);
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::size_t a = g.at(i, j, k);
+        if (band.nearest[a] < 0) continue;
+        const int coord[3] = {i, j, k};
+        const bool out_a = state[a] == kOutside;
+        bool skin = false;
+        for (int axis = 0; axis < 3 && !skin; ++axis) {
+          if (coord[axis] > 0) skin |= (state[a - g.stride(axis)] == kOutside) != out_a;
+          if (coord[axis] + 1 < g.dim(axis)) skin |= (state[a + g.stride(axis)] == kOutside) != out_a;
+        }
+        if (!skin) continue;
+        seed[a] = band.dist2[a];
+        label[a] = face_part[static_cast<std::size_t>(band.nearest[a])];
+      }
+  distance_transform(g, seed, &label);
+  return label;
+}
+
+// The object's signed field in cells, positive outside, negative
+// inside, -0.25 at slab points; never exactly zero so no vertex sits on a grid point.
+std::vector<float> signed_field(const std::vector<float>& dist2, const std::vector<std::uint8_t>& state) {
+  constexpr float kMinMagnitude = 0.02f;
+  std::vector<float> field(dist2.size());
+  for (std::size_t i = 0; i < field.size(); ++i) {
+    const float d = std::max(std::sqrt(dist2[i]), kMinMagnitude);
+    field[i] = state[i] == kOutside ? d : state[i] == kSlab ? -0.25f : -d;
+  }
+  return field;
+}
+
+// The box of inside grid points each part owns; hi.x() < 0 for a part that
+// owns none (smaller than a cell).
+struct PartBoxes {
+  std::vector<Eigen::Vector3i> lo, hi;
+};
+
+PartBoxes part_boxes(const Grid& g, const std::vector<float>& field, const std::vector<int>& label, int np) {
+  PartBoxes boxes{std::vector<Eigen::Vector3i>(static_cast<std::size_t>(np),
+                                               Eigen::Vector3i::Constant(std::numeric_limits<int>::max())),
+                  std::vector<Eigen::Vector3i>(static_cast<std::size_t>(np), Eigen::Vector3i::Constant(-1))};
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::size_t x = g.at(i, j, k);
+        const int p = label[x];
+        if (field[x] >= 0 || p < 0) continue;
+        auto& lo = boxes.lo[static_cast<std::size_t>(p)];
+        auto& hi = boxes.hi[static_cast<std::size_t>(p)];
+        lo = lo.cwiseMin(Eigen::Vector3i(i, j, k));
+        hi = hi.cwiseMax(Eigen::Vector3i(i, j, k));
+      }
+  return boxes;
+}
+
+// Part p's surface: the object's field cut by the part's region, extracted
+// within the part's box grown by a point.
+Mesh part_surface(const Grid& g, const std::vector<float>& field, const std::vector<int>& label, const PartBoxes& boxes,
+                  int p) {
+  const Eigen::Vector3i all_hi(g.nx - 1, g.ny - 1, g.nz - 1);
+  const Eigen::Vector3i lo = (boxes.lo[static_cast<std::size_t>(p)] - Eigen::Vector3i::Ones()).cwiseMax(0);
+  const Eigen::Vector3i hi = (boxes.hi[static_cast<std::size_t>(p)] + Eigen::Vector3i::Ones()).cwiseMin(all_hi);
+  return extract_surface(g, lo, hi, [&](std::size_t i) {
+    const float f = field[i];
+    if (f >= 0) return f;
+    return std::max(f, label[i] == p ? -0.5f : 0.5f);
+  });
+}
+
+// A patch as a part of its own: every face of `patch`, with `part`'s label and area.
+Part whole_patch_part(const Mesh& patch, const Part& part) {
+  std::vector<int> faces(static_cast<std::size_t>(patch.num_faces()));
+  for (int i = 0; i < patch.num_faces(); ++i) faces[static_cast<std::size_t>(i)] = i;
+  return Part{part.label, std::move(faces), part.area_m2};
+}
+
 class PartitionCompleter final : public Completer {
  public:
   Status configure(const BackendSettings& settings) override {
@@ -252,6 +551,11 @@ class PartitionCompleter final : public Completer {
   Result<Completion> complete(const CompletionInput& input) const override;
 
  private:
+  Result<GridChoice> size_grid(const Mesh& mesh, const std::vector<Part>& parts) const;
+  double thin_part_cell_size(const Mesh& mesh, const std::vector<Part>& parts, double h, int& thin_part) const;
+  bool simplify_part(CompletedPart& out, const Mesh& patch, double h) const;
+  void close_small_parts(const CompletionInput& input, const PartBoxes& boxes, Completion& result) const;
+
   double resolution_ = 160;                 // cells along the object's longest side
   double max_resolution_ = 256;             // the finest grid thin parts may ask for (cells along the longest side)
   double refine_min_area_fraction_ = 0.01;  // parts with less of the total area do not refine the grid
@@ -277,35 +581,119 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
   const Mesh& mesh = *input.mesh;
   const std::vector<Part>& parts = *input.parts;
   G2P_RETURN_IF_ERROR(validate(mesh));
-  const int nf = mesh.num_faces(), np = static_cast<int>(parts.size());
-  if (nf == 0) return Status::InvalidArgument("partition: the mesh has no triangles");
-  if (np == 0) return Status::InvalidArgument("partition: no parts to complete");
+  Result<std::vector<int>> face_part = face_parts(mesh, parts);
+  if (!face_part.ok()) return face_part.status();
+  Result<GridChoice> choice = size_grid(mesh, parts);
+  if (!choice.ok()) return choice.status();
+  const Grid& g = choice->grid;
+  const double h = choice->h;
+  Completion result;
+  result.notes.push_back(grid_note(*choice));
+  result.grid_spacing_m = h;
 
-  std::vector<int> face_part(static_cast<std::size_t>(nf), -1);
-  for (int p = 0; p < np; ++p)
-    for (int f : parts[static_cast<std::size_t>(p)].faces) {
-      if (f < 0 || f >= nf)
-        return Status::InvalidArgument("partition: part " + std::to_string(p) + " lists face " + std::to_string(f) +
-                                       ", but the mesh has " + std::to_string(nf));
-      int& fp = face_part[static_cast<std::size_t>(f)];
-      if (fp >= 0 && fp != p)
-        return Status::InvalidArgument("partition: face " + std::to_string(f) + " is in parts " + std::to_string(fp) +
-                                       " and " + std::to_string(p));
-      fp = p;
-    }
+  const auto t0 = std::chrono::steady_clock::now();
+  auto lap = [last = t0]() mutable {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last).count();
+    last = now;
+    return static_cast<long>(ms);
+  };
+  std::ostringstream timing;
+  // ---- 1. Distances ----------------------------------------------------------
+  SurfaceBand band = exact_distances_near_surface(mesh, g, h);  // for the labels below
+  timing << "distances " << lap() << " ms";
+  G2P_RETURN_IF_ERROR(input.report(0.15, "distances"));
+  std::vector<float> dist2 = band.dist2;  // cells^2, everywhere once transformed
+  distance_transform(g, dist2, nullptr);
+  timing << ", transform " << lap() << " ms";
+  G2P_RETURN_IF_ERROR(input.report(0.3, "distance transform"));
 
-  // ---- Grid -----------------------------------------------------------------
+  // ---- 2. Inside and outside ---------------------------------------------------
+  std::vector<std::uint8_t> state = inside_outside_by_closing(g, dist2, gap_);
+  timing << ", closing " << lap() << " ms";
+  G2P_RETURN_IF_ERROR(input.report(0.45, "inside and outside"));
+  Result<std::unique_ptr<detail::SegmentTester>> tester = detail::SegmentTester::create(mesh);
+  if (!tester.ok()) return tester.status();
+  const std::vector<std::size_t> near_surface = near_surface_points(band.nearest);
+  correct_near_surface(g, h, **tester, near_surface, state);
+  const int sheet_points = keep_open_sheets(g, h, **tester, near_surface, dist2, band.nearest, state);
+  if (sheet_points > 0)
+    result.notes.push_back(std::to_string(sheet_points) +
+                           " grid points kept as slabs of open sheets (surfaces with outside on both sides)");
+  timing << ", surface layer " << lap() << " ms";
+  G2P_RETURN_IF_ERROR(input.report(0.6, "surface layer"));
+  const std::vector<int> label = interior_labels_from_skin(g, state, band, *face_part);
+  timing << ", labels " << lap() << " ms";
+  G2P_RETURN_IF_ERROR(input.report(0.7, "interior labels"));
+  const std::vector<float> field = signed_field(dist2, state);
+  dist2 = {};
+  band = {};
+
+  // ---- 3. Surfaces -------------------------------------------------------------
+  const Mesh object = extract_surface(g, Eigen::Vector3i::Zero(), Eigen::Vector3i(g.nx - 1, g.ny - 1, g.nz - 1),
+                                      [&](std::size_t i) { return field[i]; });
+  result.object_volume_m3 = signed_volume(object);
+  timing << ", object surface " << lap() << " ms";
+  G2P_RETURN_IF_ERROR(input.report(0.8, "object surface"));
+  const int np = static_cast<int>(parts.size());
+  const PartBoxes boxes = part_boxes(g, field, label, np);
+  result.parts.resize(static_cast<std::size_t>(np));
+  tbb::parallel_for(0, np, [&](int p) {
+    CompletedPart& out = result.parts[static_cast<std::size_t>(p)];
+    out.part = p;
+    out.label = parts[static_cast<std::size_t>(p)].label;
+    out.backend = "partition";
+    if (boxes.hi[static_cast<std::size_t>(p)].x() < 0) return;  // smaller than a cell: closed on its own below
+    out.mesh = part_surface(g, field, label, boxes, p);
+    const Mesh patch = part_patch(mesh, parts[static_cast<std::size_t>(p)]);
+    if (!simplify_part(out, patch, h)) out.checks = check_closed_mesh(out.mesh, &patch);
+    out.ok = out.checks.watertight() && out.checks.relative_distance <= max_relative_distance_;
+    if (!out.ok) out.notes.push_back("partition: the closed surface failed its checks");
+  });
+  timing << ", parts and checks " << lap() << " ms";
+  if (!nested_) close_small_parts(input, boxes, result);
+  result.notes.push_back(timing.str());
+  for (const CompletedPart& p : result.parts) result.parts_volume_m3 += p.checks.volume_m3;
+  return result;
+}
+
+// The grid: the cell size from the object's longest side, finer for a
+// thin, stick-like part (fragments such as screws and labels do not set the
+// resolution), padded by `gap` + 2 cells and coarsened until it has at most
+// max_cells points.
+Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::vector<Part>& parts) const {
   Eigen::AlignedBox3d box;
   for (const auto& p : mesh.positions) box.extend(p.cast<double>());
   const Eigen::Vector3d ext = box.sizes();
   const double longest = ext.maxCoeff();
   if (!(longest > 0)) return Status::InvalidArgument("partition: the mesh has no extent");
-  Completion result;
-  double h = longest / resolution_;
-  int thin_part = -1;
+  GridChoice choice;
+  double h =
+      std::max(thin_part_cell_size(mesh, parts, longest / resolution_, choice.thin_part), longest / max_resolution_);
+  const int pad = gap_ + 2;
+  Grid& g = choice.grid;
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    g.h = h;
+    g.nx = static_cast<int>(std::floor(ext.x() / h)) + 2 + 2 * pad;
+    g.ny = static_cast<int>(std::floor(ext.y() / h)) + 2 + 2 * pad;
+    g.nz = static_cast<int>(std::floor(ext.z() / h)) + 2 + 2 * pad;
+    const double cells = static_cast<double>(g.nx) * g.ny * g.nz;
+    if (cells <= max_cells_) break;
+    h *= std::cbrt(cells / max_cells_) * 1.01;
+  }
+  g.origin = box.min() - pad * h * Eigen::Vector3d::Ones();
+  choice.h = h;
+  return choice;
+}
+
+// The cell size `h`, made finer where a part with at least
+// refine_min_area_fraction of the area has a second-largest extent of fewer
+// than min_cells_across cells; `thin_part` is the last part that refined it.
+double PartitionCompleter::thin_part_cell_size(const Mesh& mesh, const std::vector<Part>& parts, double h,
+                                               int& thin_part) const {
   double total_area = 0.0;
   for (const Part& p : parts) total_area += p.area_m2;
-  for (int p = 0; p < np; ++p) {
+  for (int p = 0; p < static_cast<int>(parts.size()); ++p) {
     // Fragments (screws, labels) do not set the resolution of the whole object.
     if (parts[static_cast<std::size_t>(p)].area_m2 < refine_min_area_fraction_ * total_area) continue;
     Eigen::AlignedBox3d pb;
@@ -321,323 +709,67 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
       thin_part = p;
     }
   }
-  h = std::max(h, longest / max_resolution_);
-  const int pad = gap_ + 2;
-  Grid g;
-  for (int attempt = 0; attempt < 64; ++attempt) {
-    g.h = h;
-    g.nx = static_cast<int>(std::floor(ext.x() / h)) + 2 + 2 * pad;
-    g.ny = static_cast<int>(std::floor(ext.y() / h)) + 2 + 2 * pad;
-    g.nz = static_cast<int>(std::floor(ext.z() / h)) + 2 + 2 * pad;
-    const double cells = static_cast<double>(g.nx) * g.ny * g.nz;
-    if (cells <= max_cells_) break;
-    h *= std::cbrt(cells / max_cells_) * 1.01;
-  }
-  g.origin = box.min() - pad * h * Eigen::Vector3d::Ones();
-  const std::size_t n = g.size();
-  {
-    std::ostringstream note;
-    note.precision(3);
-    note << "grid " << g.nx << "x" << g.ny << "x" << g.nz << " points, cell " << h * 1000 << " mm";
-    if (thin_part >= 0) note << " (refined for thin part " << thin_part << ")";
-    result.notes.push_back(note.str());
-  }
-  result.grid_spacing_m = h;
+  return h;
+}
 
-  const auto t0 = std::chrono::steady_clock::now();
-  auto lap = [last = t0]() mutable {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last).count();
-    last = now;
-    return static_cast<long>(ms);
-  };
-  std::ostringstream timing;
-  // ---- 1. Distances ----------------------------------------------------------
-  std::vector<float> dist2(n, kInf);  // cells^2
-  std::vector<int> nearest(n, -1);    // triangle, within one cell of the surface
-  {
-    std::vector<std::uint64_t> best(n, ~std::uint64_t{0});
-    tbb::parallel_for(tbb::blocked_range<int>(0, nf, 2048), [&](const tbb::blocked_range<int>& r) {
-      for (int t = r.begin(); t != r.end(); ++t) {
-        const Eigen::Vector3i& tri = mesh.triangles[static_cast<std::size_t>(t)];
-        const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(tri[0])].cast<double>();
-        const Eigen::Vector3d b = mesh.positions[static_cast<std::size_t>(tri[1])].cast<double>();
-        const Eigen::Vector3d c = mesh.positions[static_cast<std::size_t>(tri[2])].cast<double>();
-        const Eigen::Vector3d lo = (a.cwiseMin(b).cwiseMin(c) - g.origin) / h - Eigen::Vector3d::Ones();
-        const Eigen::Vector3d hi = (a.cwiseMax(b).cwiseMax(c) - g.origin) / h + Eigen::Vector3d::Ones();
-        const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x()))),
-                  i1 = std::min(g.nx - 1, static_cast<int>(hi.x()));
-        const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y()))),
-                  j1 = std::min(g.ny - 1, static_cast<int>(hi.y()));
-        const int k0 = std::max(0, static_cast<int>(std::ceil(lo.z()))),
-                  k1 = std::min(g.nz - 1, static_cast<int>(hi.z()));
-        for (int k = k0; k <= k1; ++k)
-          for (int j = j0; j <= j1; ++j)
-            for (int i = i0; i <= i1; ++i) {
-              const Eigen::Vector3d p = g.point(i, j, k);
-              const float d2 =
-                  static_cast<float>((detail::closest_point_on_triangle(p, a, b, c) - p).squaredNorm() / (h * h));
-              if (d2 > 1.0f) continue;
-              std::uint32_t bits;
-              std::memcpy(&bits, &d2, sizeof bits);
-              atomic_min(&best[g.at(i, j, k)],
-                         (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(t));
-            }
-      }
-    });
-    for (std::size_t i = 0; i < n; ++i) {
-      if (best[i] == ~std::uint64_t{0}) continue;
-      const auto bits = static_cast<std::uint32_t>(best[i] >> 32);
-      std::memcpy(&dist2[i], &bits, sizeof bits);
-      nearest[i] = static_cast<int>(best[i] & 0xffffffffu);
-    }
+// Simplification: marching tetrahedra makes about six triangles per
+// surface cell; collapse those that change the surface by less than
+// `simplify` cells. Where that makes the surface touch itself (collapses along
+// flat, grid-aligned faces can put a vertex on another sheet's edge), keep the
+// dense surface. Returns true if `out` now holds the simplified surface and
+// its checks; otherwise its dense surface is kept, unchecked, and a note may
+// say why.
+bool PartitionCompleter::simplify_part(CompletedPart& out, const Mesh& patch, double h) const {
+  const double tolerance = simplify_;
+  if (!(tolerance > 0)) return false;
+  if (out.mesh.num_faces() > simplify_max_triangles_) {
+    out.notes.push_back("partition: " + std::to_string(out.mesh.num_faces()) +
+                        " triangles, more than simplify_max_triangles; not simplified");
+    return false;
   }
-  timing << "distances " << lap() << " ms";
-  const std::vector<float> band = dist2;  // exact squared distances within one cell, for the labels below
-  distance_transform(g, dist2, nullptr);
-
-  // ---- 2. Inside and outside ---------------------------------------------------
-  timing << ", transform " << lap() << " ms";
-  const float core_d2 = static_cast<float>(gap_) * gap_;
-  std::vector<float> to_core(n, kInf);
-  {
-    std::vector<std::size_t> queue;
-    auto push = [&](std::size_t i) {
-      if (to_core[i] == 0.0f || !(dist2[i] > core_d2)) return;
-      to_core[i] = 0.0f;
-      queue.push_back(i);
-    };
-    for (int k = 0; k < g.nz; ++k)
-      for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i)
-          if (i == 0 || j == 0 || k == 0 || i == g.nx - 1 || j == g.ny - 1 || k == g.nz - 1) push(g.at(i, j, k));
-    const std::size_t sx = 1, sy = static_cast<std::size_t>(g.nx), sz = sy * g.ny;
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::size_t i = queue[head];
-      const std::size_t x = i % sy, y = (i / sy) % static_cast<std::size_t>(g.ny), z = i / sz;
-      if (x > 0) push(i - sx);
-      if (x + 1 < sy) push(i + sx);
-      if (y > 0) push(i - sy);
-      if (y + 1 < static_cast<std::size_t>(g.ny)) push(i + sy);
-      if (z > 0) push(i - sz);
-      if (z + 1 < static_cast<std::size_t>(g.nz)) push(i + sz);
-    }
+  Mesh simplified = out.mesh;
+  detail::simplify_closed_mesh(simplified, tolerance * h);
+  MeshChecks checks = check_closed_mesh(simplified, &patch);
+  if (checks.watertight()) {
+    out.mesh = std::move(simplified);
+    out.checks = checks;
+    return true;
   }
-  distance_transform(g, to_core, nullptr);  // grow the flooded core back by `gap` cells
-  std::vector<std::uint8_t> state(n, 0);    // 0 inside, 1 outside, 2 kept as a slab of an open sheet
-  for (std::size_t i = 0; i < n; ++i) state[i] = to_core[i] <= core_d2 + 1e-3f ? 1 : 0;
-  to_core = {};
-  timing << ", closing " << lap() << " ms";
-  // The closing leaves a thin layer of outside points next to the surface
-  // marked inside where its ball, centred on grid points, cannot reach (up to
-  // about half a cell on curved or slanted faces). A point within a cell of
-  // the surface that sees an outside neighbour without crossing the surface
-  // is outside too; two rounds, so the fix stays next to where the closing
-  // decided and cannot leak through the gaps it sealed.
-  Result<std::unique_ptr<detail::SegmentTester>> tester = detail::SegmentTester::create(mesh);
-  if (!tester.ok()) return tester.status();
-  const detail::SegmentTester& segments = **tester;
-  const std::size_t strides[3] = {1, static_cast<std::size_t>(g.nx), static_cast<std::size_t>(g.nx) * g.ny};
-  const int dims[3] = {g.nx, g.ny, g.nz};
-  auto coords = [&](std::size_t a) {
-    return Eigen::Vector3i(static_cast<int>(a % strides[1]),
-                           static_cast<int>((a / strides[1]) % static_cast<std::size_t>(g.ny)),
-                           static_cast<int>(a / strides[2]));
-  };
-  std::vector<std::size_t> near_surface;
-  for (std::size_t i = 0; i < n; ++i)
-    if (nearest[i] >= 0) near_surface.push_back(i);
-  int relabelled = 0;
-  for (int round = 0; round < 2; ++round) {
-    std::vector<std::uint8_t> flip(near_surface.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, near_surface.size(), 1024),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t x = r.begin(); x != r.end(); ++x) {
-                          const std::size_t a = near_surface[x];
-                          if (state[a] != 0) continue;
-                          const Eigen::Vector3i c = coords(a);
-                          const Eigen::Vector3d pa = g.point(c.x(), c.y(), c.z());
-                          for (int axis = 0; axis < 3 && !flip[x]; ++axis)
-                            for (int side : {-1, 1}) {
-                              if (c[axis] + side < 0 || c[axis] + side >= dims[axis]) continue;
-                              const std::size_t b = side > 0 ? a + strides[axis] : a - strides[axis];
-                              if (state[b] != 1) continue;
-                              if (!segments.crosses(pa, pa + side * h * Eigen::Vector3d::Unit(axis))) {
-                                flip[x] = 1;
-                                break;
-                              }
-                            }
-                        }
-                      });
-    for (std::size_t x = 0; x < near_surface.size(); ++x)
-      if (flip[x]) {
-        state[near_surface[x]] = 1;
-        ++relabelled;
-      }
-  }
+  out.notes.push_back(
+      "partition: simplifying by " + std::to_string(tolerance) + " cells " +
+      (checks.outward ? "made " + std::to_string(checks.num_self_intersections) + " triangle pairs touch or intersect"
+                      : std::string("folded the surface onto itself (no volume left)")) +
+      "; the dense surface is kept");
+  return false;
+}
 
-  // Open sheets the closing cannot see (a grid edge crosses the surface but
-  // both its ends are outside) keep their nearer end as a thin slab.
-  int sheet_points = 0;
-  for (std::size_t a : near_surface) {
-    if (state[a] == 0) continue;
-    const Eigen::Vector3i c = coords(a);
-    for (int axis = 0; axis < 3; ++axis) {
-      if (c[axis] + 1 >= dims[axis]) continue;
-      const std::size_t b = a + strides[axis];
-      if (state[b] == 0 || nearest[b] < 0) continue;
-      const Eigen::Vector3d pa = g.point(c.x(), c.y(), c.z());
-      if (!segments.crosses(pa, pa + h * Eigen::Vector3d::Unit(axis))) continue;
-      const std::size_t keep = dist2[a] <= dist2[b] ? a : b;
-      if (state[keep] != 2) ++sheet_points;
-      state[keep] = 2;
-    }
-  }
-  if (sheet_points > 0)
-    result.notes.push_back(std::to_string(sheet_points) +
-                           " grid points kept as slabs of open sheets (surfaces with outside on both sides)");
-
-  timing << ", surface layer " << lap() << " ms";
-  // The interior goes to the part of the nearest surface on the object's
-  // skin: grid points within a cell of the surface where inside meets
-  // outside. Surfaces with inside on both sides (the coincident faces of two
-  // touching boxes, hidden inner walls) do not claim volume.
-  std::vector<float> seed(n, kInf);
-  std::vector<int> label(n, -1);  // part of the nearest skin surface
-  {
-    for (int k = 0; k < g.nz; ++k)
-      for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i) {
-          const std::size_t a = g.at(i, j, k);
-          if (nearest[a] < 0) continue;
-          const int coord[3] = {i, j, k};
-          const bool out_a = state[a] == 1;
-          bool skin = false;
-          for (int axis = 0; axis < 3 && !skin; ++axis) {
-            if (coord[axis] > 0) skin |= (state[a - strides[axis]] == 1) != out_a;
-            if (coord[axis] + 1 < dims[axis]) skin |= (state[a + strides[axis]] == 1) != out_a;
-          }
-          if (!skin) continue;
-          seed[a] = band[a];
-          label[a] = face_part[static_cast<std::size_t>(nearest[a])];
-        }
-  }
-  distance_transform(g, seed, &label);
-  seed = {};
-
-  timing << ", labels " << lap() << " ms";
-  // Signed field in cells; never exactly zero so no vertex sits on a grid point.
-  constexpr float kMinMagnitude = 0.02f;
-  std::vector<float> field(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const float d = std::max(std::sqrt(dist2[i]), kMinMagnitude);
-    field[i] = state[i] == 1 ? d : state[i] == 2 ? -0.25f : -d;
-  }
-  dist2 = {};
-  nearest = {};
-
-  // ---- 3. Surfaces -------------------------------------------------------------
-  const Eigen::Vector3i all_lo = Eigen::Vector3i::Zero(), all_hi(g.nx - 1, g.ny - 1, g.nz - 1);
-  const Mesh object = extract_surface(g, all_lo, all_hi, [&](std::size_t i) { return field[i]; });
-  result.object_volume_m3 = signed_volume(object);
-  timing << ", object surface " << lap() << " ms";
-
-  std::vector<Eigen::Vector3i> lo(static_cast<std::size_t>(np),
-                                  Eigen::Vector3i::Constant(std::numeric_limits<int>::max()));
-  std::vector<Eigen::Vector3i> hi(static_cast<std::size_t>(np), Eigen::Vector3i::Constant(-1));
-  for (int k = 0; k < g.nz; ++k)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const std::size_t x = g.at(i, j, k);
-        const int p = label[x];
-        if (field[x] >= 0 || p < 0) continue;
-        lo[static_cast<std::size_t>(p)] = lo[static_cast<std::size_t>(p)].cwiseMin(Eigen::Vector3i(i, j, k));
-        hi[static_cast<std::size_t>(p)] = hi[static_cast<std::size_t>(p)].cwiseMax(Eigen::Vector3i(i, j, k));
-      }
-
-  result.parts.resize(static_cast<std::size_t>(np));
-  tbb::parallel_for(0, np, [&](int p) {
+// Parts smaller than a cell own no grid point: each is closed on its own, on
+// a grid sized from the part. Such a part may overlap its neighbours by up to
+// a cell of the object's grid.
+void PartitionCompleter::close_small_parts(const CompletionInput& input, const PartBoxes& boxes,
+                                           Completion& result) const {
+  const std::vector<Part>& parts = *input.parts;
+  PartitionCompleter single = *this;
+  single.nested_ = true;
+  single.resolution_ = single.max_resolution_ = 32;  // small parts need volume, not detail
+  for (int p = 0; p < static_cast<int>(parts.size()); ++p) {
     CompletedPart& out = result.parts[static_cast<std::size_t>(p)];
+    if (boxes.hi[static_cast<std::size_t>(p)].x() >= 0) continue;
+    const Mesh patch = part_patch(*input.mesh, parts[static_cast<std::size_t>(p)]);
+    const std::vector<Part> alone = {whole_patch_part(patch, parts[static_cast<std::size_t>(p)])};
+    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table});
+    if (!own.ok() || own->parts.empty() || own->parts[0].mesh.num_faces() == 0) {
+      out.notes.push_back("partition: the part is smaller than a cell and could not be closed on its own" +
+                          (own.ok() ? std::string() : ": " + own.status().message()));
+      continue;
+    }
+    std::vector<std::string> notes = {"partition: smaller than a cell of the object's grid; closed on its own (" +
+                                      own->notes.front() + "), may overlap its neighbours"};
+    out = std::move(own->parts[0]);
     out.part = p;
-    out.label = parts[static_cast<std::size_t>(p)].label;
-    out.backend = "partition";
-    if (hi[static_cast<std::size_t>(p)].x() < 0) return;  // smaller than a cell: closed on its own below
-    const Eigen::Vector3i plo = (lo[static_cast<std::size_t>(p)] - Eigen::Vector3i::Ones()).cwiseMax(0);
-    const Eigen::Vector3i phi = (hi[static_cast<std::size_t>(p)] + Eigen::Vector3i::Ones()).cwiseMin(all_hi);
-    out.mesh = extract_surface(g, plo, phi, [&](std::size_t i) {
-      const float f = field[i];
-      if (f >= 0) return f;
-      return std::max(f, label[i] == p ? -0.5f : 0.5f);
-    });
-    const Mesh patch = part_patch(mesh, parts[static_cast<std::size_t>(p)]);
-    // Marching tetrahedra makes about six triangles per surface cell; collapse
-    // those that change the surface by less than `simplify` cells. Where that
-    // makes the surface touch itself (collapses along flat, grid-aligned faces
-    // can put a vertex on another sheet's edge), keep the dense surface.
-    bool done = false;
-    for (double tolerance : {simplify_}) {
-      if (!(tolerance > 0)) break;
-      if (out.mesh.num_faces() > simplify_max_triangles_) {
-        out.notes.push_back("partition: " + std::to_string(out.mesh.num_faces()) +
-                            " triangles, more than simplify_max_triangles; not simplified");
-        break;
-      }
-      Mesh simplified = out.mesh;
-      detail::simplify_closed_mesh(simplified, tolerance * h);
-      MeshChecks checks = check_closed_mesh(simplified, &patch);
-      if (checks.watertight()) {
-        out.mesh = std::move(simplified);
-        out.checks = checks;
-        done = true;
-        break;
-      }
-      out.notes.push_back("partition: simplifying by " + std::to_string(tolerance) + " cells " +
-                          (checks.outward ? "made " + std::to_string(checks.num_self_intersections) +
-                                                " triangle pairs touch or intersect"
-                                          : std::string("folded the surface onto itself (no volume left)")) +
-                          "; the dense surface is kept");
-    }
-    if (!done) out.checks = check_closed_mesh(out.mesh, &patch);
-    out.ok = out.checks.watertight() && out.checks.relative_distance <= max_relative_distance_;
-    if (!out.ok) out.notes.push_back("partition: the closed surface failed its checks");
-  });
-  timing << ", parts and checks " << lap() << " ms";
-  // Parts smaller than a cell own no grid point: each is closed on its own,
-  // on a grid sized from the part. Such a part may overlap its neighbours by
-  // up to a cell of the object's grid.
-  if (!nested_) {
-    PartitionCompleter single = *this;
-    single.nested_ = true;
-    single.resolution_ = single.max_resolution_ = 32;  // small parts need volume, not detail
-    for (int p = 0; p < np; ++p) {
-      CompletedPart& out = result.parts[static_cast<std::size_t>(p)];
-      if (hi[static_cast<std::size_t>(p)].x() >= 0) continue;
-      const Mesh patch = part_patch(mesh, parts[static_cast<std::size_t>(p)]);
-      const std::vector<Part> alone = {Part{out.label,
-                                            [&] {
-                                              std::vector<int> f(static_cast<std::size_t>(patch.num_faces()));
-                                              for (int i = 0; i < patch.num_faces(); ++i)
-                                                f[static_cast<std::size_t>(i)] = i;
-                                              return f;
-                                            }(),
-                                            parts[static_cast<std::size_t>(p)].area_m2}};
-      Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table});
-      if (!own.ok() || own->parts.empty() || own->parts[0].mesh.num_faces() == 0) {
-        out.notes.push_back("partition: the part is smaller than a cell and could not be closed on its own" +
-                            (own.ok() ? std::string() : ": " + own.status().message()));
-        continue;
-      }
-      std::vector<std::string> notes = {"partition: smaller than a cell of the object's grid; closed on its own (" +
-                                        own->notes.front() + "), may overlap its neighbours"};
-      out = std::move(own->parts[0]);
-      out.part = p;
-      for (auto& note : out.notes) notes.push_back(std::move(note));
-      out.notes = std::move(notes);
-    }
+    for (auto& note : out.notes) notes.push_back(std::move(note));
+    out.notes = std::move(notes);
   }
-  result.notes.push_back(timing.str());
-  for (const CompletedPart& p : result.parts) result.parts_volume_m3 += p.checks.volume_m3;
-  return result;
 }
 
 }  // namespace

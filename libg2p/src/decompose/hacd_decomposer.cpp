@@ -15,8 +15,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "complete/simplify.h"
 #include "core/settings.h"
+#include "core/simplify.h"
 #include "decompose/backends.h"
 
 namespace g2p {

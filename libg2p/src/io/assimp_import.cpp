@@ -21,11 +21,11 @@
 #include <unordered_set>
 
 #include "assimp_convert.h"
+#include "core/srgb.h"
 #include "core/utf8.h"
 #include "g2p/io.h"
 #include "gltf_layout.h"
 #include "real_size.h"
-#include "render/shading.h"
 #include "scene_reader.h"
 #include "triangulate.h"
 

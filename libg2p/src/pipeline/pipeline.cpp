@@ -10,6 +10,7 @@
 #include <new>
 #include <utility>
 
+#include "g2p/folder.h"
 #include "g2p/pipeline.h"
 #include "pipeline/stage_clock.h"
 #include "segment/backends.h"
@@ -126,8 +127,19 @@ struct Pipeline::Impl {
   Slot<PropertyEstimator> estimator;
   Slot<Decomposer> decomposer;
 
-  Status run_stages(PipelineResult& r, RunContext& context);
-  Status identify_object(PipelineResult& r, RunContext& context);
+  struct RunState;
+  Status run_stages(PipelineResult& r, RunContext& context, Stage first, Stage last);
+  Status render_views(RunState& s);
+  Status identify_object(RunState& s);
+  void prepare_class_prior(RunState& s) const;
+  Status segment_views(RunState& s);
+  Status project_labels(RunState& s);
+  Status refine_labels(RunState& s);
+  Status apply_corrections(RunState& s, bool apply_classes);
+  Status complete_parts(RunState& s);
+  Status estimate(RunState& s);
+  Status decompose_collision(RunState& s);
+  Status build_asset(RunState& s);
   const ObjectTable& object_table() const { return objects ? *objects : ObjectTable::shipped(); }
 };
 
@@ -207,270 +219,343 @@ Status Pipeline::prepare() {
   return Status::Ok();
 }
 
-Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context) {
-  const PipelineOptions& o = options;
-  const Mesh& mesh = r.model.mesh;
-  const bool reset = o.measure_stage_memory;
-  auto finish = [&](detail::StageClock& clock) {
-    r.stages.push_back(clock.finish());
-    r.peak_rss_bytes = std::max(r.peak_rss_bytes, r.stages.back().peak_rss_bytes);
-  };
+// ---- The stages, one function each ----------------------------------------------
 
-  // Per face, whether the segmenter's labels came from the image alone (the
-  // `regions` refiner decides only those).
-  std::vector<std::uint8_t> image_decided;
+// What one run carries from stage to stage besides its result.
+struct Pipeline::Impl::RunState {
+  PipelineResult& r;
+  RunContext& context;
   // The object's kind's materials as a prior over the classes the image
   // decides (kind_class_prior); empty: none.
   std::vector<float> class_prior;
-
-  // 1. render: the views, each with its face-ID and material buffers.
-  {
-    detail::StageClock clock(Stage::kRender, renderer.backend(o.renderer), reset);
-    G2P_RETURN_IF_ERROR(context.report(Stage::kRender, 0.0, "cameras"));
-    Result<std::vector<Camera>> cameras = make_views(mesh, o.views);
-    if (!cameras.ok()) return cameras.status().with_context("render");
-    G2P_RETURN_IF_ERROR(renderer.get()->set_model(r.model).with_context("render"));
-    const std::size_t n = cameras->size();
-    r.views.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      G2P_RETURN_IF_ERROR(renderer.get()
-                              ->render_into((*cameras)[i], o.render, r.views[i])
-                              .with_context("render: view " + std::to_string(i)));
-      G2P_RETURN_IF_ERROR(context.report(Stage::kRender, double(i + 1) / double(n),
-                                         "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
-    }
-    finish(clock);
-  }
-
-  if (o.last_stage == Stage::kRender) return Status::Ok();
-
-  // What the object is; a normalised mesh may take its kind's size.
-  G2P_RETURN_IF_ERROR(identify_object(r, context));
-  if (o.last_stage == Stage::kIdentify) return Status::Ok();
-
-  // 2. segment: a material class per pixel.
-  {
-    detail::StageClock clock(Stage::kSegment, segmenter.backend(o.segmenter), reset);
-    G2P_RETURN_IF_ERROR(segmenter.get()->set_model(r.model, r.table).with_context("segment"));
-    // A backend that degraded (`hybrid` falls back to `pbr` without its network) says why.
-    for (const std::string& w : segmenter.get()->warnings()) r.warnings.push_back("segment: " + w);
-    image_decided = segmenter.get()->image_decided_faces();
-    // The kind's materials weigh the classes the image decides.
-    std::vector<std::string> listed;
-    if (!r.kind.name.empty()) class_prior = kind_class_prior(r.kind, r.table, o.kind_prior, &listed);
-    std::size_t prior_changed = 0;
-    const std::size_t n = r.views.size();
-    r.label_maps.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      G2P_RETURN_IF_ERROR(segmenter.get()
-                              ->segment_into(r.views[i], r.label_maps[i])
-                              .with_context("segment: view " + std::to_string(i)));
-      if (!class_prior.empty()) {
-        Result<std::size_t> changed = apply_class_prior(class_prior, image_decided, r.views[i], r.label_maps[i]);
-        if (!changed.ok()) return changed.status().with_context("segment: view " + std::to_string(i));
-        prior_changed += *changed;
-      }
-      G2P_RETURN_IF_ERROR(context.report(Stage::kSegment, double(i + 1) / double(n),
-                                         "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
-    }
-    if (!class_prior.empty()) {
-      std::string classes;
-      for (const std::string& c : listed) classes += (classes.empty() ? "" : ", ") + c;
-      clock.report().notes.push_back("the " + r.kind.name + "'s usual materials (" + classes +
-                                     ") weigh the classes read from the image, every other class x" +
-                                     fixed(o.kind_prior) + " (--kind-prior): " + std::to_string(prior_changed) +
-                                     " pixels changed class");
-    }
-    finish(clock);
-  }
-
-  if (o.last_stage == Stage::kSegment) return Status::Ok();
-
-  // 3. project: votes over all views, flood fill, connected parts.
-  {
-    detail::StageClock clock(Stage::kProject, "vote", reset);
-    Result<Projection> projection = project(mesh, r.views, r.label_maps, r.table.size(), o.project);
-    if (!projection.ok()) return projection.status().with_context("project");
-    r.projection = std::move(*projection);
-    r.projected_labels = r.projection.labels.label;
-    std::size_t seen = 0;
-    for (std::uint8_t s : r.projection.labels.seen) seen += s;
-    clock.report().notes.push_back(std::to_string(seen) + " of " + std::to_string(mesh.num_faces()) + " faces seen, " +
-                                   std::to_string(r.projection.parts.size()) + " parts");
-    G2P_RETURN_IF_ERROR(context.report(Stage::kProject, 1.0, std::to_string(r.projection.parts.size()) + " parts"));
-    finish(clock);
-  }
-
-  if (o.last_stage == Stage::kProject) return Status::Ok();
-
-  // 4. refine (optional): a failure keeps the projected labels.
-  if (refiner.custom || o.refiner.name != "none") {
-    detail::StageClock clock(Stage::kRefine, refiner.backend(o.refiner), reset);
-    RefineInput in{&mesh,    &r.projection.graph, &r.projection.votes, &r.projection.labels, &r.views,
-                   &r.table, &image_decided,      &class_prior};
-    Result<RefineResult> refined = refiner.get()->refine(in);
-    const StatusCode code = refined.ok() ? StatusCode::kOk : refined.status().code();
-    if (code == StatusCode::kInvalidArgument || code == StatusCode::kNotFound)
-      return refined.status().with_context("refine");  // its settings are wrong: the caller must fix them
-    Status applied =
-        refined.ok() ? apply_refinement(mesh, refined->labels, o.project.partition, r.projection) : refined.status();
-    StageReport& report = clock.report();
-    if (applied.ok() && refined->fell_back) {
-      report.ok = false;
-      report.error = refined->notes.empty() ? "the backend kept the input labels" : refined->notes.back();
-      // A backend that fell back to another one (regions to smooth) still changed labels.
-      r.warnings.push_back("refine (" + report.backend + ") " +
-                           (refined->changes.empty() ? "failed; the projected labels stand: " : "degraded: ") +
-                           report.error);
-      r.refinement = std::move(*refined);
-    } else if (!applied.ok()) {
-      report.ok = false;
-      report.error = applied.to_string();
-      r.warnings.push_back("refine (" + report.backend + ") failed; the projected labels stand: " + report.error);
-    } else {
-      report.notes = refined->notes;
-      report.notes.push_back(std::to_string(refined->changes.size()) + " faces changed, " +
-                             std::to_string(r.projection.parts.size()) + " parts");
-      r.refinement = std::move(*refined);
-    }
-    G2P_RETURN_IF_ERROR(context.report(Stage::kRefine, 1.0, report.ok ? "done" : "failed, skipped"));
-    finish(clock);
-  }
-
-  // A person's corrections: classes first (the parts re-form), properties in
-  // the estimator below.
+  std::vector<std::string> prior_classes;  // the classes the kind lists, for the notes
+  // The corrections, resolved on the final parts (for the estimator).
   std::unique_ptr<ResolvedOverrides> resolved;
-  if (!o.overrides.empty()) {
+
+  void finish(detail::StageClock& clock) {
+    r.stages.push_back(clock.finish());
+    r.peak_rss_bytes = std::max(r.peak_rss_bytes, r.stages.back().peak_rss_bytes);
+  }
+};
+
+// 1. render: the views, each with its face-ID and material buffers.
+Status Pipeline::Impl::render_views(RunState& s) {
+  PipelineResult& r = s.r;
+  detail::StageClock clock(Stage::kRender, renderer.backend(options.renderer), options.measure_stage_memory);
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kRender, 0.0, "cameras"));
+  Result<std::vector<Camera>> cameras = make_views(r.model.mesh, options.views);
+  if (!cameras.ok()) return cameras.status().with_context("render");
+  G2P_RETURN_IF_ERROR(renderer.get()->set_model(r.model).with_context("render"));
+  const std::size_t n = cameras->size();
+  r.views.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    G2P_RETURN_IF_ERROR(renderer.get()
+                            ->render_into((*cameras)[i], options.render, r.views[i])
+                            .with_context("render: view " + std::to_string(i)));
+    G2P_RETURN_IF_ERROR(s.context.report(Stage::kRender, double(i + 1) / double(n),
+                                         "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
+  }
+  s.finish(clock);
+  return Status::Ok();
+}
+
+// The kind's materials weigh the classes the image decides (segment, refine).
+void Pipeline::Impl::prepare_class_prior(RunState& s) const {
+  if (s.r.kind.name.empty() || !s.class_prior.empty()) return;
+  s.class_prior = kind_class_prior(s.r.kind, s.r.table, options.kind_prior, &s.prior_classes);
+}
+
+// 2. segment: a material class per pixel.
+Status Pipeline::Impl::segment_views(RunState& s) {
+  PipelineResult& r = s.r;
+  const PipelineOptions& o = options;
+  detail::StageClock clock(Stage::kSegment, segmenter.backend(o.segmenter), o.measure_stage_memory);
+  G2P_RETURN_IF_ERROR(segmenter.get()->set_model(r.model, r.table).with_context("segment"));
+  // A backend that degraded (`hybrid` falls back to `pbr` without its network) says why.
+  for (const std::string& w : segmenter.get()->warnings()) r.warnings.push_back("segment: " + w);
+  r.image_decided = segmenter.get()->image_decided_faces();
+  prepare_class_prior(s);
+  std::size_t prior_changed = 0;
+  const std::size_t n = r.views.size();
+  r.label_maps.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    G2P_RETURN_IF_ERROR(
+        segmenter.get()->segment_into(r.views[i], r.label_maps[i]).with_context("segment: view " + std::to_string(i)));
+    if (!s.class_prior.empty()) {
+      Result<std::size_t> changed = apply_class_prior(s.class_prior, r.image_decided, r.views[i], r.label_maps[i]);
+      if (!changed.ok()) return changed.status().with_context("segment: view " + std::to_string(i));
+      prior_changed += *changed;
+    }
+    G2P_RETURN_IF_ERROR(s.context.report(Stage::kSegment, double(i + 1) / double(n),
+                                         "view " + std::to_string(i + 1) + "/" + std::to_string(n)));
+  }
+  if (!s.class_prior.empty()) {
+    std::string classes;
+    for (const std::string& c : s.prior_classes) classes += (classes.empty() ? "" : ", ") + c;
+    clock.report().notes.push_back("the " + r.kind.name + "'s usual materials (" + classes +
+                                   ") weigh the classes read from the image, every other class x" +
+                                   fixed(o.kind_prior) + " (--kind-prior): " + std::to_string(prior_changed) +
+                                   " pixels changed class");
+  }
+  s.finish(clock);
+  return Status::Ok();
+}
+
+// 3. project: votes over all views, flood fill, connected parts.
+Status Pipeline::Impl::project_labels(RunState& s) {
+  PipelineResult& r = s.r;
+  const Mesh& mesh = r.model.mesh;
+  detail::StageClock clock(Stage::kProject, "vote", options.measure_stage_memory);
+  Result<Projection> projection = project(mesh, r.views, r.label_maps, r.table.size(), options.project);
+  if (!projection.ok()) return projection.status().with_context("project");
+  r.projection = std::move(*projection);
+  r.projected_labels = r.projection.labels.label;
+  std::size_t seen = 0;
+  for (std::uint8_t v : r.projection.labels.seen) seen += v;
+  clock.report().notes.push_back(std::to_string(seen) + " of " + std::to_string(mesh.num_faces()) + " faces seen, " +
+                                 std::to_string(r.projection.parts.size()) + " parts");
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kProject, 1.0, std::to_string(r.projection.parts.size()) + " parts"));
+  s.finish(clock);
+  return Status::Ok();
+}
+
+// 4. refine (optional): a failure keeps the projected labels.
+Status Pipeline::Impl::refine_labels(RunState& s) {
+  PipelineResult& r = s.r;
+  const PipelineOptions& o = options;
+  if (!refiner.custom && o.refiner.name == "none") return Status::Ok();
+  const Mesh& mesh = r.model.mesh;
+  detail::StageClock clock(Stage::kRefine, refiner.backend(o.refiner), o.measure_stage_memory);
+  prepare_class_prior(s);
+  RefineInput in{&mesh,    &r.projection.graph, &r.projection.votes, &r.projection.labels, &r.views,
+                 &r.table, &r.image_decided,    &s.class_prior};
+  Result<RefineResult> refined = refiner.get()->refine(in);
+  const StatusCode code = refined.ok() ? StatusCode::kOk : refined.status().code();
+  if (code == StatusCode::kInvalidArgument || code == StatusCode::kNotFound)
+    return refined.status().with_context("refine");  // its settings are wrong: the caller must fix them
+  Status applied =
+      refined.ok() ? apply_refinement(mesh, refined->labels, o.project.partition, r.projection) : refined.status();
+  StageReport& report = clock.report();
+  if (applied.ok() && refined->fell_back) {
+    report.ok = false;
+    report.error = refined->notes.empty() ? "the backend kept the input labels" : refined->notes.back();
+    // A backend that fell back to another one (regions to smooth) still changed labels.
+    r.warnings.push_back("refine (" + report.backend + ") " +
+                         (refined->changes.empty() ? "failed; the projected labels stand: " : "degraded: ") +
+                         report.error);
+    r.refinement = std::move(*refined);
+  } else if (!applied.ok()) {
+    report.ok = false;
+    report.error = applied.to_string();
+    r.warnings.push_back("refine (" + report.backend + ") failed; the projected labels stand: " + report.error);
+  } else {
+    report.notes = refined->notes;
+    report.notes.push_back(std::to_string(refined->changes.size()) + " faces changed, " +
+                           std::to_string(r.projection.parts.size()) + " parts");
+    r.refinement = std::move(*refined);
+  }
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kRefine, 1.0, report.ok ? "done" : "failed, skipped"));
+  s.finish(clock);
+  return Status::Ok();
+}
+
+// A person's corrections, after refine: the state's own (a folder's
+// overrides.json, already applied to its labels) and then options().overrides.
+// Classes change here (the parts re-form) when `apply_classes`; structure,
+// wall thickness and density go to the estimator through `s.resolved`.
+Status Pipeline::Impl::apply_corrections(RunState& s, bool apply_classes) {
+  PipelineResult& r = s.r;
+  const Mesh& mesh = r.model.mesh;
+  std::vector<Overrides> files;
+  if (!r.overrides.empty()) files.push_back(r.overrides);
+  if (!options.overrides.empty()) files.push_back(options.overrides);
+  if (files.empty()) return Status::Ok();
+  Overrides combined;
+  std::vector<std::string> notes;
+  for (const Overrides& file : files) {
     Result<ResolvedOverrides> res =
-        resolve_overrides(o.overrides, mesh.num_faces(), r.projection.parts, r.projection.labels.label, r.table);
+        resolve_overrides(file, mesh.num_faces(), r.projection.parts, r.projection.labels.label, r.table);
     if (!res.ok()) return res.status();
-    resolved = std::make_unique<ResolvedOverrides>(std::move(*res));
-    Result<std::vector<std::string>> applied = apply_class_overrides(*resolved, mesh, r.projection, r.table);
-    if (!applied.ok()) return applied.status();
-    r.overrides_applied = std::move(*applied);
-    r.overrides = as_face_selections(*resolved);
+    if (apply_classes) {
+      Result<std::vector<std::string>> applied = apply_class_overrides(*res, mesh, r.projection, r.table);
+      if (!applied.ok()) return applied.status();
+      notes.insert(notes.end(), applied->begin(), applied->end());
+    }
+    Overrides selections = as_face_selections(*res);
+    if (files.size() == 1) {  // the usual case: one file, resolved once
+      s.resolved = std::make_unique<ResolvedOverrides>(std::move(*res));
+      combined = std::move(selections);
+      break;
+    }
+    combined.faces_total = selections.faces_total;
+    if (combined.model.empty()) combined.model = selections.model;
+    if (!selections.object.empty()) combined.object = selections.object;
+    for (Override& e : selections.entries) combined.entries.push_back(std::move(e));
   }
-
-  if (o.last_stage == Stage::kRefine) return Status::Ok();
-
-  // 5. complete: every part closed into a watertight volume.
-  {
-    detail::StageClock clock(Stage::kComplete, completer.backend(o.completer), reset);
-    G2P_RETURN_IF_ERROR(context.report(Stage::kComplete, 0.0, std::to_string(r.projection.parts.size()) + " parts"));
-    CompletionInput input{&mesh, &r.projection.parts, &r.table};
-    Result<Completion> done = complete(input, *completer.get(), fallback.get());
-    if (!done.ok()) return done.status().with_context("complete");
-    r.completion = std::move(*done);
-    int closed = 0;
-    for (const CompletedPart& p : r.completion.parts) closed += p.ok ? 1 : 0;
-    clock.report().notes = r.completion.notes;
-    clock.report().notes.push_back(std::to_string(closed) + " of " + std::to_string(r.completion.parts.size()) +
-                                   " parts closed and checked");
-    G2P_RETURN_IF_ERROR(context.report(Stage::kComplete, 1.0, std::to_string(closed) + " parts closed"));
-    finish(clock);
+  if (!s.resolved) {  // face selections without checks always resolve
+    Result<ResolvedOverrides> res =
+        resolve_overrides(combined, mesh.num_faces(), r.projection.parts, r.projection.labels.label, r.table);
+    if (!res.ok()) return res.status();
+    s.resolved = std::make_unique<ResolvedOverrides>(std::move(*res));
   }
+  if (!options.overrides.object.empty())  // what the object is (identify or resume applied it)
+    notes.push_back("the object is taken for what the overrides' \"object\" says, '" + options.overrides.object + "'");
+  r.overrides_applied = std::move(notes);
+  r.overrides = std::move(combined);
+  return Status::Ok();
+}
 
-  if (o.last_stage == Stage::kComplete) return Status::Ok();
+// 5. complete: every part closed into a watertight volume.
+Status Pipeline::Impl::complete_parts(RunState& s) {
+  PipelineResult& r = s.r;
+  detail::StageClock clock(Stage::kComplete, completer.backend(options.completer), options.measure_stage_memory);
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kComplete, 0.0, std::to_string(r.projection.parts.size()) + " parts"));
+  CompletionInput input{&r.model.mesh, &r.projection.parts, &r.table, {}};
+  RunContext& context = s.context;
+  input.progress = [&context](double fraction, const std::string& message) {
+    return context.report(Stage::kComplete, fraction, message);
+  };
+  Result<Completion> done = complete(input, *completer.get(), fallback.get());
+  if (!done.ok()) return done.status().with_context("complete");
+  r.completion = std::move(*done);
+  int closed = 0;
+  for (const CompletedPart& p : r.completion.parts) closed += p.ok ? 1 : 0;
+  clock.report().notes = r.completion.notes;
+  clock.report().notes.push_back(std::to_string(closed) + " of " + std::to_string(r.completion.parts.size()) +
+                                 " parts closed and checked");
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kComplete, 1.0, std::to_string(closed) + " parts closed"));
+  s.finish(clock);
+  return Status::Ok();
+}
 
-  // 6. properties: density, solid or hollow, mass properties.
-  {
-    detail::StageClock clock(Stage::kProperties, estimator.backend(o.estimator), reset);
-    std::unique_ptr<PropertyEstimator> overriding;
-    if (resolved && o.overrides.changes_properties())
-      overriding = make_overriding_estimator(*estimator.get(), *resolved);
-    const PropertyEstimator& chosen = overriding ? *overriding : *estimator.get();
-    Result<PropertiesReport> report =
-        o.kind_properties && !r.kind.name.empty()
-            ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, &r.views)
-            : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, &r.views);
-    if (!report.ok()) return report.status().with_context("properties");
-    r.properties = std::move(*report);
-    r.properties.size = object_size(r.model);
-    if (resolved)
-      for (const PartReport& p : r.properties.parts) {
-        // A fill the part could not take is named beside its correction, so
-        // that the list never claims contents the report left out.
-        std::string left_out;
-        for (const std::string& n : p.properties.notes)
-          if (n.rfind(kContentsLeftOut, 0) == 0) left_out = "; " + n;
-        for (const std::string& n : p.properties.notes)
-          if (n.rfind("correction: ", 0) == 0)  // "part 2: hollow, 3 mm walls", as the class changes read
-            r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12) + left_out);
-      }
-    clock.report().notes = r.properties.notes;
-    for (const std::string& n : r.properties.notes)  // contents asked for and not given; the kind's hidden mass
-      if (n.find(kContentsLeftOut) != std::string::npos || n.rfind("hidden mass left out", 0) == 0)
-        r.warnings.push_back("properties: " + n);
-    // The vlm estimator never fails a part: it falls back to the table, which
-    // is a degraded optional stage the caller should hear about.
-    if (!estimator.custom && o.estimator.name == "vlm") {
-      int fell_back = 0, weighed = 0;
-      std::string why;
-      for (const PartReport& p : r.properties.parts) {
-        if (p.mass.mass_kg <= 0) continue;
-        ++weighed;
-        if (p.properties.density_source == ValueSource::kVlm) continue;
-        ++fell_back;
-        if (why.empty() && !p.properties.notes.empty()) why = p.properties.notes.back();
-      }
-      if (fell_back > 0) {
-        const std::string what = std::to_string(fell_back) + " of " + std::to_string(weighed) +
-                                 " parts fell back to the table's values" + (why.empty() ? "" : " (" + why + ")");
-        r.warnings.push_back("properties (vlm): " + what);
-        if (fell_back == weighed) {
-          clock.report().ok = false;
-          clock.report().error = what;
-        }
+// 6. properties: density, solid or hollow, mass properties.
+Status Pipeline::Impl::estimate(RunState& s) {
+  PipelineResult& r = s.r;
+  const PipelineOptions& o = options;
+  const Mesh& mesh = r.model.mesh;
+  detail::StageClock clock(Stage::kProperties, estimator.backend(o.estimator), o.measure_stage_memory);
+  std::unique_ptr<PropertyEstimator> overriding;
+  if (s.resolved && r.overrides.changes_properties())
+    overriding = make_overriding_estimator(*estimator.get(), *s.resolved);
+  const PropertyEstimator& chosen = overriding ? *overriding : *estimator.get();
+  const std::vector<View>* views = r.views.empty() ? nullptr : &r.views;
+  Result<PropertiesReport> report =
+      o.kind_properties && !r.kind.name.empty()
+          ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, views)
+          : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views);
+  if (!report.ok()) return report.status().with_context("properties");
+  r.properties = std::move(*report);
+  r.properties.size = object_size(r.model);
+  if (s.resolved)
+    for (const PartReport& p : r.properties.parts) {
+      // A fill the part could not take is named beside its correction, so
+      // that the list never claims contents the report left out.
+      std::string left_out;
+      for (const std::string& n : p.properties.notes)
+        if (n.rfind(kContentsLeftOut, 0) == 0) left_out = "; " + n;
+      for (const std::string& n : p.properties.notes)
+        if (n.rfind("correction: ", 0) == 0)  // "part 2: hollow, 3 mm walls", as the class changes read
+          r.overrides_applied.push_back("part " + std::to_string(p.part) + ": " + n.substr(12) + left_out);
+    }
+  clock.report().notes = r.properties.notes;
+  for (const std::string& n : r.properties.notes)  // contents asked for and not given; the kind's hidden mass
+    if (n.find(kContentsLeftOut) != std::string::npos || n.rfind("hidden mass left out", 0) == 0)
+      r.warnings.push_back("properties: " + n);
+  // The vlm estimator never fails a part: it falls back to the table, which
+  // is a degraded optional stage the caller should hear about.
+  if (!estimator.custom && o.estimator.name == "vlm") {
+    int fell_back = 0, weighed = 0;
+    std::string why;
+    for (const PartReport& p : r.properties.parts) {
+      if (p.mass.mass_kg <= 0) continue;
+      ++weighed;
+      if (p.properties.density_source == ValueSource::kVlm) continue;
+      ++fell_back;
+      if (why.empty() && !p.properties.notes.empty()) why = p.properties.notes.back();
+    }
+    if (fell_back > 0) {
+      const std::string what = std::to_string(fell_back) + " of " + std::to_string(weighed) +
+                               " parts fell back to the table's values" + (why.empty() ? "" : " (" + why + ")");
+      r.warnings.push_back("properties (vlm): " + what);
+      if (fell_back == weighed) {
+        clock.report().ok = false;
+        clock.report().error = what;
       }
     }
-    G2P_RETURN_IF_ERROR(context.report(Stage::kProperties, 1.0, "done"));
-    finish(clock);
   }
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kProperties, 1.0, "done"));
+  s.finish(clock);
+  return Status::Ok();
+}
 
-  if (o.last_stage == Stage::kProperties) return Status::Ok();
-
-  // 7. decompose: every part's collision geometry, convex hulls for engines.
-  {
-    detail::StageClock clock(Stage::kDecompose, decomposer.backend(o.decomposer), reset);
-    G2P_RETURN_IF_ERROR(context.report(Stage::kDecompose, 0.0, std::to_string(r.completion.parts.size()) + " parts"));
-    r.collision = decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer), &mesh,
-                                  &r.projection.parts);
-    int hulls = 0, fell_back = 0, none = 0;
-    for (std::size_t i = 0; i < r.collision.size(); ++i) {
-      const ConvexDecomposition& d = r.collision[i];
-      hulls += static_cast<int>(d.hulls.size());
-      fell_back += d.fell_back ? 1 : 0;
-      const bool weighed = i < r.properties.parts.size() && r.properties.parts[i].mass.mass_kg > 0;
-      if (d.hulls.empty() && weighed) ++none;
-      for (const std::string& n : d.notes) clock.report().notes.push_back("part " + std::to_string(i) + ": " + n);
-    }
-    clock.report().notes.push_back(std::to_string(hulls) + " convex hulls for " + std::to_string(r.collision.size()) +
-                                   " parts");
-    if (fell_back + none > 0)
-      r.warnings.push_back("decompose (" + clock.report().backend + "): " + std::to_string(fell_back) +
-                           " parts fell back to their single convex hull and " + std::to_string(none) +
-                           " have no collision shape (see report.json)");
-    G2P_RETURN_IF_ERROR(context.report(Stage::kDecompose, 1.0, std::to_string(hulls) + " hulls"));
-    finish(clock);
+// 7. decompose: every part's collision geometry, convex hulls for engines.
+Status Pipeline::Impl::decompose_collision(RunState& s) {
+  PipelineResult& r = s.r;
+  const PipelineOptions& o = options;
+  detail::StageClock clock(Stage::kDecompose, decomposer.backend(o.decomposer), o.measure_stage_memory);
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kDecompose, 0.0, std::to_string(r.completion.parts.size()) + " parts"));
+  r.collision = decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer),
+                                &r.model.mesh, &r.projection.parts);
+  int hulls = 0, fell_back = 0, none = 0;
+  for (std::size_t i = 0; i < r.collision.size(); ++i) {
+    const ConvexDecomposition& d = r.collision[i];
+    hulls += static_cast<int>(d.hulls.size());
+    fell_back += d.fell_back ? 1 : 0;
+    const bool weighed = i < r.properties.parts.size() && r.properties.parts[i].mass.mass_kg > 0;
+    if (d.hulls.empty() && weighed) ++none;
+    for (const std::string& n : d.notes) clock.report().notes.push_back("part " + std::to_string(i) + ": " + n);
   }
+  clock.report().notes.push_back(std::to_string(hulls) + " convex hulls for " + std::to_string(r.collision.size()) +
+                                 " parts");
+  if (fell_back + none > 0)
+    r.warnings.push_back("decompose (" + clock.report().backend + "): " + std::to_string(fell_back) +
+                         " parts fell back to their single convex hull and " + std::to_string(none) +
+                         " have no collision shape (see report.json)");
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kDecompose, 1.0, std::to_string(hulls) + " hulls"));
+  s.finish(clock);
+  return Status::Ok();
+}
 
-  if (o.last_stage == Stage::kDecompose) return Status::Ok();
+// The simulation asset (written by write_pipeline_output).
+Status Pipeline::Impl::build_asset(RunState& s) {
+  PipelineResult& r = s.r;
+  detail::StageClock clock(Stage::kExport, "asset", options.measure_stage_memory);
+  std::string name = options.name;
+  if (name.empty()) name = std::filesystem::path(r.model.info.path).stem().string();
+  if (name.empty()) name = "object";
+  Result<SimulationAsset> asset =
+      make_asset(name, r.model.mesh, r.projection.parts, r.completion, r.properties, r.table, r.collision);
+  if (!asset.ok()) return asset.status().with_context("export");
+  r.asset = std::move(*asset);
+  r.asset.identification_json = identification_json(r.identification, object_table(), r.size_assumed_m);
+  clock.report().notes = r.asset.notes;
+  plausibility_warnings(r);
+  G2P_RETURN_IF_ERROR(s.context.report(Stage::kExport, 1.0, r.asset.name));
+  s.finish(clock);
+  return Status::Ok();
+}
 
-  // The simulation asset (written by write_pipeline_output).
-  {
-    detail::StageClock clock(Stage::kExport, "asset", reset);
-    std::string name = o.name;
-    if (name.empty()) name = std::filesystem::path(r.model.info.path).stem().string();
-    if (name.empty()) name = "object";
-    Result<SimulationAsset> asset =
-        make_asset(name, mesh, r.projection.parts, r.completion, r.properties, r.table, r.collision);
-    if (!asset.ok()) return asset.status().with_context("export");
-    r.asset = std::move(*asset);
-    r.asset.identification_json = identification_json(r.identification, object_table(), r.size_assumed_m);
-    clock.report().notes = r.asset.notes;
-    plausibility_warnings(r);
-    G2P_RETURN_IF_ERROR(context.report(Stage::kExport, 1.0, r.asset.name));
-    finish(clock);
+Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context, Stage first, Stage last) {
+  RunState s{r, context, {}, {}, {}};
+  using Step = Status (Impl::*)(RunState&);
+  struct Entry {
+    Stage stage;
+    Step step;
+  };
+  static constexpr Entry kSteps[] = {
+      {Stage::kRender, &Impl::render_views},   {Stage::kIdentify, &Impl::identify_object},
+      {Stage::kSegment, &Impl::segment_views}, {Stage::kProject, &Impl::project_labels},
+      {Stage::kRefine, &Impl::refine_labels},  {Stage::kComplete, &Impl::complete_parts},
+      {Stage::kProperties, &Impl::estimate},   {Stage::kDecompose, &Impl::decompose_collision},
+      {Stage::kExport, &Impl::build_asset}};
+  for (const Entry& e : kSteps) {
+    if (e.stage > last) break;
+    if (e.stage >= first) G2P_RETURN_IF_ERROR((this->*e.step)(s));
+    // The corrections follow refine, and the estimator needs them resolved
+    // even when the run starts after complete.
+    if (e.stage == Stage::kRefine && first <= Stage::kProperties)
+      G2P_RETURN_IF_ERROR(apply_corrections(s, /*apply_classes=*/first <= Stage::kComplete));
+    if (e.stage >= first || r.last_stage < e.stage) r.last_stage = e.stage;
   }
   return Status::Ok();
 }
@@ -497,7 +582,9 @@ void scale_run(PipelineResult& r, double s) {
 
 }  // namespace
 
-Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
+Status Pipeline::Impl::identify_object(RunState& s) {
+  PipelineResult& r = s.r;
+  RunContext& context = s.context;
   const PipelineOptions& o = options;
   detail::StageClock clock(Stage::kIdentify, identifier.backend(o.identifier), o.measure_stage_memory);
   G2P_RETURN_IF_ERROR(context.report(Stage::kIdentify, 0.0, "identifying"));
@@ -558,6 +645,7 @@ Status Pipeline::Impl::identify_object(PipelineResult& r, RunContext& context) {
       const double target = r.kind.typical_longest_side_m;
       if (longest > 0.0 && std::isfinite(longest) && target > 0.0) {
         scale_run(r, target / longest);
+        r.kind_scale = target / longest;
         info.scale_source = "kind";
         r.size_assumed_m = target;
         const std::string text =
@@ -646,7 +734,7 @@ Result<PipelineResult> Pipeline::run_unguarded(Model model, RunContext* context)
   if (impl_->options.anonymize_names) anonymize_names(r.model);
   if (impl_->options.base_color_only) reduce_to_base_color(r.model);
   r.table = impl_->table;
-  Status s = impl_->run_stages(r, ctx);
+  Status s = impl_->run_stages(r, ctx, Stage::kRender, impl_->options.last_stage);
   if (!s.ok()) {
     const std::string& path = r.model.info.path;
     return path.empty() ? s : s.with_context(path);
@@ -676,6 +764,91 @@ Result<PipelineResult> Pipeline::run_file(const std::string& path, RunContext* c
   r->stages.insert(r->stages.begin(), load);
   r->peak_rss_bytes = std::max(r->peak_rss_bytes, load.peak_rss_bytes);
   r->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+namespace {
+
+// What a resumed run needs of its state before `first`, said in the terms of
+// the commands that make it.
+Status check_resumable(const PipelineResult& r, Stage first) {
+  auto missing = [&](const std::string& what, const char* command) {
+    return Status::InvalidArgument("Pipeline::resume at " + std::string(to_string(first)) + ": the state has no " +
+                                   what + " (run " + command + " first)");
+  };
+  if (r.model.mesh.num_faces() == 0) return missing("model", "g2p project");
+  if (r.table.size() == 0) return missing("material table", "g2p project");
+  if (first == Stage::kRefine && (r.views.empty() || r.projection.graph.num_faces() != r.model.mesh.num_faces()))
+    return missing("views and votes", "g2p project");
+  if (r.projection.labels.label.size() != static_cast<std::size_t>(r.model.mesh.num_faces()))
+    return missing("face labels", "g2p project");
+  if (first > Stage::kComplete && r.completion.parts.size() != r.projection.parts.size())
+    return missing("closed parts", "g2p complete");
+  if (first > Stage::kProperties && r.properties.parts.size() != r.projection.parts.size())
+    return missing("properties", "g2p properties");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<PipelineResult> Pipeline::resume(PipelineResult state, Stage first, Stage last, RunContext* context) {
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    RunContext local;
+    RunContext& ctx = context != nullptr ? *context : local;
+    G2P_RETURN_IF_ERROR(prepare());
+    if (first < Stage::kRefine || first > Stage::kExport)
+      return Status::InvalidArgument(std::string("Pipeline::resume: the first stage must be refine ... export (got ") +
+                                     to_string(first) + "); a run from the model is Pipeline::run");
+    if (last < first)
+      return Status::InvalidArgument(std::string("Pipeline::resume: the last stage (") + to_string(last) +
+                                     ") comes before the first (" + to_string(first) + ")");
+    // Corrections go back as far as what they change.
+    const Overrides& corrections = impl_->options.overrides;
+    if (corrections.changes_labels())
+      first = std::min(first, Stage::kComplete);
+    else if (!corrections.empty())
+      first = std::min(first, Stage::kProperties);
+    if (!corrections.object.empty()) {  // what the object is, corrected: its kind weighs the parts
+      Result<std::string> kind = kind_from_text(impl_->object_table(), corrections.object, "the overrides' \"object\"");
+      if (!kind.ok()) return kind.status();
+      const int k = impl_->object_table().find(*kind);
+      state.kind = impl_->object_table().kinds()[static_cast<std::size_t>(k)];
+      state.identification.candidates.insert(
+          state.identification.candidates.begin(),
+          KindGuess{*kind, 1.0, "override", "overrides \"object\": '" + corrections.object + "'"});
+    }
+    G2P_RETURN_IF_ERROR(check_resumable(state, first));
+    state.stages.clear();
+    state.peak_rss_bytes = 0;
+    state.last_stage = static_cast<Stage>(static_cast<int>(first) - 1);
+    Status s = impl_->run_stages(state, ctx, first, last);
+    if (!s.ok()) return state.model.info.path.empty() ? s : s.with_context(state.model.info.path);
+    state.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return state;
+  } catch (const std::bad_alloc&) {
+    return Status::OutOfMemory("the run ran out of memory while resuming it");
+  }
+}
+
+Result<PipelineResult> Pipeline::resume(const std::string& folder, Stage first, Stage last, RunContext* context) {
+  Result<FolderState> state = read_pipeline_folder(folder, first, impl_->options.import);
+  if (!state.ok()) return state.status();
+  // What the folder was made with stays: how its model is read and its labels voted.
+  PipelineOptions& o = impl_->options;
+  const FolderManifest& m = state->manifest;
+  o.import.unit_scale = m.import.unit_scale;
+  o.import.height_m = m.import.height_m;
+  o.import.longest_side_m = m.import.longest_side_m;
+  o.import.up_axis = m.import.up_axis;
+  o.import.z_up = m.import.z_up;
+  o.import.load_textures = m.import.load_textures;
+  o.import.strict = m.import.strict;
+  o.anonymize_names = m.anonymize_names;
+  o.base_color_only = m.base_color_only;
+  o.project = m.project;
+  Result<PipelineResult> r = resume(std::move(state->result), state->first, last, context);
+  if (r.ok()) r->warnings.insert(r->warnings.begin(), state->notes.begin(), state->notes.end());
   return r;
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "core/srgb.h"
 #include "g2p/identify.h"
 #include "g2p/vlm.h"
 #include "pipeline/run_summary.h"

@@ -124,7 +124,7 @@ Status write_projection(const std::string& dir, const Model& model, const std::v
   std::vector<LabelMap> projected;
   projected.reserve(views.size());
   for (const View& v : views) projected.push_back(render_face_labels(v, projection.labels.label));
-  G2P_RETURN_IF_ERROR(write_label_maps(dir + "/projected", projected, table));
+  if (!projected.empty()) G2P_RETURN_IF_ERROR(write_label_maps(dir + "/projected", projected, table));
   G2P_RETURN_IF_ERROR(write_faces_csv(dir + "/faces.csv", model, projection, table));
   G2P_RETURN_IF_ERROR(write_labelled_ply(dir + "/labelled.ply", model.mesh, projection.labels.label, table));
   nlohmann::json parts = nlohmann::json::array();

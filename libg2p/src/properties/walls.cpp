@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <random>
 
-#include "complete/segment_tester.h"
+#include "core/segment_tester.h"
 #include "g2p/properties.h"
 
 namespace g2p {

@@ -13,12 +13,11 @@
 #include <numeric>
 #include <queue>
 
+#include "core/srgb.h"
 #include "g2p/regions.h"
 
 namespace g2p {
 namespace {
-
-float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
 
 int find(std::vector<int>& parent, int x) {
   while (parent[static_cast<std::size_t>(x)] != x) {
@@ -50,8 +49,8 @@ FaceColours face_colours(const Mesh& mesh, const std::vector<View>& views) {
         if (base)
           c = {v.base_color.at(x, y, 0), v.base_color.at(x, y, 1), v.base_color.at(x, y, 2)};
         else
-          c = {srgb_to_linear(v.rgb.at(x, y, 0) / 255.f), srgb_to_linear(v.rgb.at(x, y, 1) / 255.f),
-               srgb_to_linear(v.rgb.at(x, y, 2) / 255.f)};
+          c = {detail::srgb_to_linear(v.rgb.at(x, y, 0) / 255.f), detail::srgb_to_linear(v.rgb.at(x, y, 1) / 255.f),
+               detail::srgb_to_linear(v.rgb.at(x, y, 2) / 255.f)};
         sum[static_cast<std::size_t>(f)] += c;
         out.pixels[static_cast<std::size_t>(f)] += 1.f;
       }

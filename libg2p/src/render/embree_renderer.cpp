@@ -13,8 +13,9 @@
 #include <memory>
 #include <mutex>
 
-#include "backends.h"
-#include "shading.h"
+#include "core/srgb.h"
+#include "render/backends.h"
+#include "render/shading.h"
 
 namespace g2p {
 namespace {

@@ -15,11 +15,13 @@
 //   ambient: a sky/ground hemisphere (0.25 above, 0.10 below, world +Z up) for
 //   the diffuse part and a uniform 0.35 environment for the specular part, so
 //   metals are never black. No shadows.
-#include "shading.h"
+#include "render/shading.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+
+#include "core/srgb.h"
 
 namespace g2p::detail {
 namespace {
@@ -50,22 +52,6 @@ int wrap(int i, int n, WrapMode mode) {
 constexpr float kSky = 0.25f, kGround = 0.10f, kEnvironment = 0.35f;
 
 }  // namespace
-
-float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-
-float linear_to_srgb(float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f; }
-
-std::uint8_t linear_to_srgb8(float c) {
-  // 4096-entry table: the inverse transfer function is too slow per pixel.
-  static const std::array<std::uint8_t, 4097> lut = [] {
-    std::array<std::uint8_t, 4097> t{};
-    for (int i = 0; i <= 4096; ++i)
-      t[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(std::lround(255.f * linear_to_srgb(i / 4096.f)));
-    return t;
-  }();
-  if (!(c > 0.f)) return 0;  // also NaN
-  return lut[static_cast<std::size_t>(std::min(c, 1.f) * 4096.f + 0.5f)];
-}
 
 Eigen::Vector4f sample(const Texture& texture, const Eigen::Vector2f& uv, bool srgb) {
   if (!texture.image || texture.image->empty()) return Eigen::Vector4f::Ones();

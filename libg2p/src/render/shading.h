@@ -1,6 +1,7 @@
 // Private: what a renderer needs to turn a surface hit into colour. Texture
-// sampling through a material's UV transform and wrap modes, colour-space
-// conversion, and the studio lighting with a metallic-roughness BRDF.
+// sampling through a material's UV transform and wrap modes, and the studio
+// lighting with a metallic-roughness BRDF. (The sRGB transfer function is
+// core/srgb.h.)
 #pragma once
 
 #include <Eigen/Core>
@@ -11,11 +12,6 @@
 #include "g2p/render.h"
 
 namespace g2p::detail {
-
-// sRGB <-> linear (IEC 61966-2-1).
-float srgb_to_linear(float c);
-float linear_to_srgb(float c);
-std::uint8_t linear_to_srgb8(float c);  // clamps to [0, 1] first
 
 // Bilinear sample of a texture at mesh UV `uv` (image convention), after the
 // texture's uv_transform and wrap modes. `srgb` converts texels to linear

@@ -9,9 +9,9 @@
 
 #include "core/file_util.h"
 #include "core/json_text.h"
+#include "core/srgb.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
-#include "render/shading.h"
 
 namespace g2p {
 namespace {

@@ -1,6 +1,5 @@
-// g2p export SOURCE -o OUT: stages 5 and 6 and the simulation assets (MJCF,
-// URDF, SDF with per-part meshes, report.json). g2p validate DIR: the MJCF in
-// MuJoCo next to libg2p's numbers, and a drop onto a plane.
+// g2p validate DIR: the MJCF in MuJoCo next to libg2p's numbers, a drop onto
+// a plane, and (--contact) probe balls dropped onto the object.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,134 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "common.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
 #include "json_out.h"
-#include "stage_inputs.h"
 
 namespace g2p::cli {
 namespace {
-
-struct ExportArgs {
-  LabelledSourceArgs source;
-  CompleterArgs completer;
-  DecomposerArgs decomposer;
-  EstimatorArgs estimator;
-  std::string out, name;
-  std::vector<std::string> formats{"mjcf", "urdf", "sdf", "glb"};
-  bool fixed = false;
-};
-
-int run_export(const ExportArgs& args) {
-  int exit_code = kExitOk;
-  LabelledSourceArgs source = args.source;
-  source.textures = std::find(args.formats.begin(), args.formats.end(), "glb") != args.formats.end();
-  if (args.out.empty()) {
-    std::cerr << "g2p export: error: give -o OUT\n";
-    return kExitUsage;
-  }
-  // A `g2p properties` folder is used as it is; any other source runs stages 5 and 6 first.
-  Result<PropertiesOutput> previous = Status::NotFound("");
-  // With --overrides, the stages after the change run again: complete and
-  // properties when a class changes, properties alone otherwise.
-  if (is_properties_folder(args.source.source)) {
-    previous = load_properties_output("export", args.source.source, exit_code);
-    if (!previous.ok()) return exit_code;
-    LabelledObject& object = previous->object;
-    if (!args.source.overrides.empty()) {
-      const std::size_t known = object.overrides.notes.size();  // printed while loading
-      object.overrides.changed_classes = false;                 // the folder's closed parts fit what was loaded
-      if (!apply_overrides_file("export", args.source.overrides, object.model.mesh, object.table, object.faces,
-                                object.overrides, exit_code)
-               .ok())
-        return exit_code;
-      finish_overrides(object.model.mesh.num_faces(), object.faces.parts, object.faces.labels, object.table,
-                       object.overrides);
-      for (std::size_t i = known; i < object.overrides.notes.size(); ++i)
-        std::cout << "correction: " << object.overrides.notes[i] << "\n";
-      if (object.overrides.changed_classes) {
-        std::cout << "classes changed: closing the parts again\n";
-        Result<Completion> done = run_completion("export", args.completer, object, exit_code);
-        if (!done.ok()) return exit_code;
-        previous->completion = std::move(*done);
-      } else {
-        std::cout << "using the closed parts of " << args.source.source << "; estimating the properties again\n";
-      }
-      Result<PropertiesReport> report =
-          run_estimation("export", args.estimator, object, previous->completion, exit_code);
-      if (!report.ok()) return exit_code;
-      previous->report = std::move(*report);
-    } else {
-      std::cout << "using the closed parts and properties of " << args.source.source << "\n";
-    }
-  } else {
-    Result<LabelledObject> loaded = load_labelled_source("export", source, exit_code);
-    if (!loaded.ok()) return exit_code;
-    PropertiesOutput fresh;
-    fresh.object = std::move(*loaded);
-    Result<Completion> done = run_completion("export", args.completer, fresh.object, exit_code);
-    if (!done.ok()) return exit_code;
-    Result<PropertiesReport> report = run_estimation("export", args.estimator, fresh.object, *done, exit_code);
-    if (!report.ok()) return exit_code;
-    fresh.completion = std::move(*done);
-    fresh.report = std::move(*report);
-    previous = std::move(fresh);
-  }
-  const LabelledObject* object = &previous->object;
-  const Completion* done = &previous->completion;
-  const PropertiesReport* report = &previous->report;
-  namespace fs = std::filesystem;
-  std::string name = args.name;
-  if (name.empty()) {
-    name = fs::path(object->model.info.path).stem().string();  // the model file's stem
-    if (name.empty()) name = "object";
-  }
-  Result<BackendSettings> settings = parse_settings(args.decomposer.settings);
-  if (!settings.ok()) {
-    std::cerr << "g2p export: error: --decompose-set: " << settings.status().message() << "\n";
-    return kExitUsage;
-  }
-  if (Status valid = validate(args.decomposer.options); !valid.ok()) {
-    std::cerr << "g2p export: error: " << valid.message() << "\n";
-    return kExitUsage;
-  }
-  Result<std::unique_ptr<Decomposer>> decomposer = make_decomposer(args.decomposer.name, *settings);
-  if (!decomposer.ok()) {
-    std::cerr << "g2p export: error: --decomposer: " << decomposer.status().to_string() << "\n";
-    return kExitUsage;
-  }
-  const std::vector<ConvexDecomposition> collision = decompose_parts(
-      *done, **decomposer, args.decomposer.options, args.decomposer.name, &object->model.mesh, &object->faces.parts);
-  Result<SimulationAsset> asset =
-      make_asset(name, object->model.mesh, object->faces.parts, *done, *report, object->table, collision);
-  if (!asset.ok()) {
-    std::cerr << "g2p export: error: " << asset.status().to_string() << "\n";
-    return kExitFailure;
-  }
-  ExportOptions options;
-  options.free_joint = !args.fixed;
-  std::vector<std::string> engine_formats;
-  bool glb = false;
-  for (const std::string& f : args.formats) {
-    if (f == "glb")
-      glb = true;
-    else
-      engine_formats.push_back(f);
-  }
-  Status s = write_asset(args.out, *asset, engine_formats, options);
-  if (s.ok() && glb) s = write_glb(args.out + "/" + asset->name + ".glb", object->model, object->faces.parts, *asset);
-  if (s.ok()) s = write_asset_report(args.out + "/report.json", *report, *asset, object->table);
-  if (s.ok()) s = write_overrides(args.out, object->overrides, object->table);
-  if (!s.ok()) {
-    std::cerr << "g2p export: error: " << s.to_string() << "\n";
-    return kExitFailure;
-  }
-  std::printf("exported '%s': %zu parts, %.4g kg, centre of mass (%.4g %.4g %.4g) m -> %s\n", asset->name.c_str(),
-              asset->parts.size(), asset->total.mass_kg, asset->total.center_of_mass.x(),
-              asset->total.center_of_mass.y(), asset->total.center_of_mass.z(), args.out.c_str());
-  for (const std::string& n : asset->notes) std::printf("  note: %s\n", n.c_str());
-  return kExitOk;
-}
 
 struct ValidateArgs {
   std::string dir;
@@ -292,22 +170,7 @@ int run_validate(const ValidateArgs& args) {
 
 }  // namespace
 
-void add_export_command(CLI::App& app, Command& run) {
-  auto args = std::make_shared<ExportArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "export", "Close the parts, estimate their properties and write MJCF, URDF and SDF assets (stages 5, 6, export)");
-  add_labelled_source_flags(cmd, args->source);
-  cmd->add_option("-o,--output", args->out, "Output folder")->required();
-  cmd->add_option("--name", args->name, "Model name (default: the model file's stem)");
-  cmd->add_option("--format", args->formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
-  cmd->add_flag("--fixed", args->fixed, "MJCF: fix the body to the world instead of a free joint");
-  add_completer_flags(cmd, args->completer);
-  add_decomposer_flags(cmd, args->decomposer);
-  add_estimator_flags(cmd, args->estimator);
-  cmd->callback([args, &run] { run = [args] { return run_export(*args); }; });
-
+void add_validate_command(CLI::App& app, Command& run) {
   auto vargs = std::make_shared<ValidateArgs>();
   CLI::App* v = app.add_subcommand(
       "validate", "Load an exported MJCF in MuJoCo, compare, and drop it on a plane (--contact: drop balls onto it)");

@@ -1,4 +1,4 @@
-#include "complete/segment_tester.h"
+#include "core/segment_tester.h"
 
 #include <embree3/rtcore.h>
 

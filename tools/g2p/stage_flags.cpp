@@ -1,0 +1,158 @@
+#include "stage_flags.h"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "g2p/overrides.h"
+#if defined(G2P_CLI_WITH_CGAL)
+#include "g2p/complete_cgal.h"
+#endif
+
+namespace g2p::cli {
+
+void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& default_name) {
+  args.name = default_name;
+  cmd->add_option("--refiner", args.name,
+                  "Refiner: none, smooth, regions, vlm (vlm needs --refine-set model=NAME --refine-set url=URL); "
+                  "default " +
+                      default_name);
+  cmd->add_option("--refine-set", args.settings,
+                  "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps; vlm: url, model, "
+                  "api_key_env, timeout, retries, backoff, max_response_bytes, prompt_file, max_views)");
+}
+
+void add_completer_flags(CLI::App* cmd, CompleterArgs& args) {
+  cmd->add_option("--completer", args.name,
+                  "Stage 5 backend: partition (default), external, alpha-wrap and fill (CGAL builds)");
+  cmd->add_option("--complete-set", args.settings, "Completer setting KEY=VALUE (repeatable), e.g. resolution=200");
+  cmd->add_option("--fallback", args.fallback, "Backend for parts the completer fails, or 'none' (default partition)");
+}
+
+void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args) {
+  cmd->add_option("--estimator", args.name, "Stage 6 backend: table (default) or vlm");
+  cmd->add_option("--estimate-set", args.settings,
+                  "Estimator setting KEY=VALUE (repeatable), e.g. model=qwen2.5-vl url=http://host/v1");
+}
+
+void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
+  cmd->add_option("--decomposer", args.name,
+                  "Collision geometry: voxel-cut (default: convex decomposition), hull (one convex hull per part)");
+  cmd->add_option("--decompose-set", args.settings,
+                  "Decomposer setting KEY=VALUE (repeatable), e.g. resolution=96 (voxel-cut: resolution, error, cuts)");
+  cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256, default 16)");
+  cmd->add_option("--hull-vertices", args.options.max_vertices_per_hull,
+                  "Vertices per convex hull at most (4-255, default 64; engines cap hulls at 255)");
+  cmd->add_option(
+      "--min-concavity", args.options.min_depth_m,
+      "Leave concavities shallower than this alone, in metres (default 0: 1 % of the object's bounding-box diagonal)");
+}
+
+void add_export_flags(CLI::App* cmd, ExportArgs& args) {
+  cmd->add_option("--name", args.name, "Asset name (default: the model file's stem)");
+  cmd->add_option("--format", args.formats, "Formats: mjcf, urdf, sdf, glb (comma-separated; default all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"mjcf", "urdf", "sdf", "glb"}));
+  cmd->add_flag("--fixed", args.fixed, "MJCF: fix the body to the world instead of a free joint");
+}
+
+void add_overrides_flag(CLI::App* cmd, std::string& path) {
+  cmd->add_option("--overrides", path,
+                  "Corrections to apply (JSON from summary.html's 3D view, docs/pipeline.md#overrides): classes, "
+                  "solid/hollow, wall thickness, density, contents per part or face");
+}
+
+Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs) {
+  BackendSettings s;
+  for (const std::string& p : pairs) {
+    const std::size_t eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) return Status::InvalidArgument("expected KEY=VALUE, got '" + p + "'");
+    s[p.substr(0, eq)] = p.substr(eq + 1);
+  }
+  return s;
+}
+
+Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
+  PipelineOptions o;
+  Result<ImportOptions> import = import_options(args.import);
+  if (!import.ok()) return import.status();
+  o.import = *import;
+  o.anonymize_names = args.anonymize;
+  o.base_color_only = args.base_color_only;
+  if (args.soft) o.project.vote.mode = VoteMode::kSoft;
+  Result<ViewOptions> views = view_options(args.views);
+  if (!views.ok()) return views.status();
+  o.views = *views;
+  o.renderer.name = args.views.renderer;
+  struct StageFlags {
+    BackendChoice* choice;
+    const std::string* name;
+    const std::vector<std::string>* settings;
+    const char* flag;
+  };
+  const StageFlags stages[] = {{&o.identifier, &args.identify.name, &args.identify.settings, "--identify-set"},
+                               {&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
+                               {&o.refiner, &args.refiner.name, &args.refiner.settings, "--refine-set"},
+                               {&o.completer, &args.completer.name, &args.completer.settings, "--complete-set"},
+                               {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"},
+                               {&o.decomposer, &args.decomposer.name, &args.decomposer.settings, "--decompose-set"}};
+  for (const StageFlags& s : stages) {
+    Result<BackendSettings> settings = parse_settings(*s.settings);
+    if (!settings.ok()) return settings.status().with_context(s.flag);
+    *s.choice = BackendChoice{*s.name, *settings};
+  }
+  if (args.refiner.name == "none" && !args.refiner.settings.empty())
+    return Status::InvalidArgument("--refine-set needs a --refiner other than none");
+  // --vlm-url/--vlm-model go to every stage that asks a vision-language model.
+  if (!args.vlm_url.empty() || !args.vlm_model.empty()) {
+    bool used = false;
+    for (BackendChoice* c : {&o.identifier, &o.refiner, &o.estimator}) {
+      if (c->name != "vlm") continue;
+      used = true;
+      if (!args.vlm_url.empty()) c->settings.emplace("url", args.vlm_url);
+      if (!args.vlm_model.empty()) c->settings.emplace("model", args.vlm_model);
+    }
+    if (!used)
+      return Status::InvalidArgument(
+          "--vlm-url and --vlm-model need --identifier vlm, --refiner vlm or --estimator vlm");
+  }
+  o.object = args.identify.object;
+  Result<SizePolicy> size_policy = parse_size_policy(args.identify.size_from);
+  if (!size_policy.ok()) return size_policy.status();
+  o.size_policy = *size_policy;
+  o.kind_confidence = args.identify.kind_confidence;
+  o.kind_prior = args.identify.kind_prior;
+  o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
+  o.decompose = args.decomposer.options;
+  if (!(args.memory_limit_gib >= 0))
+    return Status::InvalidArgument("--memory-limit must be 0 (the machine's memory) or more GiB");
+  o.memory_limit_bytes = static_cast<std::size_t>(args.memory_limit_gib * 1024.0 * 1024.0 * 1024.0);
+  G2P_RETURN_IF_ERROR(validate(o.decompose));
+  o.formats = args.export_args.formats;
+  o.name = args.export_args.name;
+  o.export_options.free_joint = !args.export_args.fixed;
+  return o;
+}
+
+Result<Pipeline> make_pipeline(const PipelineArgs& args) {
+#if defined(G2P_CLI_WITH_CGAL)
+  (void)register_cgal_completers();
+#endif
+  Result<PipelineOptions> options = pipeline_options(args);
+  if (!options.ok()) return options.status();
+  Pipeline pipeline(std::move(*options));
+  if (!args.materials.empty()) {
+    Result<MaterialTable> table = MaterialTable::load(args.materials);
+    if (!table.ok()) return table.status().with_context("--materials");
+    pipeline.set_material_table(std::move(*table));
+  }
+  if (!args.overrides.empty()) {
+    Result<Overrides> overrides = read_overrides(args.overrides, pipeline.material_table());
+    if (!overrides.ok()) return Status::InvalidArgument("--overrides " + overrides.status().message());
+    pipeline.options().overrides = std::move(*overrides);
+  }
+  G2P_RETURN_IF_ERROR(pipeline.prepare());
+  return pipeline;
+}
+
+}  // namespace g2p::cli

@@ -1,0 +1,85 @@
+// The flags of the pipeline's stages, one group per stage, and the library
+// options they make: g2p run, project, refine, complete, properties, export
+// and batch register the groups they take; pipeline_options() turns all of
+// them into one PipelineOptions (a group a command does not take keeps the
+// library's default, which the flags' defaults are).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "common.h"
+#include "g2p/pipeline.h"
+
+namespace g2p::cli {
+
+// --refiner, --refine-set.
+struct RefineArgs {
+  std::string name = PipelineOptions{}.refiner.name;
+  std::vector<std::string> settings;
+};
+void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& default_name);
+
+// --completer, --complete-set and --fallback.
+struct CompleterArgs {
+  std::string name = PipelineOptions{}.completer.name;
+  std::vector<std::string> settings;
+  std::string fallback = PipelineOptions{}.completion_fallback;
+};
+void add_completer_flags(CLI::App* cmd, CompleterArgs& args);
+
+// --estimator and --estimate-set.
+struct EstimatorArgs {
+  std::string name = PipelineOptions{}.estimator.name;
+  std::vector<std::string> settings;
+};
+void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args);
+
+// --decomposer, --decompose-set, --max-hulls, --hull-vertices, --min-concavity.
+struct DecomposerArgs {
+  std::string name = PipelineOptions{}.decomposer.name;
+  std::vector<std::string> settings;
+  DecomposeOptions options;
+};
+void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args);
+
+// --name, --format, --fixed.
+struct ExportArgs {
+  std::string name;
+  std::vector<std::string> formats = PipelineOptions{}.formats;
+  bool fixed = false;
+};
+void add_export_flags(CLI::App* cmd, ExportArgs& args);
+
+// --overrides FILE (g2p/overrides.h, docs/pipeline.md#overrides).
+void add_overrides_flag(CLI::App* cmd, std::string& path);
+
+// Every stage's flags.
+struct PipelineArgs {
+  std::string materials, overrides;
+  ImportArgs import;
+  ViewArgs views;
+  IdentifyArgs identify;
+  SegmenterArgs segmenter;
+  RefineArgs refiner;
+  CompleterArgs completer;
+  EstimatorArgs estimator;
+  DecomposerArgs decomposer;
+  ExportArgs export_args;
+  std::string vlm_url, vlm_model;
+  bool soft = false, anonymize = false, base_color_only = false;
+  double memory_limit_gib = 0.0;
+};
+
+// The options the flags ask for; a bad value fails naming its flag.
+Result<PipelineOptions> pipeline_options(const PipelineArgs& args);
+
+// A pipeline with the flags' options, --materials and --overrides loaded;
+// prepare()d, so unknown backends and settings fail here, before any work.
+Result<Pipeline> make_pipeline(const PipelineArgs& args);
+
+// KEY=VALUE pairs as BackendSettings.
+Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs);
+
+}  // namespace g2p::cli

@@ -1,0 +1,245 @@
+// The stage commands: g2p project MODEL, then g2p refine, complete,
+// properties and export on its folder (or on a model file with its ground
+// truth, --truth). Each is the library's pipeline run from a first to a last
+// stage (Pipeline::run_file, Pipeline::resume), written through
+// write_pipeline_output like `g2p run`: a folder advanced command by command
+// holds what one `g2p run` with the same flags holds.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "common.h"
+#include "g2p/folder.h"
+#include "g2p/pipeline.h"
+#include "stage_flags.h"
+
+namespace g2p::cli {
+namespace {
+
+// One stage command: where it starts and stops, and its flags.
+struct StageCommand {
+  std::string name;              // "refine"
+  Stage first = Stage::kRefine;  // where it resumes a folder (project: from the model)
+  Stage last = Stage::kRefine;   // where it stops
+  std::string source, out;       // SOURCE (folder or model file), -o
+  std::string truth, key;        // a model file's ground truth (--truth, --key)
+  bool overwrite = false;
+  std::vector<std::string> mesh_formats{"obj"};  // completed/ (g2p complete --format)
+  PipelineArgs pipeline;
+};
+
+int fail(const StageCommand& c, const Status& s, bool setup = false) {
+  // Flags: a bad value, and in setting up the pipeline an unknown backend name.
+  const bool usage = s.code() == StatusCode::kInvalidArgument || (setup && s.code() == StatusCode::kNotFound);
+  // A corrections file that does not fit the object is the user's input, like a bad flag.
+  const std::string& m = s.message();
+  std::size_t at = m.find(": overrides entry ");
+  if (at == std::string::npos) at = m.find(": overrides: ");
+  if (!c.pipeline.overrides.empty() && usage && at != std::string::npos) {
+    std::cerr << "g2p " << c.name << ": --overrides " << c.pipeline.overrides << ": " << m.substr(at + 2)
+              << "; nothing was written\n";
+    return kExitUsage;
+  }
+  std::cerr << "g2p " << c.name << ": error: " << (usage ? s.message() : s.to_string()) << "\n";
+  return usage ? kExitUsage : kExitFailure;
+}
+
+void print_result(const StageCommand& c, const PipelineResult& r, const std::string& out) {
+  for (const std::string& w : r.warnings) std::cerr << "g2p " << c.name << ": warning: " << w << "\n";
+  for (const std::string& n : r.overrides_applied) std::cout << "correction: " << n << "\n";
+  for (const StageReport& s : r.stages)
+    std::printf("  %-10s %-10s %6.2f s%s\n", to_string(s.stage), s.backend.c_str(), s.seconds,
+                s.ok ? "" : "  FAILED (skipped)");
+  const MaterialTable& table = r.table;
+  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) {
+    const Part& p = r.projection.parts[i];
+    std::printf("  part %zu: %s, %zu faces, %.6g m^2", i,
+                table.valid_label(p.label) ? table[p.label].name.c_str() : "(unknown)", p.faces.size(), p.area_m2);
+    if (i < r.completion.parts.size())
+      std::printf(", %s %.6g cm^3", r.completion.parts[i].ok ? "closed" : "NOT CLOSED",
+                  r.completion.parts[i].checks.volume_m3 * 1e6);
+    if (i < r.properties.parts.size()) {
+      const PartReport& pr = r.properties.parts[i];
+      std::printf(", %s, %.4g kg/m^3 (%s), %.4g kg", to_string(pr.properties.structure), pr.properties.density_kg_m3,
+                  to_string(pr.properties.density_source), pr.mass.mass_kg);
+    }
+    std::printf("\n");
+  }
+  if (r.last_stage >= Stage::kProperties)
+    std::printf("object: %.4g kg (range %.3g - %.3g), centre of mass (%.4g %.4g %.4g) m\n", r.properties.object.mass_kg,
+                r.properties.mass_min_kg, r.properties.mass_max_kg, r.properties.object.center_of_mass.x(),
+                r.properties.object.center_of_mass.y(), r.properties.object.center_of_mass.z());
+  std::printf("g2p %s: %zu parts -> %s\n", c.name.c_str(), r.projection.parts.size(), out.c_str());
+}
+
+int run_stage_command(const StageCommand& c) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const bool folder = fs::is_directory(c.source, ec);
+  if (c.first != Stage::kRender && !folder && c.truth.empty())
+    return fail(c, Status::InvalidArgument(c.source + " is not a folder; for a model file give its ground truth with "
+                                                      "--truth"));
+  if (folder && !c.truth.empty())
+    return fail(c, Status::InvalidArgument("--truth is for model files; " + c.source + " is a folder"));
+  const ImportArgs& import = c.pipeline.import;
+  const ImportArgs as_made;
+  if (folder && c.first != Stage::kRender &&
+      (import.unit != as_made.unit || import.height != as_made.height || import.longest_side != as_made.longest_side ||
+       import.up != as_made.up || import.keep_axes || import.no_textures || import.lenient))
+    return fail(c, Status::InvalidArgument("the import flags (--unit, --height, --longest-side, --up, --keep-axes, "
+                                           "--no-textures, --lenient) are for a model file; " +
+                                           c.source +
+                                           " keeps the ones it was made with (run g2p project again "
+                                           "to change them)"));
+  if (folder && c.first != Stage::kRender)  // not a g2p folder, or an older one: said before anything else
+    if (Result<FolderManifest> m = read_folder_manifest(c.source); !m.ok()) return fail(c, m.status());
+  // A folder is advanced in place unless -o names another; a new folder needs -o.
+  const std::string out = !c.out.empty() ? c.out : folder && c.first != Stage::kRender ? c.source : "";
+  if (out.empty()) return fail(c, Status::InvalidArgument("give -o OUT for a model file"));
+  OutputOptions output;
+  output.written_by = "g2p " + c.name;
+  output.mesh_formats = c.mesh_formats;
+  std::error_code same_error;
+  const bool in_place = folder && fs::exists(out, ec) && fs::equivalent(out, c.source, same_error);
+  output.overwrite = c.overwrite || in_place;
+  output.input_path = folder ? "" : c.source;
+  if (Status s = check_output_folder(out, output); !s.ok())
+    return fail(c, Status::InvalidArgument("-o " + s.message() + (c.overwrite ? "" : " (--overwrite replaces it)")));
+
+  Result<Pipeline> pipeline = make_pipeline(c.pipeline);
+  if (!pipeline.ok()) return fail(c, pipeline.status(), /*setup=*/true);
+  Result<PipelineResult> result = Status::Internal("not run");
+  if (c.first == Stage::kRender) {  // g2p project: from the model file
+    pipeline->options().last_stage = c.last;
+    result = pipeline->run_file(c.source);
+  } else if (folder) {
+    result = pipeline->resume(c.source, c.first, c.last);
+  } else {
+    Result<PipelineResult> labelled =
+        labelled_from_truth(c.source, c.truth, c.key, pipeline->material_table(), pipeline->options().import);
+    if (!labelled.ok()) return fail(c, labelled.status());
+    result = pipeline->resume(std::move(*labelled), Stage::kComplete, c.last);
+  }
+  if (!result.ok()) return fail(c, result.status());
+  if (Status s = write_pipeline_output(out, *result, pipeline->options(), output); !s.ok()) return fail(c, s);
+  print_result(c, *result, out);
+  if (!c.truth.empty() && result->last_stage >= Stage::kProperties) {
+    const std::string key = c.key.empty() ? fs::path(c.source).stem().string() : c.key;
+    Result<std::array<double, 2>> range = truth_mass_range(c.truth, key);
+    const double m = result->properties.object.mass_kg;
+    if (range.ok())
+      std::printf("plausible mass %.4g - %.4g kg (%s): %s\n", (*range)[0], (*range)[1], c.truth.c_str(),
+                  m >= (*range)[0] && m <= (*range)[1] ? "inside" : "OUTSIDE");
+  }
+  for (const CompletedPart& p : result->completion.parts)
+    if (!p.ok) {
+      std::cerr << "g2p " << c.name << ": part " << p.part << " failed its checks (see completed/completion.json)\n";
+      return kExitFailure;
+    }
+  return kExitOk;
+}
+
+// SOURCE, -o, --overwrite and, for a model file, --truth and --key.
+void add_source_flags(CLI::App* cmd, StageCommand& c) {
+  cmd->add_option("source", c.source,
+                  "Output folder of an earlier stage command or g2p run, or a model file together with --truth")
+      ->required();
+  cmd->add_option("-o,--output", c.out,
+                  "Output folder (default: SOURCE itself, advanced in place; written whole and renamed into place)");
+  cmd->add_flag("--overwrite", c.overwrite, "Replace an existing -o folder (only once the new one is complete)");
+  cmd->add_option("--truth", c.truth, "For a model file: labels.json with its ground-truth material classes");
+  cmd->add_option("--key", c.key, "Entry of --truth to use (default: the model file's stem)");
+  cmd->add_option("--materials", c.pipeline.materials,
+                  "For a model file: material table JSON (default: the paper's 12 classes; a folder keeps its own)");
+  add_overrides_flag(cmd, c.pipeline.overrides);
+  add_import_flags(cmd, c.pipeline.import);
+}
+
+CLI::App* add_stage(CLI::App& app, Command& run, const std::string& name, const std::string& help, Stage first,
+                    Stage last, std::shared_ptr<StageCommand>& c) {
+  c = std::make_shared<StageCommand>();
+  c->name = name;
+  c->first = first;
+  c->last = last;
+  CLI::App* cmd = app.add_subcommand(name, help);
+  std::shared_ptr<StageCommand> captured = c;
+  cmd->callback([captured, &run] { run = [captured] { return run_stage_command(*captured); }; });
+  return cmd;
+}
+
+}  // namespace
+
+void add_project_command(CLI::App& app, Command& run) {
+  std::shared_ptr<StageCommand> c;
+  CLI::App* cmd = add_stage(app, run, "project",
+                            "Render, identify, segment and vote the labels onto the mesh's faces; parts (with "
+                            "--refiner, refine them too)",
+                            Stage::kRender, Stage::kProject, c);
+  PipelineArgs& p = c->pipeline;
+  cmd->add_option("model", c->source, "Model file")->required();
+  cmd->add_option("-o,--output", c->out, "Output folder (must not exist unless --overwrite)")->required();
+  cmd->add_flag("--overwrite", c->overwrite, "Replace an existing output folder (only once the new one is complete)");
+  cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
+  cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
+  cmd->add_flag("--base-color-only", p.base_color_only,
+                "Keep only base colour, metallic and roughness at glTF's default of 1 (what generators emit)");
+  cmd->add_flag("--soft", p.soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
+  add_import_flags(cmd, p.import);
+  add_view_flags(cmd, p.views);
+  add_identify_flags(cmd, p.identify);
+  add_segmenter_flags(cmd, p.segmenter);
+  add_refiner_flags(cmd, p.refiner, "none");
+  cmd->callback([c, &run] {
+    c->last = c->pipeline.refiner.name == "none" ? Stage::kProject : Stage::kRefine;
+    run = [c] { return run_stage_command(*c); };
+  });
+}
+
+void add_refine_command(CLI::App& app, Command& run) {
+  std::shared_ptr<StageCommand> c;
+  CLI::App* cmd = add_stage(app, run, "refine", "Refine the face labels of a g2p project or g2p run folder (stage 4)",
+                            Stage::kRefine, Stage::kRefine, c);
+  add_source_flags(cmd, *c);
+  add_refiner_flags(cmd, c->pipeline.refiner, "smooth");
+}
+
+void add_complete_command(CLI::App& app, Command& run) {
+  std::shared_ptr<StageCommand> c;
+  CLI::App* cmd = add_stage(app, run, "complete", "Close every part into a watertight volume (stage 5)",
+                            Stage::kComplete, Stage::kComplete, c);
+  add_source_flags(cmd, *c);
+  add_completer_flags(cmd, c->pipeline.completer);
+  cmd->add_option("--format", c->mesh_formats, "Formats of the closed parts in completed/: obj, ply, stl")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"obj", "ply", "stl"}));
+}
+
+void add_properties_command(CLI::App& app, Command& run) {
+  std::shared_ptr<StageCommand> c;
+  CLI::App* cmd = add_stage(app, run, "properties",
+                            "Close every part and estimate density, structure and mass properties (stages 5 and 6)",
+                            Stage::kComplete, Stage::kProperties, c);
+  add_source_flags(cmd, *c);
+  add_completer_flags(cmd, c->pipeline.completer);
+  add_estimator_flags(cmd, c->pipeline.estimator);
+}
+
+void add_export_command(CLI::App& app, Command& run) {
+  std::shared_ptr<StageCommand> c;
+  CLI::App* cmd = add_stage(app, run, "export",
+                            "Collision hulls and the simulation assets: MJCF, URDF, SDF, glTF (stages 5 and 6 first "
+                            "when the folder lacks them)",
+                            Stage::kDecompose, Stage::kExport, c);
+  add_source_flags(cmd, *c);
+  add_export_flags(cmd, c->pipeline.export_args);
+  add_completer_flags(cmd, c->pipeline.completer);
+  add_estimator_flags(cmd, c->pipeline.estimator);
+  add_decomposer_flags(cmd, c->pipeline.decomposer);
+  add_validate_command(app, run);
+}
+
+}  // namespace g2p::cli

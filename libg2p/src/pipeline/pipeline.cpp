@@ -131,6 +131,7 @@ struct Pipeline::Impl {
   Status run_stages(PipelineResult& r, RunContext& context, Stage first, Stage last);
   Status render_views(RunState& s);
   Status identify_object(RunState& s);
+  void assume_kind_size(PipelineResult& r, const std::string& said, StageReport& report) const;
   void prepare_class_prior(RunState& s) const;
   Status segment_views(RunState& s);
   Status project_labels(RunState& s);
@@ -582,6 +583,50 @@ void scale_run(PipelineResult& r, double s) {
 
 }  // namespace
 
+// A normalised mesh with no size given takes its kind's typical longest side,
+// when the kind is confident enough and the policy allows; the import's
+// warning says what was assumed, or why not.
+void Pipeline::Impl::assume_kind_size(PipelineResult& r, const std::string& said, StageReport& report) const {
+  ImportInfo& info = r.model.info;
+  if (!info.looks_normalised || info.scale_source != "file") return;
+  const PipelineOptions& o = options;
+  const Identification& ident = r.identification;
+  const bool confident = !r.kind.name.empty();
+  auto normalised_warning = [&info] {
+    return std::find_if(info.warnings.begin(), info.warnings.end(),
+                        [](const std::string& w) { return w.rfind("the model looks normalised", 0) == 0; });
+  };
+  const auto it = normalised_warning();
+  if (o.size_policy == SizePolicy::kKind && confident) {
+    const double longest = bounds(r.model.mesh).sizes().maxCoeff();
+    const double target = r.kind.typical_longest_side_m;
+    if (longest > 0.0 && std::isfinite(longest) && target > 0.0) {
+      scale_run(r, target / longest);
+      r.kind_scale = target / longest;
+      info.scale_source = "kind";
+      r.size_assumed_m = target;
+      const std::string text =
+          "the model looks normalised (its longest side was " + fixed(longest) + " m) and is identified as " + said +
+          ": it is scaled to a " + r.kind.name + "'s typical longest side, " + fixed(target) +
+          " m (the object table). Give the real size with --height or --longest-side, or keep the file's with "
+          "--size-from file (PipelineOptions::size_policy)";
+      if (it != info.warnings.end())
+        *it = text;
+      else
+        info.warnings.push_back(text);
+      report.notes.push_back("size assumed: longest side " + fixed(target) + " m, a " + r.kind.name + "'s");
+    }
+  } else if (it != info.warnings.end()) {
+    if (o.size_policy == SizePolicy::kFile)
+      *it += "; its size is kept as the file's (--size-from file)";
+    else if (ident.known())
+      *it += "; identified as " + said + ", below the " + fixed(100.0 * o.kind_confidence, "%.0f") +
+             " % needed to assume its size (--kind-confidence)";
+    else
+      *it += "; what the object is could not be told (give it with --object to assume its kind's size)";
+  }
+}
+
 Status Pipeline::Impl::identify_object(RunState& s) {
   PipelineResult& r = s.r;
   RunContext& context = s.context;
@@ -630,45 +675,7 @@ Status Pipeline::Impl::identify_object(RunState& s) {
                                          : std::string("unknown");
   report.notes.push_back("identified as " + said);
 
-  // A normalised mesh with no size given: the kind's typical longest side,
-  // when the kind is confident enough and the policy allows.
-  ImportInfo& info = r.model.info;
-  if (info.looks_normalised && info.scale_source == "file") {
-    const bool confident = k >= 0;
-    auto normalised_warning = [&info] {
-      return std::find_if(info.warnings.begin(), info.warnings.end(),
-                          [](const std::string& w) { return w.rfind("the model looks normalised", 0) == 0; });
-    };
-    const auto it = normalised_warning();
-    if (o.size_policy == SizePolicy::kKind && confident) {
-      const double longest = bounds(r.model.mesh).sizes().maxCoeff();
-      const double target = r.kind.typical_longest_side_m;
-      if (longest > 0.0 && std::isfinite(longest) && target > 0.0) {
-        scale_run(r, target / longest);
-        r.kind_scale = target / longest;
-        info.scale_source = "kind";
-        r.size_assumed_m = target;
-        const std::string text =
-            "the model looks normalised (its longest side was " + fixed(longest) + " m) and is identified as " + said +
-            ": it is scaled to a " + r.kind.name + "'s typical longest side, " + fixed(target) +
-            " m (the object table). Give the real size with --height or --longest-side, or keep the file's with "
-            "--size-from file (PipelineOptions::size_policy)";
-        if (it != info.warnings.end())
-          *it = text;
-        else
-          info.warnings.push_back(text);
-        report.notes.push_back("size assumed: longest side " + fixed(target) + " m, a " + r.kind.name + "'s");
-      }
-    } else if (it != info.warnings.end()) {
-      if (o.size_policy == SizePolicy::kFile)
-        *it += "; its size is kept as the file's (--size-from file)";
-      else if (ident.known())
-        *it += "; identified as " + said + ", below the " + fixed(100.0 * o.kind_confidence, "%.0f") +
-               " % needed to assume its size (--kind-confidence)";
-      else
-        *it += "; what the object is could not be told (give it with --object to assume its kind's size)";
-    }
-  }
+  assume_kind_size(r, said, report);
   G2P_RETURN_IF_ERROR(context.report(Stage::kIdentify, 1.0, ident.kind()));
   r.stages.push_back(clock.finish());
   r.peak_rss_bytes = std::max(r.peak_rss_bytes, r.stages.back().peak_rss_bytes);

@@ -36,7 +36,7 @@ struct CompletionInput {
   const MaterialTable* table = nullptr;      // optional: class names in messages and files
   // Optional: checked between the steps of a backend and between parts; a
   // status other than OK (cancellation) ends complete() with it.
-  StageProgress progress = nullptr;
+  StageProgress progress;
 
   Status report(double fraction, const std::string& message) const {
     return progress ? progress(fraction, message) : Status::Ok();

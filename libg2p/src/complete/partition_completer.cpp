@@ -757,7 +757,7 @@ void PartitionCompleter::close_small_parts(const CompletionInput& input, const P
     if (boxes.hi[static_cast<std::size_t>(p)].x() >= 0) continue;
     const Mesh patch = part_patch(*input.mesh, parts[static_cast<std::size_t>(p)]);
     const std::vector<Part> alone = {whole_patch_part(patch, parts[static_cast<std::size_t>(p)])};
-    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table});
+    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table, nullptr});
     if (!own.ok() || own->parts.empty() || own->parts[0].mesh.num_faces() == 0) {
       out.notes.push_back("partition: the part is smaller than a cell and could not be closed on its own" +
                           (own.ok() ? std::string() : ": " + own.status().message()));

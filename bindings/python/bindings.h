@@ -190,6 +190,13 @@ T from_kwargs(const py::kwargs& kwargs) {
 
 // ---- Per-file binding functions ------------------------------------------------------
 
+// Backend settings from Python: a dict (or BackendSettings) and keyword
+// arguments, each value as --set writes it (True -> "on", 0.5 -> "0.5").
+BackendSettings settings_from_python(const py::handle& settings, const py::kwargs& kwargs);
+// A backend's described settings as a list of dicts (key, type, unit, range,
+// value, help).
+py::list settings_to_python(const std::vector<SettingInfo>& info);
+
 void bind_core(py::module_& m);         // core.cpp: errors' enums, Mesh, Model, materials, io
 void bind_stage_types(py::module_& m);  // stage_types.cpp: cameras, views, label maps, parts, results
 void bind_stages(py::module_& m);       // stages.cpp: the stage interfaces, registries, stage functions

@@ -67,16 +67,42 @@ py::array_t<std::int32_t> face_source_array(const Mesh& mesh) {
   return out;
 }
 
+// One value as --set writes it.
+std::string setting_text(const py::handle& v) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "on" : "off";
+  if (py::isinstance<py::float_>(v)) return py::str(py::repr(v));  // shortest round trip
+  return py::str(v);
+}
+
 }  // namespace
+
+BackendSettings settings_from_python(const py::handle& settings, const py::kwargs& kwargs) {
+  BackendSettings out;
+  if (!settings.is_none()) {
+    if (py::isinstance<BackendSettings>(settings)) {
+      out = settings.cast<BackendSettings>();
+    } else if (py::isinstance<py::dict>(settings)) {
+      for (const auto& item : settings.cast<py::dict>()) out[py::str(item.first)] = setting_text(item.second);
+    } else {
+      throw py::type_error("settings must be a dict of KEY: VALUE");
+    }
+  }
+  for (const auto& item : kwargs) out[py::str(item.first)] = setting_text(item.second);
+  return out;
+}
+
+py::list settings_to_python(const std::vector<SettingInfo>& info) {
+  py::list out;
+  for (const SettingInfo& i : info)
+    out.append(py::dict(py::arg("key") = i.key, py::arg("type") = i.type, py::arg("unit") = i.unit,
+                        py::arg("range") = i.range, py::arg("value") = i.value, py::arg("help") = i.help));
+  return out;
+}
 
 void bind_core(py::module_& m) {
   // Settings edited in place; a dict converts implicitly where a function takes them.
   py::bind_map<BackendSettings>(m, "BackendSettings", "Backend settings, KEY -> VALUE strings.")
-      .def(py::init([](const py::dict& d) {
-        BackendSettings s;
-        for (const auto& item : d) s[py::str(item.first)] = py::str(item.second);
-        return s;
-      }));
+      .def(py::init([](const py::dict& d) { return settings_from_python(d, py::kwargs()); }));
   py::implicitly_convertible<py::dict, BackendSettings>();
 
   py::enum_<Structure>(m, "Structure")

@@ -82,6 +82,9 @@ void bind_decompose(py::module_& m) {
       "a list of hulls, each a g2p.Mesh or an (N, 3) array of points (libg2p takes their convex hull). "
       "decompose_part checks the result and falls back to the part's single hull when it is invalid or raises.")
       .def(py::init<>())
+      .def(
+          "settings", [](Decomposer& d) { return settings_to_python(d.settings().info()); },
+          "Its settings with their current values: a list of dicts (key, type, unit, range, value, help).")
       .def("configure", [](Decomposer& d, const BackendSettings& settings) { throw_if_error(d.configure(settings)); })
       .def(
           "decompose",
@@ -98,10 +101,12 @@ void bind_decompose(py::module_& m) {
   m.def("decomposer_names", []() { return decomposer_registry().names(); });
   m.def(
       "make_decomposer",
-      [](const std::string& name, const BackendSettings& settings) {
-        return std::shared_ptr<Decomposer>(unwrap(make_decomposer(name, settings)));
+      [](const std::string& name, const py::object& settings, const py::kwargs& kwargs) {
+        return std::shared_ptr<Decomposer>(
+            unwrap(decomposer_registry().make(name, settings_from_python(settings, kwargs))));
       },
-      py::arg("name") = "voxel-cut", py::arg("settings") = BackendSettings{});
+      py::arg("name") = PipelineOptions{}.decomposer.name, py::arg("settings") = py::none(),
+      "A decomposer with its settings applied, as a dict or keywords (resolution=96).");
   m.def(
       "decompose_part",
       [](const Mesh& closed, const Decomposer& decomposer, const DecomposeOptions& options) {

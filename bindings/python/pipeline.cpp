@@ -230,10 +230,12 @@ void bind_pipeline(py::module_& m) {
 
   // ---- Options ----
   py::class_<BackendChoice>(m, "BackendChoice", "A backend by registry name plus its KEY=VALUE settings.")
-      .def(py::init([](std::string name, BackendSettings settings) {
-             return BackendChoice{std::move(name), std::move(settings)};
+      .def(py::init([](std::string name, const py::object& settings, const py::kwargs& kwargs) {
+             return BackendChoice{std::move(name), settings_from_python(settings, kwargs)};
            }),
-           py::arg("name"), py::arg("settings") = BackendSettings{})
+           py::arg("name"), py::arg("settings") = py::none(),
+           "BackendChoice('hybrid', colour=False, share=0.5): settings as a dict or keywords, checked by "
+           "Pipeline.prepare (g2p.backend_settings('hybrid') lists them)")
       .def_readwrite("name", &BackendChoice::name)
       .def_readwrite("settings", &BackendChoice::settings, "edited in place: choice.settings['key'] = 'value'")
       .def("__repr__", [](const BackendChoice& c) { return "<g2p.BackendChoice '" + c.name + "'>"; });

@@ -498,6 +498,9 @@ void bind_stages(py::module_& m) {
       "set_model(self, model, table), configure(self, settings) and warnings(self) (a list of str: what degraded, "
       "which the pipeline adds to PipelineResult.warnings).")
       .def(py::init<>())
+      .def(
+          "settings", [](Segmenter& s) { return settings_to_python(s.settings().info()); },
+          "Its settings with their current values: a list of dicts (key, type, unit, range, value, help).")
       .def("configure", [](Segmenter& s, const BackendSettings& settings) { throw_if_error(s.configure(settings)); })
       .def(
           "set_model",
@@ -534,6 +537,9 @@ void bind_stages(py::module_& m) {
       "dtype, one per face, or a g2p.RefineResult. A failure (an exception) keeps the projected labels; the "
       "pipeline reports the stage as failed and adds a warning.")
       .def(py::init<>())
+      .def(
+          "settings", [](Refiner& r) { return settings_to_python(r.settings().info()); },
+          "Its settings with their current values: a list of dicts (key, type, unit, range, value, help).")
       .def("configure", [](Refiner& r, const BackendSettings& settings) { throw_if_error(r.configure(settings)); })
       .def(
           "refine",
@@ -550,6 +556,9 @@ void bind_stages(py::module_& m) {
       "closed g2p.Mesh, (positions, triangles) or None (libg2p checks each one; attribute max_relative_distance, "
       "default 0.25, bounds its distance to the patch) or complete(self, input) returning a g2p.Completion.")
       .def(py::init<>())
+      .def(
+          "settings", [](Completer& c) { return settings_to_python(c.settings().info()); },
+          "Its settings with their current values: a list of dicts (key, type, unit, range, value, help).")
       .def("configure", [](Completer& c, const BackendSettings& settings) { throw_if_error(c.configure(settings)); })
       .def("complete", [](const Completer& c, const CompletionInputView& input) {
         const CompletionInput& in = input.get();
@@ -563,6 +572,9 @@ void bind_stages(py::module_& m) {
       "a dict of its fields (missing ones come from the material table's class; given ones are marked USER), "
       "e.g. {'density_kg_m3': 7850.0, 'structure': 'solid'}.")
       .def(py::init<>())
+      .def(
+          "settings", [](PropertyEstimator& e) { return settings_to_python(e.settings().info()); },
+          "Its settings with their current values: a list of dicts (key, type, unit, range, value, help).")
       .def("configure",
            [](PropertyEstimator& e, const BackendSettings& settings) { throw_if_error(e.configure(settings)); })
       .def("estimate", [](const PropertyEstimator& e, const PropertyInputView& input) {
@@ -572,6 +584,18 @@ void bind_stages(py::module_& m) {
       });
 
   // ---- Registries ----
+  m.def(
+      "backend_settings",
+      [](const std::string& name) {
+        py::list out;
+        for (const BackendSettingsInfo& b : unwrap(describe_backend_settings(name)))
+          out.append(py::dict(py::arg("stage") = to_string(b.stage), py::arg("backend") = b.backend,
+                              py::arg("settings") = settings_to_python(b.settings)));
+        return out;
+      },
+      py::arg("name"),
+      "The settings of the backends called NAME in any stage, of STAGE:NAME, or of 'all': a list of dicts "
+      "(stage, backend, settings: key, type, unit, range, value (the default), help).");
   m.def("renderer_names", []() { return renderer_registry().names(); });
   m.def("segmenter_names", []() { return segmenter_registry().names(); });
   m.def("refiner_names", []() { return refiner_registry().names(); });
@@ -580,31 +604,38 @@ void bind_stages(py::module_& m) {
   m.def(
       "make_renderer",
       [](const std::string& name) { return std::shared_ptr<Renderer>(unwrap(renderer_registry().create(name))); },
-      py::arg("name") = "embree");
+      py::arg("name") = PipelineOptions{}.renderer.name);
   m.def(
       "make_segmenter",
-      [](const std::string& name, const BackendSettings& settings) {
-        return std::shared_ptr<Segmenter>(unwrap(make_segmenter(name, settings)));
+      [](const std::string& name, const py::object& settings, const py::kwargs& kwargs) {
+        return std::shared_ptr<Segmenter>(
+            unwrap(segmenter_registry().make(name, settings_from_python(settings, kwargs))));
       },
-      py::arg("name") = "hybrid", py::arg("settings") = BackendSettings{});
+      py::arg("name") = PipelineOptions{}.segmenter.name, py::arg("settings") = py::none(),
+      "A backend with its settings applied, as a dict or keywords (colour=False, share=0.5).");
   m.def(
       "make_refiner",
-      [](const std::string& name, const BackendSettings& settings) {
-        return std::shared_ptr<Refiner>(unwrap(make_refiner(name, settings)));
+      [](const std::string& name, const py::object& settings, const py::kwargs& kwargs) {
+        return std::shared_ptr<Refiner>(unwrap(refiner_registry().make(name, settings_from_python(settings, kwargs))));
       },
-      py::arg("name") = "smooth", py::arg("settings") = BackendSettings{});
+      py::arg("name") = PipelineOptions{}.refiner.name, py::arg("settings") = py::none(),
+      "A backend with its settings applied, as a dict or keywords (colour=False, share=0.5).");
   m.def(
       "make_completer",
-      [](const std::string& name, const BackendSettings& settings) {
-        return std::shared_ptr<Completer>(unwrap(make_completer(name, settings)));
+      [](const std::string& name, const py::object& settings, const py::kwargs& kwargs) {
+        return std::shared_ptr<Completer>(
+            unwrap(completer_registry().make(name, settings_from_python(settings, kwargs))));
       },
-      py::arg("name") = "partition", py::arg("settings") = BackendSettings{});
+      py::arg("name") = PipelineOptions{}.completer.name, py::arg("settings") = py::none(),
+      "A backend with its settings applied, as a dict or keywords (colour=False, share=0.5).");
   m.def(
       "make_estimator",
-      [](const std::string& name, const BackendSettings& settings) {
-        return std::shared_ptr<PropertyEstimator>(unwrap(make_estimator(name, settings)));
+      [](const std::string& name, const py::object& settings, const py::kwargs& kwargs) {
+        return std::shared_ptr<PropertyEstimator>(
+            unwrap(estimator_registry().make(name, settings_from_python(settings, kwargs))));
       },
-      py::arg("name") = "table", py::arg("settings") = BackendSettings{});
+      py::arg("name") = PipelineOptions{}.estimator.name, py::arg("settings") = py::none(),
+      "A backend with its settings applied, as a dict or keywords (colour=False, share=0.5).");
 
   // ---- Stages as functions ----
   m.def(

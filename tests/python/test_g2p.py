@@ -667,6 +667,41 @@ class DecomposeTest(unittest.TestCase):
             g2p.Pipeline(quick_options(decomposer=g2p.BackendChoice("no-such-decomposer"))).run_file(HAMMER)
 
 
+class BackendSettingsTest(unittest.TestCase):
+    """Settings as the backends describe them (docs/settings.md)."""
+
+    def test_listed_with_types_ranges_and_defaults(self):
+        hybrid = g2p.backend_settings("hybrid")
+        self.assertEqual([(b["stage"], b["backend"]) for b in hybrid], [("segment", "hybrid")])
+        share = next(s for s in hybrid[0]["settings"] if s["key"] == "share")
+        self.assertEqual((share["type"], share["range"], share["value"]), ("number", "(0, 1]", "0.99"))
+        self.assertTrue(share["help"])
+        stages = {b["stage"] for b in g2p.backend_settings("vlm")}
+        self.assertEqual(stages, {"identify", "refine", "properties"})
+        with self.assertRaises(g2p.NotFoundError):
+            g2p.backend_settings("no-such-backend")
+
+    def test_keywords_as_the_command_line_writes_them(self):
+        d = g2p.make_decomposer("voxel-cut", resolution=96, error=0.05)
+        values = {s["key"]: s["value"] for s in d.settings()}
+        self.assertEqual((values["resolution"], values["error"]), ("96", "0.05"))
+        s = g2p.make_segmenter("pbr", names=False)
+        self.assertEqual({x["key"]: x["value"] for x in s.settings()}["names"], "off")
+        choice = g2p.BackendChoice("hybrid", colour=False, share=0.5)
+        self.assertEqual(dict(choice.settings), {"colour": "off", "share": "0.5"})
+        # A bad keyword fails before any work and names what the setting takes.
+        with self.assertRaises(ValueError) as bad:
+            g2p.Pipeline(quick_options(segmenter=g2p.BackendChoice("hybrid", share=2))).prepare()
+        self.assertIn("share takes a number in (0, 1]", str(bad.exception))
+
+    def test_a_refused_setting_changes_nothing(self):
+        r = g2p.make_refiner("smooth")
+        before = r.settings()
+        with self.assertRaises(ValueError):
+            r.configure({"lambda": "3", "sweeps": "-1"})
+        self.assertEqual(r.settings(), before)
+
+
 class OverridesTest(unittest.TestCase):
     """Corrections from a file (docs/pipeline.md#overrides) on a run."""
 

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -221,7 +222,7 @@ TEST(ToolRun, BadFlagsAreUsageErrorsAndWriteNothing) {
     std::string flags, message;
   };
   for (const Case& c :
-       {Case{"--segmenter nope", "no backend named 'nope'"}, Case{"--complete-set resolution", "--complete-set"},
+       {Case{"--segmenter nope", "no segmenter named 'nope'"}, Case{"--complete-set resolution", "--complete-set"},
         Case{"--vlm-url http://127.0.0.1:9/v1", "--vlm-url"}, Case{"--format obj", "obj"}}) {
     test::ToolRun r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + " " + c.flags);
     EXPECT_EQ(r.exit_code, 2) << c.flags << "\n" << r.err;
@@ -447,6 +448,53 @@ TEST(ToolRun, HelpListsEveryStageFlagAndTheExitCodes) {
         "--vlm-url", "--vlm-model", "--format", "--json", "--save-intermediates"})
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
   EXPECT_NE(r.out.find("130 cancelled"), std::string::npos);
+  // The backends and defaults come from the library: its registries and options.
+  EXPECT_NE(r.out.find("Segmenter: pbr, onnx"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1000]=11"), std::string::npos) << r.out;  // --views: ViewOptions::num_views
+  EXPECT_NE(r.out.find("`g2p run --settings refine:NAME` lists them"), std::string::npos);
+}
+
+// `--settings` lists a backend's settings from its own description, exits 0
+// without a model, and the reference page holds this build's listing.
+TEST(ToolRun, SettingsListsEachBackendAsTheReferencePageDoes) {
+  test::ToolRun r = test::run_tool("run --settings voxel-cut");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("decompose voxel-cut (--decompose-set KEY=VALUE):"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("resolution                 an integer in 8..256 (cells) (default 64)"), std::string::npos)
+      << r.out;
+
+  r = test::run_tool("run --settings paint:vlm");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("no stage named 'paint'"), std::string::npos) << r.err;
+
+  // A bad setting is a usage error before any work, naming the setting.
+  const std::string dir = test::scratch_dir("ToolRunSettings");
+  r = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/out") + " --set share=2");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("share takes a number in (0, 1]"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+
+  r = test::run_tool("run --settings all");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream file(test::source_path("docs/settings.md"));
+  std::stringstream page;
+  page << file.rdbuf();
+  // Each backend's block (its heading line up to the next) appears verbatim:
+  // scripts/settings_doc.sh rewrites the page when they differ.
+  std::size_t blocks = 0;
+  for (std::size_t at = 0; at < r.out.size();) {
+    std::size_t next = at;
+    do {
+      next = r.out.find('\n', next);
+      next = next == std::string::npos ? r.out.size() : next + 1;
+    } while (next < r.out.size() && r.out[next] == ' ');
+    const std::string block = r.out.substr(at, next - at);
+    EXPECT_NE(page.str().find(block), std::string::npos) << "docs/settings.md lacks (run scripts/settings_doc.sh):\n"
+                                                         << block;
+    ++blocks;
+    at = next;
+  }
+  EXPECT_GE(blocks, 20u);
 }
 
 }  // namespace

@@ -82,14 +82,27 @@ Result<Model> load_with_flags(const std::string& command, const std::string& pat
 }
 
 void add_view_flags(CLI::App* cmd, ViewArgs& args) {
-  cmd->add_option("--views", args.views, "Number of views (default 11, as in the paper)")->check(CLI::Range(1, 1000));
-  cmd->add_option("--resolution", args.resolution, "Image width and height in pixels (default 512)")
-      ->check(CLI::Range(16, 8192));
+  cmd->add_option("--views", args.views, "Number of views around the object")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--resolution", args.resolution, "Image width and height in pixels")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
   cmd->add_option("--layout", args.layout, "View layout: sphere (poles and two rings), fibonacci, turntable")
-      ->transform(CLI::IsMember({"sphere", "fibonacci", "turntable"}, CLI::ignore_case));
-  cmd->add_option("--fov", args.fov, "Vertical field of view in degrees (default 40)")->check(CLI::Range(5.0, 150.0));
+      ->transform(CLI::IsMember({"sphere", "fibonacci", "turntable"}, CLI::ignore_case))
+      ->capture_default_str();
+  cmd->add_option("--fov", args.fov, "Vertical field of view in degrees")
+      ->check(CLI::Range(5.0, 150.0))
+      ->capture_default_str();
   cmd->add_flag("--ortho", args.ortho, "Orthographic projection");
-  cmd->add_option("--renderer", args.renderer, "Render backend (default embree)");
+  cmd->add_option("--renderer", args.renderer, "Render backend: " + backend_list(renderer_registry().names()))
+      ->capture_default_str();
+}
+
+std::string backend_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
 }
 
 Result<ViewOptions> view_options(const ViewArgs& args) {
@@ -125,14 +138,10 @@ Result<std::vector<View>> render_with_flags(const std::string& command, const Mo
 }
 
 void add_segmenter_flags(CLI::App* cmd, SegmenterArgs& args) {
-  cmd->add_option("--segmenter", args.name, "Segmenter backend: hybrid (default), pbr, learned, auto, onnx, oracle");
-  cmd->add_option(
-      "--set", args.settings,
-      "Segmenter setting KEY=VALUE, repeatable (onnx: model_card=FILE, flip=on|off; learned, auto: the same and "
-      "names=T|off, pbr=on|off; hybrid: model_card, flip, names, share=S, prior=W, scope=model|material, "
-      "colour=on|off, atlas_charts=N, unnamed=nameless|network|pbr; oracle: "
-      "labels=FILE, key=NAME; "
-      "pbr: names=on|off, temperature=T)");
+  cmd->add_option("--segmenter", args.name, "Segmenter: " + backend_list(segmenter_registry().names()))
+      ->capture_default_str();
+  cmd->add_option("--set", args.settings,
+                  "Segmenter setting KEY=VALUE, repeatable (`g2p run --settings segment:NAME` lists them)");
 }
 
 void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
@@ -141,12 +150,11 @@ void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
                   "it wins over what the names and the views suggest; words that name no kind of the object "
                   "table are an error naming the nearest (g2p identify --list)");
   cmd->add_option("--identifier", args.name,
-                  "How the object is identified: auto (--object, else names and the COCO detector), object, "
-                  "names, detector, vlm, none")
+                  "How the object is identified: " + backend_list(identifier_registry().names()) +
+                      " (auto: --object, else names and the COCO detector)")
       ->capture_default_str();
   cmd->add_option("--identify-set", args.settings,
-                  "Identifier setting KEY=VALUE, repeatable (auto: detector=on|off, model_card, min_score; "
-                  "detector: model_card=FILE, min_score, min_iou; vlm: url, model, api_key_env, max_views)");
+                  "Identifier setting KEY=VALUE, repeatable (`g2p run --settings identify:NAME` lists them)");
   cmd->add_option("--size-from", args.size_from,
                   "A mesh that looks normalised, with no --height or --longest-side: kind (its kind's typical "
                   "size when identified confidently) or file (keep the file's size)")

@@ -42,15 +42,17 @@ Result<Model> load_with_flags(const std::string& command, const std::string& pat
 
 // Which views to render: --views, --resolution, --layout, --fov, --ortho, --renderer.
 struct ViewArgs {
-  int views = 11;
-  int resolution = 512;
-  std::string layout = "sphere";
-  double fov = 40.0;
-  bool ortho = false;
-  std::string renderer = "embree";
+  int views = ViewOptions{}.num_views;
+  int resolution = ViewOptions{}.width;
+  std::string layout = "sphere";  // ViewOptions{}.layout
+  double fov = ViewOptions{}.fov_y_deg;
+  bool ortho = ViewOptions{}.orthographic;
+  std::string renderer = PipelineOptions{}.renderer.name;
 };
 
 void add_view_flags(CLI::App* cmd, ViewArgs& args);
+// A stage's backends for a flag's help: "hybrid, pbr, learned".
+std::string backend_list(const std::vector<std::string>& names);
 Result<ViewOptions> view_options(const ViewArgs& args);
 
 // Renders the model's views with the flags (full shading and buffers).
@@ -59,7 +61,7 @@ Result<std::vector<View>> render_with_flags(const std::string& command, const Mo
 
 // Which segmenter: --segmenter NAME, --set KEY=VALUE (repeatable).
 struct SegmenterArgs {
-  std::string name = "hybrid";
+  std::string name = PipelineOptions{}.segmenter.name;
   std::vector<std::string> settings;
 };
 

@@ -186,6 +186,7 @@ void add_run_command(CLI::App& app, Command& run) {
   add_completer_flags(cmd, p.completer);
   add_estimator_flags(cmd, p.estimator);
   add_decomposer_flags(cmd, p.decomposer);
+  add_settings_flag(cmd);
   cmd->footer(
       "Exit codes: 0 success, 1 the run failed (bad input file, a stage error), 2 bad command line, 130 cancelled "
       "(Ctrl-C), 143 terminated (SIGTERM). Nothing is written unless the run succeeds.");

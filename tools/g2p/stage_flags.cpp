@@ -1,5 +1,7 @@
 #include "stage_flags.h"
 
+#include <cstdio>
+#include <iostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,41 +13,97 @@
 
 namespace g2p::cli {
 
+void register_optional_backends() {
+#if defined(G2P_CLI_WITH_CGAL)
+  (void)register_cgal_completers();
+#endif
+}
+
+const char* settings_flag(Stage stage) {
+  switch (stage) {
+    case Stage::kIdentify: return "--identify-set";
+    case Stage::kSegment: return "--set";
+    case Stage::kRefine: return "--refine-set";
+    case Stage::kComplete: return "--complete-set";
+    case Stage::kProperties: return "--estimate-set";
+    case Stage::kDecompose: return "--decompose-set";
+    default: return "";
+  }
+}
+
+Status print_backend_settings(const std::string& name) {
+  register_optional_backends();
+  Result<std::vector<BackendSettingsInfo>> found = describe_backend_settings(name);
+  if (!found.ok()) return found.status();
+  for (const BackendSettingsInfo& b : *found) {
+    std::printf("%s %s", to_string(b.stage), b.backend.c_str());
+    if (b.settings.empty()) {
+      std::printf(": no settings\n");
+      continue;
+    }
+    std::printf(" (%s KEY=VALUE):\n", settings_flag(b.stage));
+    for (const SettingInfo& i : b.settings) {
+      std::printf("  %-26s %s (default %s): %s\n", i.key.c_str(), i.takes().c_str(),
+                  i.value.empty() ? "\"\"" : i.value.c_str(), i.help.c_str());
+    }
+  }
+  return Status::Ok();
+}
+
+void add_settings_flag(CLI::App* cmd) {
+  cmd->add_option_function<std::string>(
+         "--settings",
+         [](const std::string& name) {
+           if (Status s = print_backend_settings(name); !s.ok()) throw CLI::ValidationError("--settings", s.message());
+           throw CLI::Success();
+         },
+         "List a backend's settings with their types, ranges and defaults, and exit: NAME (every stage's backend "
+         "of that name), STAGE:NAME (refine:vlm) or all")
+      ->trigger_on_parse();
+}
+
 void add_refiner_flags(CLI::App* cmd, RefineArgs& args, const std::string& default_name) {
   args.name = default_name;
   cmd->add_option("--refiner", args.name,
-                  "Refiner: none, smooth, regions, vlm (vlm needs --refine-set model=NAME --refine-set url=URL); "
-                  "default " +
-                      default_name);
+                  "Refiner: " + backend_list(refiner_registry().names()) + " (vlm needs --refine-set model=NAME)")
+      ->capture_default_str();
   cmd->add_option("--refine-set", args.settings,
-                  "Refiner setting KEY=VALUE, repeatable (smooth: lambda, island, sweeps; vlm: url, model, "
-                  "api_key_env, timeout, retries, backoff, max_response_bytes, prompt_file, max_views)");
+                  "Refiner setting KEY=VALUE, repeatable (`g2p run --settings refine:NAME` lists them)");
 }
 
 void add_completer_flags(CLI::App* cmd, CompleterArgs& args) {
-  cmd->add_option("--completer", args.name,
-                  "Stage 5 backend: partition (default), external, alpha-wrap and fill (CGAL builds)");
-  cmd->add_option("--complete-set", args.settings, "Completer setting KEY=VALUE (repeatable), e.g. resolution=200");
-  cmd->add_option("--fallback", args.fallback, "Backend for parts the completer fails, or 'none' (default partition)");
+  register_optional_backends();
+  cmd->add_option("--completer", args.name, "Completer: " + backend_list(completer_registry().names()))
+      ->capture_default_str();
+  cmd->add_option("--complete-set", args.settings,
+                  "Completer setting KEY=VALUE, repeatable (`g2p run --settings complete:NAME` lists them)");
+  cmd->add_option("--fallback", args.fallback, "Completer for the parts the completer fails, or 'none'")
+      ->capture_default_str();
 }
 
 void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args) {
-  cmd->add_option("--estimator", args.name, "Stage 6 backend: table (default) or vlm");
+  cmd->add_option("--estimator", args.name, "Property estimator: " + backend_list(estimator_registry().names()))
+      ->capture_default_str();
   cmd->add_option("--estimate-set", args.settings,
-                  "Estimator setting KEY=VALUE (repeatable), e.g. model=qwen2.5-vl url=http://host/v1");
+                  "Estimator setting KEY=VALUE, repeatable (`g2p run --settings properties:NAME` lists them)");
 }
 
 void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
   cmd->add_option("--decomposer", args.name,
-                  "Collision geometry: voxel-cut (default: convex decomposition), hull (one convex hull per part)");
+                  "Collision geometry: " + backend_list(decomposer_registry().names()) +
+                      " (voxel-cut: a convex decomposition; hull: one convex hull per part)")
+      ->capture_default_str();
   cmd->add_option("--decompose-set", args.settings,
-                  "Decomposer setting KEY=VALUE (repeatable), e.g. resolution=96 (voxel-cut: resolution, error, cuts)");
-  cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256, default 16)");
+                  "Decomposer setting KEY=VALUE, repeatable (`g2p run --settings decompose:NAME` lists them)");
+  cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256)")
+      ->capture_default_str();
   cmd->add_option("--hull-vertices", args.options.max_vertices_per_hull,
-                  "Vertices per convex hull at most (4-255, default 64; engines cap hulls at 255)");
-  cmd->add_option(
-      "--min-concavity", args.options.min_depth_m,
-      "Leave concavities shallower than this alone, in metres (default 0: 1 % of the object's bounding-box diagonal)");
+                  "Vertices per convex hull at most (4-255; engines cap hulls at 255)")
+      ->capture_default_str();
+  cmd->add_option("--min-concavity", args.options.min_depth_m,
+                  "Leave concavities shallower than this alone, in metres (0: 1 % of the object's bounding-box "
+                  "diagonal)")
+      ->capture_default_str();
 }
 
 void add_export_flags(CLI::App* cmd, ExportArgs& args) {
@@ -88,17 +146,17 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
     BackendChoice* choice;
     const std::string* name;
     const std::vector<std::string>* settings;
-    const char* flag;
+    Stage stage;
   };
-  const StageFlags stages[] = {{&o.identifier, &args.identify.name, &args.identify.settings, "--identify-set"},
-                               {&o.segmenter, &args.segmenter.name, &args.segmenter.settings, "--set"},
-                               {&o.refiner, &args.refiner.name, &args.refiner.settings, "--refine-set"},
-                               {&o.completer, &args.completer.name, &args.completer.settings, "--complete-set"},
-                               {&o.estimator, &args.estimator.name, &args.estimator.settings, "--estimate-set"},
-                               {&o.decomposer, &args.decomposer.name, &args.decomposer.settings, "--decompose-set"}};
+  const StageFlags stages[] = {{&o.identifier, &args.identify.name, &args.identify.settings, Stage::kIdentify},
+                               {&o.segmenter, &args.segmenter.name, &args.segmenter.settings, Stage::kSegment},
+                               {&o.refiner, &args.refiner.name, &args.refiner.settings, Stage::kRefine},
+                               {&o.completer, &args.completer.name, &args.completer.settings, Stage::kComplete},
+                               {&o.estimator, &args.estimator.name, &args.estimator.settings, Stage::kProperties},
+                               {&o.decomposer, &args.decomposer.name, &args.decomposer.settings, Stage::kDecompose}};
   for (const StageFlags& s : stages) {
     Result<BackendSettings> settings = parse_settings(*s.settings);
-    if (!settings.ok()) return settings.status().with_context(s.flag);
+    if (!settings.ok()) return settings.status().with_context(settings_flag(s.stage));
     *s.choice = BackendChoice{*s.name, *settings};
   }
   if (args.refiner.name == "none" && !args.refiner.settings.empty())
@@ -135,9 +193,7 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
 }
 
 Result<Pipeline> make_pipeline(const PipelineArgs& args) {
-#if defined(G2P_CLI_WITH_CGAL)
-  (void)register_cgal_completers();
-#endif
+  register_optional_backends();
   Result<PipelineOptions> options = pipeline_options(args);
   if (!options.ok()) return options.status();
   Pipeline pipeline(std::move(*options));

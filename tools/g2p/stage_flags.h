@@ -14,6 +14,17 @@
 
 namespace g2p::cli {
 
+// The GPL component's completers, in a build that has it (idempotent).
+void register_optional_backends();
+
+// Every setting of the backends `name` names ("hybrid", "refine:vlm", "all";
+// describe_backend_settings), with the flag that sets it, on stdout.
+Status print_backend_settings(const std::string& name);
+// --settings NAME: print_backend_settings, then exit.
+void add_settings_flag(CLI::App* cmd);
+// The flag that sets a stage's backend settings ("--refine-set").
+const char* settings_flag(Stage stage);
+
 // --refiner, --refine-set.
 struct RefineArgs {
   std::string name = PipelineOptions{}.refiner.name;

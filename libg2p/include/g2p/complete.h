@@ -105,7 +105,12 @@ struct Completion {
 class G2P_API Completer {
  public:
   virtual ~Completer();
-  // Backend settings, key = value; unknown keys are errors.
+  // This backend's settings bound to this instance (settings.h): info()
+  // lists them with their values, apply() sets them. Default: none.
+  virtual SettingsSpec settings();
+  // Applies settings, all or none: a bad key or value leaves the backend as it
+  // was. Default: settings().apply(); a backend overrides it only to act on
+  // the new values (load a network, make a client).
   virtual Status configure(const BackendSettings& settings);
   // Closes every part of the object. A backend may fail single parts (their
   // CompletedPart::ok = false) without failing the call; complete() below
@@ -117,8 +122,11 @@ class G2P_API Completer {
 // "external" (a user command such as a HoloPart wrapper, docs/complete.md).
 // register_cgal_completers() adds "alpha-wrap" and "fill".
 G2P_API Registry<Completer>& completer_registry();
-G2P_API Result<std::unique_ptr<Completer>> make_completer(const std::string& name,
-                                                          const BackendSettings& settings = {});
+// Creates a backend and applies its settings: completer_registry().make().
+inline Result<std::unique_ptr<Completer>> make_completer(const std::string& name,
+                                                         const BackendSettings& settings = {}) {
+  return completer_registry().make(name, settings);
+}
 
 // Runs `completer`; parts it failed (not ok) are redone by `fallback` (if
 // given) and noted. The result always has one entry per part.

@@ -64,7 +64,12 @@ struct ConvexDecomposition {
 class G2P_API Decomposer {
  public:
   virtual ~Decomposer();
-  // Backend settings, key = value; unknown keys are errors.
+  // This backend's settings bound to this instance (settings.h): info()
+  // lists them with their values, apply() sets them. Default: none.
+  virtual SettingsSpec settings();
+  // Applies settings, all or none: a bad key or value leaves the backend as it
+  // was. Default: settings().apply(); a backend overrides it only to act on
+  // the new values (load a network, make a client).
   virtual Status configure(const BackendSettings& settings);
   // Splits one closed, outward mesh (a completed part) into convex pieces:
   // fills `hulls` (at most options.max_hulls, each within the vertex budget
@@ -76,8 +81,11 @@ class G2P_API Decomposer {
 
 // Backends by name; libg2p registers "voxel-cut" (the default) and "hull".
 G2P_API Registry<Decomposer>& decomposer_registry();
-G2P_API Result<std::unique_ptr<Decomposer>> make_decomposer(const std::string& name,
-                                                            const BackendSettings& settings = {});
+// Creates a backend and applies its settings: decomposer_registry().make().
+inline Result<std::unique_ptr<Decomposer>> make_decomposer(const std::string& name,
+                                                           const BackendSettings& settings = {}) {
+  return decomposer_registry().make(name, settings);
+}
 G2P_API Status validate(const DecomposeOptions& options);  // ranges above; names the field's CLI flag
 
 // Runs `decomposer` on one part and measures the result. When the backend

@@ -145,7 +145,12 @@ struct IdentifyInput {
 class G2P_API Identifier {
  public:
   virtual ~Identifier();
-  // Backend settings, key = value; unknown keys are errors. Default: none.
+  // This backend's settings bound to this instance (settings.h): info()
+  // lists them with their values, apply() sets them. Default: none.
+  virtual SettingsSpec settings();
+  // Applies settings, all or none: a bad key or value leaves the backend as it
+  // was. Default: settings().apply(); a backend overrides it only to act on
+  // the new values (load a network, make a client).
   virtual Status configure(const BackendSettings& settings);
   // An unknown object is not an error: it is an Identification with no
   // candidate. Errors are for input the backend cannot use at all (the
@@ -166,8 +171,11 @@ class G2P_API Identifier {
 //   "vlm"      a vision-language model asked to name the object (docs/vlm.md);
 //   "none"     always unknown (the behaviour before identification).
 G2P_API Registry<Identifier>& identifier_registry();
-G2P_API Result<std::unique_ptr<Identifier>> make_identifier(const std::string& name,
-                                                            const BackendSettings& settings = {});
+// Creates a backend and applies its settings: identifier_registry().make().
+inline Result<std::unique_ptr<Identifier>> make_identifier(const std::string& name,
+                                                           const BackendSettings& settings = {}) {
+  return identifier_registry().make(name, settings);
+}
 // The `vlm` identifier with a client of the caller's.
 G2P_API std::unique_ptr<Identifier> make_vlm_identifier(std::shared_ptr<const VlmClient> client);
 

@@ -192,6 +192,19 @@ struct PipelineOptions {
   bool measure_stage_memory = true;
 };
 
+// The settings one backend takes: the stage's registry name, and each
+// setting with a new instance's default (settings.h).
+struct BackendSettingsInfo {
+  Stage stage = Stage::kSegment;  // kIdentify, kSegment, kRefine, kComplete, kProperties or kDecompose
+  std::string backend;
+  std::vector<SettingInfo> settings;
+};
+
+// The backends called `name` in any stage ("vlm" refines, estimates and
+// identifies), or in one ("refine:vlm"), with their settings; "all" lists
+// every backend of every stage. NotFound names the known backends.
+G2P_API Result<std::vector<BackendSettingsInfo>> describe_backend_settings(const std::string& name);
+
 // ---- Results ------------------------------------------------------------------
 
 struct StageReport {

@@ -168,7 +168,12 @@ struct PropertyInput {
 class G2P_API PropertyEstimator {
  public:
   virtual ~PropertyEstimator();
-  // Backend settings, key = value; unknown keys are errors.
+  // This backend's settings bound to this instance (settings.h): info()
+  // lists them with their values, apply() sets them. Default: none.
+  virtual SettingsSpec settings();
+  // Applies settings, all or none: a bad key or value leaves the backend as it
+  // was. Default: settings().apply(); a backend overrides it only to act on
+  // the new values (load a network, make a client).
   virtual Status configure(const BackendSettings& settings);
   virtual Result<PartProperties> estimate(const PropertyInput& input) const = 0;
 };
@@ -178,8 +183,11 @@ class G2P_API PropertyEstimator {
 // states the rule) and
 // "vlm" (asks a vision-language model, falls back to "table").
 G2P_API Registry<PropertyEstimator>& estimator_registry();
-G2P_API Result<std::unique_ptr<PropertyEstimator>> make_estimator(const std::string& name,
-                                                                  const BackendSettings& settings = {});
+// Creates a backend and applies its settings: estimator_registry().make().
+inline Result<std::unique_ptr<PropertyEstimator>> make_estimator(const std::string& name,
+                                                                 const BackendSettings& settings = {}) {
+  return estimator_registry().make(name, settings);
+}
 // The vlm estimator with a client of the caller's.
 G2P_API std::unique_ptr<PropertyEstimator> make_vlm_estimator(std::shared_ptr<const VlmClient> client);
 

@@ -62,7 +62,12 @@ struct RefineResult {
 class G2P_API Refiner {
  public:
   virtual ~Refiner();
-  // Backend settings, key = value; unknown keys are errors.
+  // This backend's settings bound to this instance (settings.h): info()
+  // lists them with their values, apply() sets them. Default: none.
+  virtual SettingsSpec settings();
+  // Applies settings, all or none: a bad key or value leaves the backend as it
+  // was. Default: settings().apply(); a backend overrides it only to act on
+  // the new values (load a network, make a client).
   virtual Status configure(const BackendSettings& settings);
   virtual Result<RefineResult> refine(const RefineInput& input) const = 0;
 };
@@ -72,7 +77,10 @@ class G2P_API Refiner {
 // "regions" (the region classifier of regions.h) and "none" (labels
 // unchanged, for ablations).
 G2P_API Registry<Refiner>& refiner_registry();
-G2P_API Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings = {});
+// Creates a backend and applies its settings: refiner_registry().make().
+inline Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings = {}) {
+  return refiner_registry().make(name, settings);
+}
 
 // Puts a refiner's per-face labels into a projection: the parts are
 // partitioned again (small fragments merge unless their votes were confident)

@@ -14,18 +14,18 @@
 #include <utility>
 #include <vector>
 
+#include "g2p/settings.h"
 #include "g2p/status.h"
 
 namespace g2p {
-
-// Backend settings, key = value (keys are documented per backend in docs/,
-// one page per stage).
-using BackendSettings = std::map<std::string, std::string>;
 
 template <typename Interface>
 class Registry {
  public:
   using Factory = std::function<std::unique_ptr<Interface>()>;
+
+  // `kind` names the stage's backends in messages ("segmenter").
+  explicit Registry(std::string kind = "backend") : kind_(std::move(kind)) {}
 
   // Adds a backend. Fails if the name is empty or taken.
   Status add(const std::string& name, Factory factory) {
@@ -48,12 +48,30 @@ class Registry {
     if (!factory) {
       std::string known;
       for (const std::string& n : names()) known += (known.empty() ? "" : ", ") + n;
-      return Status::NotFound("no backend named '" + name + "' (known: " + known + ")");
+      return Status::NotFound("no " + kind_ + " named '" + name + "' (known: " + known + ")");
     }
     std::unique_ptr<Interface> instance = factory();
     if (!instance) return Status::Internal("the factory of backend '" + name + "' returned nothing");
     return instance;
   }
+
+  // A new instance of `name` with `settings` applied (its configure(): all or
+  // none, errors naming the setting): how every stage makes its backends.
+  Result<std::unique_ptr<Interface>> make(const std::string& name, const BackendSettings& settings = {}) const {
+    Result<std::unique_ptr<Interface>> made = create(name);
+    if (!made.ok()) return made.status();
+    G2P_RETURN_IF_ERROR((*made)->configure(settings));
+    return made;
+  }
+
+  // The settings backend `name` takes, with a new instance's defaults.
+  Result<std::vector<SettingInfo>> settings(const std::string& name) const {
+    Result<std::unique_ptr<Interface>> made = create(name);
+    if (!made.ok()) return made.status();
+    return (*made)->settings().info();
+  }
+
+  const std::string& kind() const { return kind_; }
 
   std::vector<std::string> names() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -68,6 +86,7 @@ class Registry {
   }
 
  private:
+  std::string kind_;
   mutable std::mutex mutex_;
   std::vector<std::pair<std::string, Factory>> entries_;  // in registration order
 };

@@ -36,7 +36,12 @@ struct LabelMap {
 class G2P_API Segmenter {
  public:
   virtual ~Segmenter();
-  // Applies backend settings; the default accepts none. Unknown keys are errors.
+  // This backend's settings bound to this instance (settings.h): info()
+  // lists them with their values, apply() sets them. Default: none.
+  virtual SettingsSpec settings();
+  // Applies settings, all or none: a bad key or value leaves the backend as it
+  // was. Default: settings().apply(); a backend overrides it only to act on
+  // the new values (load a network, make a client).
   virtual Status configure(const BackendSettings& settings);
   // Prepares for the views of one model: the vocabulary to predict, and the
   // model itself (source materials, names) for backends that use it. Both must
@@ -65,9 +70,11 @@ class G2P_API Segmenter {
 // docs/training.md), "auto".
 G2P_API Registry<Segmenter>& segmenter_registry();
 
-// Creates a backend and applies its settings.
-G2P_API Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& name,
-                                                          const BackendSettings& settings = {});
+// Creates a backend and applies its settings: segmenter_registry().make().
+inline Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& name,
+                                                         const BackendSettings& settings = {}) {
+  return segmenter_registry().make(name, settings);
+}
 
 // ---- A prior over classes ----------------------------------------------------
 

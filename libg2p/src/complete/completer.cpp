@@ -12,26 +12,18 @@ namespace g2p {
 
 Completer::~Completer() = default;
 
-Status Completer::configure(const BackendSettings& settings) {
-  if (settings.empty()) return Status::Ok();
-  return Status::InvalidArgument("this completer takes no settings (got '" + settings.begin()->first + "')");
-}
+SettingsSpec Completer::settings() { return SettingsSpec("this completer"); }
+
+Status Completer::configure(const BackendSettings& settings) { return this->settings().apply(settings); }
 
 Registry<Completer>& completer_registry() {
   static Registry<Completer>* registry = [] {
-    auto* r = new Registry<Completer>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<Completer>("completer");  // never destroyed: usable during static destruction
     (void)r->add("partition", &make_partition_completer);
     (void)r->add("external", &make_external_completer);
     return r;
   }();
   return *registry;
-}
-
-Result<std::unique_ptr<Completer>> make_completer(const std::string& name, const BackendSettings& settings) {
-  Result<std::unique_ptr<Completer>> r = completer_registry().create(name);
-  if (!r.ok()) return r.status();
-  G2P_RETURN_IF_ERROR((*r)->configure(settings).with_context("completer '" + name + "'"));
-  return r;
 }
 
 Result<Completion> complete(const CompletionInput& input, const Completer& completer, const Completer* fallback) {

@@ -67,32 +67,19 @@ Status run_command(const std::string& command, double timeout_s) {
 
 class ExternalCompleter final : public Completer {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      if (key == "command") {
-        command_ = value;
-      } else if (key == "timeout") {
-        double v = 0;
-        if (!detail::parse_double(value, v) || !(v > 0))
-          return Status::InvalidArgument("external: timeout needs a positive number of seconds, got '" + value + "'");
-        timeout_s_ = v;
-      } else if (key == "format") {
-        if (value != "obj" && value != "ply" && value != "stl")
-          return Status::InvalidArgument("external: format must be obj, ply or stl, got '" + value + "'");
-        format_ = value;
-      } else if (key == "max_relative_distance") {
-        double v = 0;
-        if (!detail::parse_double(value, v) || !(v > 0))
-          return Status::InvalidArgument("external: max_relative_distance needs a positive number");
-        max_relative_distance_ = v;
-      } else {
-        return Status::InvalidArgument("external: unknown setting '" + key +
-                                       "' (known: command, timeout, format, max_relative_distance)");
-      }
-    }
-    if (command_.find("{output}") == std::string::npos && !command_.empty())
-      return Status::InvalidArgument("external: the command must contain {output} (where it writes the closed mesh)");
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("external")
+        .text("command", command_,
+              "the command closing one part: {input}, {output}, {object}, {label} and {part} are replaced")
+        .number("timeout", timeout_s_, Range::above(0), "s", "per part")
+        .choice("format", format_, {{"obj", "obj"}, {"ply", "ply"}, {"stl", "stl"}}, "the mesh format exchanged")
+        .number("max_relative_distance", max_relative_distance_, Range::above(0), "",
+                "a part whose surface strays farther from its patch (x the patch's diagonal) fails")
+        .check([this] {
+          if (command_.empty() || command_.find("{output}") != std::string::npos) return Status::Ok();
+          return Status::InvalidArgument(
+              "external: the command must contain {output} (where it writes the closed mesh)");
+        });
   }
 
   Result<Completion> complete(const CompletionInput& input) const override {

@@ -514,38 +514,24 @@ Part whole_patch_part(const Mesh& patch, const Part& part) {
 
 class PartitionCompleter final : public Completer {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      if (!detail::parse_double(value, v))
-        return Status::InvalidArgument("partition: " + key + " needs a number, got '" + value + "'");
-      if (key == "resolution" && v >= 8 && v <= 2048)
-        resolution_ = v;
-      else if (key == "max_resolution" && v >= 8 && v <= 2048)
-        max_resolution_ = v;
-      else if (key == "min_cells_across" && v >= 0 && v <= 64)
-        min_cells_across_ = v;
-      else if (key == "simplify" && v >= 0 && v <= 1)
-        simplify_ = v;
-      else if (key == "simplify_max_triangles" && v >= 0 && v <= 1e9 && v == std::floor(v))
-        simplify_max_triangles_ = static_cast<int>(v);
-      else if (key == "refine_min_area_fraction" && v >= 0 && v <= 1)
-        refine_min_area_fraction_ = v;
-      else if (key == "gap" && v >= 1 && v <= 16 && v == std::floor(v))
-        gap_ = static_cast<int>(v);
-      else if (key == "max_cells" && v >= 1e3 && v <= 1e9)
-        max_cells_ = v;
-      else if (key == "max_relative_distance" && v > 0)  // checked on every part
-        max_relative_distance_ = v;
-      else
-        return Status::InvalidArgument(
-            "partition: bad setting " + key + "=" + value +
-            " (known: resolution and max_resolution in [8, 2048], min_cells_across in "
-            "[0, 64], refine_min_area_fraction and simplify in [0, 1], simplify_max_triangles >= 0, gap an integer in "
-            "[1, 16], max_cells in [1e3, 1e9], "
-            "max_relative_distance > 0)");
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("partition")
+        .number("resolution", resolution_, Range::closed(8, 2048), "cells", "cells along the object's longest side")
+        .number("max_resolution", max_resolution_, Range::closed(8, 2048), "cells",
+                "the finest grid thin parts may ask for, along the longest side")
+        .number("min_cells_across", min_cells_across_, Range::closed(0, 64), "cells",
+                "a stick-like part's second-largest extent spans at least this many cells")
+        .number("simplify", simplify_, Range::closed(0, 1), "cells",
+                "largest surface change of the simplification (0 keeps every triangle)")
+        .integer("simplify_max_triangles", simplify_max_triangles_, 0, 1000000000, "",
+                 "larger surfaces are not simplified")
+        .number("refine_min_area_fraction", refine_min_area_fraction_, Range::closed(0, 1), "",
+                "parts with less of the total area do not refine the grid")
+        .integer("gap", gap_, 1, 16, "cells", "closing radius")
+        .number("max_cells", max_cells_, Range::closed(1e3, 1e9), "", "memory guard: grid points (about 30 bytes each)")
+        .number("max_relative_distance", max_relative_distance_, Range::above(0), "",
+                "a part whose surface strays farther from its patch (x the patch's diagonal) fails")
+        .or_word("off", std::numeric_limits<double>::infinity());
   }
 
   Result<Completion> complete(const CompletionInput& input) const override;

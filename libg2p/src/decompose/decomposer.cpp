@@ -16,14 +16,13 @@ namespace g2p {
 
 Decomposer::~Decomposer() = default;
 
-Status Decomposer::configure(const BackendSettings& settings) {
-  if (settings.empty()) return Status::Ok();
-  return Status::InvalidArgument("this decomposer takes no settings (got '" + settings.begin()->first + "')");
-}
+SettingsSpec Decomposer::settings() { return SettingsSpec("this decomposer"); }
+
+Status Decomposer::configure(const BackendSettings& settings) { return this->settings().apply(settings); }
 
 Registry<Decomposer>& decomposer_registry() {
   static Registry<Decomposer>* registry = [] {
-    auto* r = new Registry<Decomposer>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<Decomposer>("decomposer");  // never destroyed: usable during static destruction
     (void)r->add("voxel-cut", &make_voxel_cut_decomposer);
     (void)r->add("hull", &make_hull_decomposer);
 #ifdef G2P_WITH_HACD
@@ -32,13 +31,6 @@ Registry<Decomposer>& decomposer_registry() {
     return r;
   }();
   return *registry;
-}
-
-Result<std::unique_ptr<Decomposer>> make_decomposer(const std::string& name, const BackendSettings& settings) {
-  Result<std::unique_ptr<Decomposer>> r = decomposer_registry().create(name);
-  if (!r.ok()) return r.status();
-  G2P_RETURN_IF_ERROR((*r)->configure(settings).with_context("decomposer '" + name + "'"));
-  return r;
 }
 
 Status validate(const DecomposeOptions& o) {

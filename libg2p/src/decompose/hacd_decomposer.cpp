@@ -24,19 +24,12 @@ namespace {
 
 class HacdDecomposer : public Decomposer {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      const bool number = detail::parse_double(value, v);
-      if (key == "concavity" && number && v > 0)
-        concavity_ = v;
-      else if (key == "triangles" && number && v >= 100 && v <= 1e6 && v == std::floor(v))
-        triangles_ = static_cast<int>(v);
-      else
-        return Status::InvalidArgument("hacd: bad setting " + key + "=" + value +
-                                       " (concavity > 0 in HACD's units, triangles = 100..1000000)");
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("hacd")
+        .number("concavity", concavity_, Range::above(0), "",
+                "HACD's bound on a cluster's concavity, in its normalised units")
+        .integer("triangles", triangles_, 100, 1000000, "",
+                 "the closed volume is simplified to about this many triangles first");
   }
 
   Status decompose(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) const override {

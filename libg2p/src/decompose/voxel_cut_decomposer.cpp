@@ -213,21 +213,12 @@ std::vector<int> cross_section_corners(const std::vector<Eigen::Vector3d>& point
 
 class VoxelCutDecomposer : public Decomposer {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      const bool number = detail::parse_double(value, v);
-      if (key == "resolution" && number && v >= 8 && v <= 256 && v == std::floor(v))
-        resolution_ = static_cast<int>(v);
-      else if (key == "error" && number && v >= 0 && v <= 1)
-        error_ = v;
-      else if (key == "cuts" && number && v >= 1 && v <= 64 && v == std::floor(v))
-        cuts_per_axis_ = static_cast<int>(v);
-      else
-        return Status::InvalidArgument("voxel-cut: bad setting " + key + "=" + value +
-                                       " (resolution=8..256 cells, error=0..1 of the part's volume, cuts=1..64)");
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("voxel-cut")
+        .integer("resolution", resolution_, 8, 256, "cells", "grid cells along the part's longest side")
+        .number("error", error_, Range::closed(0, 1), "",
+                "a piece whose hull exceeds it by at most this share of the part is not cut further")
+        .integer("cuts", cuts_per_axis_, 1, 64, "", "planes tried per axis in the coarse pass");
   }
 
   Status decompose(const Mesh& closed, const DecomposeOptions& options, ConvexDecomposition& out) const override {

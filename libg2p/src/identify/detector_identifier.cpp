@@ -131,25 +131,18 @@ double iou(const Box& a, const Box& b) {
 
 class DetectorIdentifier final : public Identifier {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      if (key == "model_card") {
-        card_path_ = value;
-      } else if (key == "min_score" && detail::parse_double(value, v) && v >= 0 && v <= 1) {
-        min_score_ = v;
-      } else if (key == "min_iou" && detail::parse_double(value, v) && v >= 0 && v <= 1) {
-        min_iou_ = v;
-      } else if (key == "views" && (value == "turntable" || value == "given")) {
-        turntable_ = value == "turntable";
-      } else {
-        return Status::InvalidArgument(
-            "detector: bad setting " + key + "=" + value +
-            " (known: model_card=CARD.json, min_score in [0, 1], min_iou in [0, 1], views=turntable|given)");
-      }
-    }
-    loaded_ = false;
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("detector")
+        .text("model_card", card_path_, "the detector's card (JSON); \"\" finds the shipped one")
+        .number("min_score", min_score_, Range::closed(0, 1), "", "the least detection score counted")
+        .number("min_iou", min_iou_, Range::closed(0, 1), "",
+                "the least overlap (IoU) of a detection with the object's box")
+        .choice("views", turntable_, {{"turntable", true}, {"given", false}},
+                "render its own turntable views (turntable) or read the run's (given)")
+        .check([this] {
+          loaded_ = false;  // the card is read again, with these settings, at the next identify
+          return Status::Ok();
+        });
   }
 
   Result<Identification> identify(const IdentifyInput& in) const override {

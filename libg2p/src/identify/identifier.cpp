@@ -17,10 +17,9 @@ namespace g2p {
 
 Identifier::~Identifier() = default;
 
-Status Identifier::configure(const BackendSettings& settings) {
-  if (settings.empty()) return Status::Ok();
-  return Status::InvalidArgument("this identifier takes no settings (got '" + settings.begin()->first + "')");
-}
+SettingsSpec Identifier::settings() { return SettingsSpec("this identifier"); }
+
+Status Identifier::configure(const BackendSettings& settings) { return this->settings().apply(settings); }
 
 namespace {
 
@@ -134,20 +133,10 @@ class AutoIdentifier final : public Identifier {
  public:
   AutoIdentifier() : names_(std::make_unique<NamesIdentifier>()), detector_(detail::make_detector_identifier()) {}
 
-  Status configure(const BackendSettings& settings) override {
-    BackendSettings detector;
-    for (const auto& [k, v] : settings) {
-      if (k == "detector") {
-        if (v != "on" && v != "off") return Status::InvalidArgument("auto: detector needs on or off, got '" + v + "'");
-        use_detector_ = v == "on";
-      } else if (k == "model_card" || k == "min_score" || k == "min_iou" || k == "views") {
-        detector[k] = v;
-      } else {
-        return Status::InvalidArgument("auto: unknown setting '" + k +
-                                       "' (known: detector, model_card, min_score, min_iou, views)");
-      }
-    }
-    return detector_->configure(detector);
+  SettingsSpec settings() override {
+    return SettingsSpec("auto")
+        .flag("detector", use_detector_, "join the detector's answer with the names'")
+        .include(detector_->settings());
   }
 
   Result<Identification> identify(const IdentifyInput& in) const override {
@@ -204,7 +193,7 @@ class AutoIdentifier final : public Identifier {
 
 Registry<Identifier>& identifier_registry() {
   static Registry<Identifier>* registry = [] {
-    auto* r = new Registry<Identifier>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<Identifier>("identifier");  // never destroyed: usable during static destruction
     (void)r->add("auto", [] { return std::unique_ptr<Identifier>(std::make_unique<AutoIdentifier>()); });
     (void)r->add("object", [] { return std::unique_ptr<Identifier>(std::make_unique<ObjectIdentifier>()); });
     (void)r->add("names", [] { return std::unique_ptr<Identifier>(std::make_unique<NamesIdentifier>()); });
@@ -214,13 +203,6 @@ Registry<Identifier>& identifier_registry() {
     return r;
   }();
   return *registry;
-}
-
-Result<std::unique_ptr<Identifier>> make_identifier(const std::string& name, const BackendSettings& settings) {
-  Result<std::unique_ptr<Identifier>> r = identifier_registry().create(name);
-  if (!r.ok()) return r.status();
-  G2P_RETURN_IF_ERROR((*r)->configure(settings));
-  return r;
 }
 
 Result<Identification> identify(const IdentifyInput& input) { return AutoIdentifier().identify(input); }

@@ -21,26 +21,12 @@ class VlmIdentifier final : public Identifier {
   explicit VlmIdentifier(std::shared_ptr<const VlmClient> client = nullptr)
       : client_(std::move(client)), injected_(client_ != nullptr) {}
 
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double number = 0;
-      if (detail::set_openai_option(options_, key, value)) continue;
-      if (key == "max_views" && detail::parse_double(value, number) && number >= 1 && number <= 20 &&
-          number == std::floor(number))
-        max_views_ = static_cast<int>(number);
-      else
-        return Status::InvalidArgument("identify vlm: bad setting " + key + "=" + value +
-                                       " (known: " + detail::kOpenAiOptionKeys + ", max_views)");
-    }
-    if (injected_) return Status::Ok();
-    if (options_.model.empty())
-      return Status::InvalidArgument(
-          "identify vlm: needs the setting model=NAME (and url=URL unless the server listens on "
-          "http://127.0.0.1:8080/v1)");
-    Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
-    if (!c.ok()) return c.status();
-    client_ = std::move(*c);
-    return Status::Ok();
+  SettingsSpec settings() override {
+    SettingsSpec spec("identify vlm");
+    detail::bind_openai(spec, options_)
+        .integer("max_views", max_views_, 1, 20, "", "rendered views shown to the model")
+        .check([this] { return connect(); });
+    return spec;
   }
 
   Result<Identification> identify(const IdentifyInput& in) const override {
@@ -92,6 +78,19 @@ class VlmIdentifier final : public Identifier {
   }
 
  private:
+  // A client for the settings as they are (an injected one is kept).
+  Status connect() {
+    if (injected_) return Status::Ok();
+    if (options_.model.empty())
+      return Status::InvalidArgument(
+          "identify vlm: needs the setting model=NAME (and url=URL unless the server listens on "
+          "http://127.0.0.1:8080/v1)");
+    Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
+    if (!c.ok()) return c.status();
+    client_ = std::move(*c);
+    return Status::Ok();
+  }
+
   OpenAiClientOptions options_;
   std::shared_ptr<const VlmClient> client_;
   bool injected_ = false;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "g2p/properties.h"
+#include "g2p/settings.h"
 
 namespace g2p {
 
@@ -20,9 +21,8 @@ struct TableRule {
   double max_dense_solid_m3 = 0.0005;  // ...are hollow above this closed volume (0.5 litre)
 };
 
-// Applies one setting of the rule; false if the key or value is bad.
-bool set_table_rule(TableRule& rule, const std::string& key, const std::string& value);
-extern const char* const kTableRuleKeys;
+// The rule's settings (rays, dense_kg_m3, max_dense_solid_m3), bound to `rule`.
+SettingsSpec& bind_table_rule(SettingsSpec& spec, TableRule& rule);
 
 // The table backend's answer for one part (also the vlm backend's fallback):
 // the class's values, structure and thickness decided with measure_walls.

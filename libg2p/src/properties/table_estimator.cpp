@@ -39,10 +39,9 @@ namespace g2p {
 
 PropertyEstimator::~PropertyEstimator() = default;
 
-Status PropertyEstimator::configure(const BackendSettings& settings) {
-  if (settings.empty()) return Status::Ok();
-  return Status::InvalidArgument("this estimator takes no settings (got '" + settings.begin()->first + "')");
-}
+SettingsSpec PropertyEstimator::settings() { return SettingsSpec("this estimator"); }
+
+Status PropertyEstimator::configure(const BackendSettings& settings) { return this->settings().apply(settings); }
 
 const char* to_string(ValueSource source) {
   switch (source) {
@@ -77,20 +76,12 @@ double class_volume_m3(const PropertyInput& in) {
 
 }  // namespace
 
-const char* const kTableRuleKeys = "rays (integer >= 0), dense_kg_m3 (> 0), max_dense_solid_m3 (>= 0)";
-
-bool set_table_rule(TableRule& rule, const std::string& key, const std::string& value) {
-  double v = 0;
-  if (!parse_double(value, v)) return false;
-  if (key == "rays" && v >= 0 && v <= 1e6 && v == std::floor(v))
-    rule.rays = static_cast<int>(v);
-  else if (key == "dense_kg_m3" && v > 0)
-    rule.dense_kg_m3 = v;
-  else if (key == "max_dense_solid_m3" && v >= 0)
-    rule.max_dense_solid_m3 = v;
-  else
-    return false;
-  return true;
+SettingsSpec& bind_table_rule(SettingsSpec& spec, TableRule& rule) {
+  return spec
+      .integer("rays", rule.rays, 0, 1000000, "", "rays per part measuring its walls (0: the classes' defaults only)")
+      .number("dense_kg_m3", rule.dense_kg_m3, Range::above(0), "kg/m^3", "classes at least this dense...")
+      .number("max_dense_solid_m3", rule.max_dense_solid_m3, Range::at_least(0), "m^3",
+              "...are hollow above this closed volume");
 }
 
 void apply_geometry_guards(PartProperties& p, const CompletedPart& completed) {
@@ -205,12 +196,9 @@ namespace {
 
 class TableEstimator final : public PropertyEstimator {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings)
-      if (!detail::set_table_rule(rule_, key, value))
-        return Status::InvalidArgument("table: bad setting " + key + "=" + value +
-                                       " (known: " + detail::kTableRuleKeys + ")");
-    return Status::Ok();
+  SettingsSpec settings() override {
+    SettingsSpec spec("table");
+    return detail::bind_table_rule(spec, rule_);
   }
   Result<PartProperties> estimate(const PropertyInput& input) const override {
     return detail::table_properties(input, rule_);
@@ -226,19 +214,12 @@ std::unique_ptr<PropertyEstimator> make_table_estimator() { return std::make_uni
 
 Registry<PropertyEstimator>& estimator_registry() {
   static Registry<PropertyEstimator>* registry = [] {
-    auto* r = new Registry<PropertyEstimator>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<PropertyEstimator>("estimator");  // never destroyed: usable during static destruction
     (void)r->add("table", &make_table_estimator);
     (void)r->add("vlm", [] { return make_vlm_estimator(); });
     return r;
   }();
   return *registry;
-}
-
-Result<std::unique_ptr<PropertyEstimator>> make_estimator(const std::string& name, const BackendSettings& settings) {
-  Result<std::unique_ptr<PropertyEstimator>> r = estimator_registry().create(name);
-  if (!r.ok()) return r.status();
-  G2P_RETURN_IF_ERROR((*r)->configure(settings).with_context("estimator '" + name + "'"));
-  return r;
 }
 
 }  // namespace g2p

@@ -26,23 +26,11 @@ class VlmEstimator final : public PropertyEstimator {
   explicit VlmEstimator(std::shared_ptr<const VlmClient> client = nullptr)
       : client_(std::move(client)), injected_(client_ != nullptr) {}
 
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      if (detail::set_openai_option(options_, key, value)) continue;
-      if (key == "max_views" && detail::parse_double(value, v) && v >= 0 && v <= 100 && v == std::floor(v))
-        max_views_ = static_cast<int>(v);
-      else if (!detail::set_table_rule(rule_, key, value))
-        return Status::InvalidArgument("vlm: bad setting " + key + "=" + value +
-                                       " (known: " + detail::kOpenAiOptionKeys +
-                                       ", max_views, and the table fallback's " + detail::kTableRuleKeys + ")");
-    }
-    if (!injected_ && !options_.model.empty()) {
-      Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
-      if (!c.ok()) return c.status();
-      client_ = std::move(*c);
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    SettingsSpec spec("vlm");
+    detail::bind_openai(spec, options_)
+        .integer("max_views", max_views_, 0, 100, "", "views sent, each as render and part mask");
+    return detail::bind_table_rule(spec, rule_).check([this] { return connect(); });
   }
 
   Result<PartProperties> estimate(const PropertyInput& in) const override {
@@ -91,6 +79,15 @@ class VlmEstimator final : public PropertyEstimator {
   }
 
  private:
+  // A client for the settings as they are; without a model, the table's values.
+  Status connect() {
+    if (injected_ || options_.model.empty()) return Status::Ok();
+    Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
+    if (!c.ok()) return c.status();
+    client_ = std::move(*c);
+    return Status::Ok();
+  }
+
   Result<VlmRequest> build_request(const PropertyInput& in, const PartProperties& p) const {
     const Eigen::AlignedBox3d object_box = bounds(*in.object);
     const Eigen::AlignedBox3d part_box = bounds(in.completed->mesh);

@@ -6,10 +6,9 @@ namespace g2p {
 
 Refiner::~Refiner() = default;
 
-Status Refiner::configure(const BackendSettings& settings) {
-  if (settings.empty()) return Status::Ok();
-  return Status::InvalidArgument("this refiner takes no settings (got '" + settings.begin()->first + "')");
-}
+SettingsSpec Refiner::settings() { return SettingsSpec("this refiner"); }
+
+Status Refiner::configure(const BackendSettings& settings) { return this->settings().apply(settings); }
 
 namespace {
 
@@ -29,7 +28,7 @@ class NoRefiner final : public Refiner {
 
 Registry<Refiner>& refiner_registry() {
   static Registry<Refiner>* registry = [] {
-    auto* r = new Registry<Refiner>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<Refiner>("refiner");  // never destroyed: usable during static destruction
     (void)r->add("smooth", &make_smooth_refiner);
     (void)r->add("vlm", [] { return make_vlm_refiner(); });
     (void)r->add("regions", &make_regions_refiner);
@@ -56,13 +55,6 @@ Status apply_refinement(const Mesh& mesh, const std::vector<int>& labels, const 
     projection.labels.confidence[f] = h != nullptr && t > 0.f && l >= 0 ? h[l] / t : 0.f;
   }
   return Status::Ok();
-}
-
-Result<std::unique_ptr<Refiner>> make_refiner(const std::string& name, const BackendSettings& settings) {
-  Result<std::unique_ptr<Refiner>> r = refiner_registry().create(name);
-  if (!r.ok()) return r.status();
-  G2P_RETURN_IF_ERROR((*r)->configure(settings));
-  return r;
 }
 
 }  // namespace g2p

@@ -38,22 +38,12 @@ namespace {
 
 class SmoothRefiner final : public Refiner {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      if (!detail::parse_double(value, v))
-        return Status::InvalidArgument("smooth: " + key + " needs a number, got '" + value + "'");
-      if (key == "lambda" && v >= 0)
-        lambda_ = v;
-      else if (key == "island" && v >= 0 && v < 0.5)
-        island_ = v;
-      else if (key == "sweeps" && v >= 0 && v <= 1000)
-        sweeps_ = static_cast<int>(v);
-      else
-        return Status::InvalidArgument("smooth: bad setting " + key + "=" + value +
-                                       " (known: lambda >= 0, island in [0, 0.5), sweeps in [0, 1000])");
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("smooth")
+        .number("lambda", lambda_, Range::at_least(0), "", "weight of agreeing with neighbours against the votes")
+        .number("island", island_, Range::up_to_below(0, 0.5), "",
+                "regions under this share of the area join a neighbour")
+        .integer("sweeps", sweeps_, 0, 1000, "", "smoothing sweeps over the face graph");
   }
 
   Result<RefineResult> refine(const RefineInput& in) const override {

@@ -41,29 +41,13 @@ class VlmRefiner final : public Refiner {
   explicit VlmRefiner(std::shared_ptr<const VlmClient> client = nullptr)
       : client_(std::move(client)), injected_(client_ != nullptr) {}
 
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      double number = 0;
-      const bool is_count = detail::parse_double(value, number) && number >= 0.0 && number == std::floor(number);
-      if (detail::set_openai_option(options_, key, value)) continue;
-      if (key == "prompt_file")
-        prompt_file_ = value;
-      else if (key == "max_views" && is_count && number >= 1 && number <= 100)
-        max_views_ = static_cast<int>(number);
-      else
-        return Status::InvalidArgument("vlm: bad setting " + key + "=" + value +
-                                       " (known: " + detail::kOpenAiOptionKeys + ", prompt_file, max_views)");
-    }
-    if (injected_) return Status::Ok();
-    // Without a model there is nothing to ask: said here, when the pipeline is
-    // prepared, rather than after rendering, segmenting and projecting.
-    if (options_.model.empty())
-      return Status::InvalidArgument(
-          "vlm: needs the setting model=NAME (and url=URL unless the server listens on http://127.0.0.1:8080/v1)");
-    Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
-    if (!c.ok()) return c.status();
-    client_ = std::move(*c);
-    return Status::Ok();
+  SettingsSpec settings() override {
+    SettingsSpec spec("vlm");
+    detail::bind_openai(spec, options_)
+        .file("prompt_file", prompt_file_, "a prompt to use instead of the built-in one")
+        .integer("max_views", max_views_, 1, 100, "", "views shown to the model")
+        .check([this] { return connect(); });
+    return spec;
   }
 
   Result<RefineResult> refine(const RefineInput& in) const override {
@@ -140,6 +124,20 @@ class VlmRefiner final : public Refiner {
   }
 
  private:
+  // A client for the settings as they are (an injected one is kept). Without
+  // a model there is nothing to ask: said when the pipeline is prepared, not
+  // after rendering, segmenting and projecting.
+  Status connect() {
+    if (injected_) return Status::Ok();
+    if (options_.model.empty())
+      return Status::InvalidArgument(
+          "vlm: needs the setting model=NAME (and url=URL unless the server listens on http://127.0.0.1:8080/v1)");
+    Result<std::unique_ptr<VlmClient>> c = make_openai_client(options_);
+    if (!c.ok()) return c.status();
+    client_ = std::move(*c);
+    return Status::Ok();
+  }
+
   Result<std::string> build_prompt(const RefineInput& in) const {
     std::string prompt = kDefaultRefinePrompt;
     if (!prompt_file_.empty()) {

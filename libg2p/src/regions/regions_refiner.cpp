@@ -33,43 +33,21 @@ namespace {
 
 class RegionsRefiner final : public Refiner {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      if (key == "card") {
-        std::error_code ec;
-        if (value.empty() || !std::filesystem::is_regular_file(value, ec))
-          return Status::InvalidArgument("regions: card=" + value + " is not a file (a g2p-regions.json)");
-        card_ = value;
-        continue;
-      }
-      if (key == "scope" || key == "rest") {
-        if (key == "scope" && (value == "image" || value == "all")) {
-          image_only_ = value == "image";
-        } else if (key == "rest" && (value == "smooth" || value == "keep")) {
-          smooth_rest_ = value == "smooth";
-        } else {
-          return Status::InvalidArgument("regions: bad setting " + key + "=" + value +
-                                         (key == "scope" ? " (scope is image or all)" : " (rest is smooth or keep)"));
-        }
-        continue;
-      }
-      double v = 0;
-      if (!detail::parse_double(value, v))
-        return Status::InvalidArgument("regions: " + key + " needs a number, got '" + value + "'");
-      if (key == "crease" && v >= 0 && v <= 180)
-        options_.crease_deg = v;
-      else if (key == "colour" && v >= 0)
-        options_.colour_step = v;
-      else if (key == "min_area" && v >= 0 && v < 1)
-        options_.min_area_fraction = v;
-      else if (key == "min_probability" && v >= 0 && v <= 1)
-        min_probability_ = v;
-      else
-        return Status::InvalidArgument("regions: bad setting " + key + "=" + value +
-                                       " (known: card, scope=image|all, rest=smooth|keep, crease in [0, 180], "
-                                       "colour >= 0, min_area in [0, 1), min_probability in [0, 1])");
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("regions")
+        .file("card", card_, "the region classifier (a g2p-regions.json); \"\" finds the shipped one")
+        .choice("scope", image_only_, {{"image", true}, {"all", false}},
+                "decide only the regions the image decided (image) or all")
+        .choice("rest", smooth_rest_, {{"smooth", true}, {"keep", false}},
+                "the faces it does not decide are smoothed (smooth) or kept")
+        .number("crease", options_.crease_deg, Range::closed(0, 180), "degrees",
+                "neighbours meeting at a sharper dihedral angle are cut apart")
+        .number("colour", options_.colour_step, Range::at_least(0), "",
+                "...and neighbours whose colours differ by more (linear RGB, Euclidean)")
+        .number("min_area", options_.min_area_fraction, Range::up_to_below(0, 1), "",
+                "smaller regions (share of the area) join a neighbour")
+        .number("min_probability", min_probability_, Range::closed(0, 1), "",
+                "a region is decided only when its best class is at least this probable");
   }
 
   Result<RefineResult> refine(const RefineInput& in) const override {

@@ -5,7 +5,7 @@ namespace g2p {
 
 Registry<Renderer>& renderer_registry() {
   static Registry<Renderer>* registry = [] {
-    auto* r = new Registry<Renderer>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<Renderer>("renderer");  // never destroyed: usable during static destruction
     (void)r->add("embree", &make_embree_renderer);
     return r;
   }();

@@ -89,42 +89,40 @@ struct HybridOptions {
 
 class HybridSegmenter final : public Segmenter {
  public:
+  SettingsSpec settings() override {
+    HybridOptions& o = options_;
+    return SettingsSpec("hybrid")
+        .text("model_card", card_, "the network's card (g2p-materials.json); \"\" finds the shipped one")
+        .flag("flip", flip_, "the network also reads each view mirrored")
+        .number("share", o.share, Range::above_to(0, 1), "",
+                "share of the surface at or above which an unnamed material is taken to cover several parts")
+        .number("prior", o.prior, Range::closed(0, 1), "",
+                "exponent on pbr's probabilities of an authored several-part material, joined with the network's")
+        .number("names", o.names, Range::above_to(0, 1), "",
+                "name-evidence threshold for a face's names to name a class")
+        .or_word("off", 2.0)
+        .choice("scope", o.model_scope, {{"model", true}, {"material", false}},
+                "where names count: a named model is read by pbr throughout (model), or per material")
+        .flag("colour", o.colour, "a several-part material also needs colour the image can show regions by")
+        .integer("atlas_charts", o.atlas_charts, 0, 1000000, "",
+                 "the fewest UV charts for a texture to count as a baked atlas (0: any texture)")
+        .choice("unnamed", o.unnamed,
+                {{"network", HybridOptions::Unnamed::kNetwork},
+                 {"nameless", HybridOptions::Unnamed::kNameless},
+                 {"pbr", HybridOptions::Unnamed::kPbr}},
+                "a model nothing names goes to the network whole (network), when its names are placeholders "
+                "(nameless), or is read by pbr");
+  }
+
+  // The settings, then the network they ask for. A network that cannot run is
+  // not an error: the backend labels as `pbr` and says so in warnings().
   Status configure(const BackendSettings& settings) override {
-    BackendSettings network;
-    HybridOptions o;
-    for (const auto& [key, value] : settings) {
-      double v = 0;
-      const bool number = detail::parse_double(value, v);
-      if (key == "model_card" || (key == "flip" && (value == "on" || value == "off"))) {
-        network[key] = value;
-      } else if (key == "share" && number && v > 0 && v <= 1) {
-        o.share = v;
-      } else if (key == "prior" && number && v >= 0 && v <= 1) {
-        o.prior = v;
-      } else if (key == "names" && (value == "off" || (number && v > 0 && v <= 1))) {
-        o.names = value == "off" ? 2.0 : v;
-      } else if (key == "scope" && (value == "model" || value == "material")) {
-        o.model_scope = value == "model";
-      } else if (key == "colour" && (value == "on" || value == "off")) {
-        o.colour = value == "on";
-      } else if (key == "atlas_charts" && number && v >= 0 && v <= 1e6 && v == std::floor(v)) {
-        o.atlas_charts = static_cast<int>(v);
-      } else if (key == "unnamed" && (value == "network" || value == "nameless" || value == "pbr")) {
-        o.unnamed = value == "network"    ? HybridOptions::Unnamed::kNetwork
-                    : value == "nameless" ? HybridOptions::Unnamed::kNameless
-                                          : HybridOptions::Unnamed::kPbr;
-      } else {
-        return Status::InvalidArgument(
-            "hybrid: bad setting " + key + "=" + value +
-            " (known: model_card=FILE, flip=on|off, share=(0,1], prior=[0,1], "
-            "names=(0,1]|off, scope=model|material, colour=on|off, atlas_charts=N, unnamed=network|nameless|pbr)");
-      }
-    }
-    options_ = o;
+    G2P_RETURN_IF_ERROR(Segmenter::configure(settings));
     warnings_.clear();
     unavailable_.clear();
     network_.reset();
-    if (network.count("model_card") == 0) {
+    BackendSettings network{{"model_card", card_}, {"flip", flip_ ? "on" : "off"}};
+    if (card_.empty()) {
       const std::string card = detail::shipped_model_card();
       if (card.empty()) {
         unavailable_ =
@@ -366,6 +364,8 @@ class HybridSegmenter final : public Segmenter {
   }
 
   HybridOptions options_;
+  std::string card_;                    // model_card ("" = the shipped card)
+  bool flip_ = false;                   // flip
   std::unique_ptr<Segmenter> network_;  // null when it cannot run
   std::unique_ptr<Segmenter> pbr_ = make_pbr_segmenter();
   std::string unavailable_;            // why the network cannot run (empty: it can, or has not been asked)

@@ -83,35 +83,15 @@ class LearnedSegmenter final : public Segmenter {
  public:
   explicit LearnedSegmenter(bool per_model) : per_model_(per_model), name_(per_model ? "auto" : "learned") {}
 
-  Status configure(const BackendSettings& settings) override {
-    BackendSettings network;
-    for (const auto& [key, value] : settings) {
-      if (key == "model_card" || key == "flip") {
-        network[key] = value;
-      } else if (key == "names") {
-        double v = 0;
-        if (value == "off")
-          threshold_ = 2.0;  // never reached
-        else if (detail::parse_double(value, v) && v > 0 && v <= 1)
-          threshold_ = v;
-        else
-          return Status::InvalidArgument(name_ + ": names needs a threshold in (0, 1] or 'off', got '" + value + "'");
-      } else if (key == "pbr" && (value == "on" || value == "off")) {
-        trust_pbr_ = value == "on";
-      } else {
-        return Status::InvalidArgument(name_ + ": bad setting " + key + "=" + value +
-                                       " (known: model_card=FILE, flip=on|off, names=THRESHOLD|off, pbr=on|off)");
-      }
-    }
-    if (network.count("model_card") == 0) {
-      const std::string card = detail::shipped_model_card();
-      if (card.empty()) return Status::Ok();  // set_model says what is missing
-      network["model_card"] = card;
-    }
-    network_ = detail::make_deferred_onnx_segmenter();  // loaded by set_model, for the first model that needs it
-    G2P_RETURN_IF_ERROR(network_->configure(network));
-    configured_ = true;
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec(name_)
+        .text("model_card", card_, "the network's card (g2p-materials.json); \"\" finds the shipped one")
+        .flag("flip", flip_, "the network also reads each view mirrored")
+        .number("names", threshold_, Range::above_to(0, 1), "",
+                "name-evidence threshold for a face's names to name a class")
+        .or_word("off", 2.0)
+        .flag("pbr", trust_pbr_, "a material with authored PBR counts as named")
+        .check([this] { return connect(); });
   }
 
   Status set_model(const Model& model, const MaterialTable& table) override {
@@ -182,6 +162,24 @@ class LearnedSegmenter final : public Segmenter {
   }
 
  private:
+  // The network for the settings as they are: loaded by set_model, for the
+  // first model that needs it. No card found: set_model says what is missing.
+  Status connect() {
+    BackendSettings network{{"model_card", card_}, {"flip", flip_ ? "on" : "off"}};
+    if (card_.empty()) {
+      const std::string card = detail::shipped_model_card();
+      if (card.empty()) return Status::Ok();
+      network["model_card"] = card;
+    }
+    std::unique_ptr<Segmenter> net = detail::make_deferred_onnx_segmenter();
+    G2P_RETURN_IF_ERROR(net->configure(network));
+    network_ = std::move(net);
+    configured_ = true;
+    return Status::Ok();
+  }
+
+  std::string card_;   // model_card ("" = the shipped card)
+  bool flip_ = false;  // flip
   std::unique_ptr<Segmenter> network_;
   std::unique_ptr<Segmenter> names_ = make_pbr_segmenter();
   bool configured_ = false;

@@ -162,28 +162,11 @@ class OnnxSegmenter final : public Segmenter {
   // loaded by the first set_model (see make_deferred_onnx_segmenter).
   explicit OnnxSegmenter(bool deferred = false) : deferred_(deferred) {}
 
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [k, v] : settings) {
-      if (k == "flip") {
-        if (v != "on" && v != "off") return Status::InvalidArgument("onnx: flip needs on or off, got '" + v + "'");
-        flip_ = v == "on";
-        continue;
-      }
-      if (k != "model_card")
-        return Status::InvalidArgument("onnx: unknown setting '" + k + "' (known: model_card, flip)");
-      Result<ModelCard> card = read_card(v);
-      if (!card.ok()) return card.status();
-      card_ = std::move(*card);
-      net_ = cv::dnn::Net();
-      if (deferred_) {
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(card_.model_path, ec))
-          return Status::NotFound(card_.model_path + ": the model card's network file is missing");
-        continue;
-      }
-      G2P_RETURN_IF_ERROR(load_network());
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("onnx")
+        .text("model_card", card_path_, "the network's card (JSON: the ONNX file, input size, classes)")
+        .flag("flip", flip_, "also read each view mirrored and average the two")
+        .check([this] { return load_card(); });
   }
 
   Status set_model(const Model&, const MaterialTable& table) override {
@@ -304,6 +287,30 @@ class OnnxSegmenter final : public Segmenter {
   }
 
  private:
+  // The card named by model_card, and its network unless deferred; the
+  // backend keeps its old card when either cannot be read.
+  Status load_card() {
+    if (card_path_ == loaded_card_) return Status::Ok();
+    Result<ModelCard> card = read_card(card_path_);
+    if (!card.ok()) return card.status();
+    if (deferred_) {
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(card->model_path, ec))
+        return Status::NotFound(card->model_path + ": the model card's network file is missing");
+    }
+    ModelCard old = std::move(card_);
+    card_ = std::move(*card);
+    net_ = cv::dnn::Net();
+    if (!deferred_) {
+      if (Status s = load_network(); !s.ok()) {
+        card_ = std::move(old);
+        return s;
+      }
+    }
+    loaded_card_ = card_path_;
+    return Status::Ok();
+  }
+
   // Reads card_.model_path into net_ (OpenCV's dnn module, on the CPU).
   Status load_network() {
     try {
@@ -319,6 +326,7 @@ class OnnxSegmenter final : public Segmenter {
   }
 
   bool deferred_ = false;
+  std::string card_path_, loaded_card_;  // model_card, and the card card_ holds
   ModelCard card_;
   bool flip_ = false;  // test-time mirroring (setting flip)
   mutable cv::dnn::Net net_;

@@ -56,19 +56,16 @@ namespace {
 
 class OracleSegmenter final : public Segmenter {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [k, v] : settings) {
-      if (k == "labels")
-        labels_path_ = v;
-      else if (k == "key")
-        key_ = v;
-      else
-        return Status::InvalidArgument("oracle: unknown setting '" + k + "' (known: labels, key)");
-    }
-    // Refused when made, before a run loads and renders anything.
-    if (labels_path_.empty())
-      return Status::InvalidArgument("oracle: needs the setting labels=FILE.json (the ground truth, labels.json form)");
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("oracle")
+        .text("labels", labels_path_, "the ground truth (labels.json form; required)")
+        .text("key", key_, "the model's entry in it (default: the model file's name)")
+        .check([this] {
+          // Refused when made, before a run loads and renders anything.
+          if (!labels_path_.empty()) return Status::Ok();
+          return Status::InvalidArgument(
+              "oracle: needs the setting labels=FILE.json (the ground truth, labels.json form)");
+        });
   }
 
   Status set_model(const Model& model, const MaterialTable& table) override {

@@ -160,21 +160,10 @@ float texture_grain(const Texture& t) {
 
 class PbrSegmenter final : public Segmenter {
  public:
-  Status configure(const BackendSettings& settings) override {
-    for (const auto& [key, value] : settings) {
-      if (key == "names") {
-        if (value != "on" && value != "off") return Status::InvalidArgument("pbr: names must be on or off");
-        use_names_ = value == "on";
-      } else if (key == "temperature") {
-        char* end = nullptr;
-        temperature_ = std::strtof(value.c_str(), &end);
-        if (end == value.c_str() || *end != '\0' || !std::isfinite(temperature_) || !(temperature_ > 0.f))
-          return Status::InvalidArgument("pbr: temperature must be a number > 0, got '" + value + "'");
-      } else {
-        return Status::InvalidArgument("pbr: unknown setting '" + key + "' (known: names, temperature)");
-      }
-    }
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("pbr")
+        .flag("names", use_names_, "material, texture, mesh and node names count as evidence")
+        .number("temperature", temperature_, Range::above(0), "", "softness of the class probabilities");
   }
 
   Status set_model(const Model& model, const MaterialTable& table) override {

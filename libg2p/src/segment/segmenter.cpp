@@ -6,10 +6,9 @@ namespace g2p {
 
 Segmenter::~Segmenter() = default;
 
-Status Segmenter::configure(const BackendSettings& settings) {
-  if (settings.empty()) return Status::Ok();
-  return Status::InvalidArgument("this segmenter takes no settings (got '" + settings.begin()->first + "')");
-}
+SettingsSpec Segmenter::settings() { return SettingsSpec("this segmenter"); }
+
+Status Segmenter::configure(const BackendSettings& settings) { return this->settings().apply(settings); }
 
 std::vector<std::string> Segmenter::warnings() const { return {}; }
 std::vector<std::uint8_t> Segmenter::image_decided_faces() const { return {}; }
@@ -22,7 +21,7 @@ Result<LabelMap> Segmenter::segment(const View& view) const {
 
 Registry<Segmenter>& segmenter_registry() {
   static Registry<Segmenter>* registry = [] {
-    auto* r = new Registry<Segmenter>();  // never destroyed: usable during static destruction
+    auto* r = new Registry<Segmenter>("segmenter");  // never destroyed: usable during static destruction
     (void)r->add("pbr", &make_pbr_segmenter);
     (void)r->add("onnx", &make_onnx_segmenter);
     (void)r->add("oracle", &make_oracle_segmenter);
@@ -32,13 +31,6 @@ Registry<Segmenter>& segmenter_registry() {
     return r;
   }();
   return *registry;
-}
-
-Result<std::unique_ptr<Segmenter>> make_segmenter(const std::string& name, const BackendSettings& settings) {
-  Result<std::unique_ptr<Segmenter>> s = segmenter_registry().create(name);
-  if (!s.ok()) return s.status();
-  G2P_RETURN_IF_ERROR((*s)->configure(settings));
-  return s;
 }
 
 }  // namespace g2p

@@ -31,7 +31,6 @@ namespace g2p {
 namespace {
 
 using cgal_detail::number;
-using cgal_detail::parse_positive;
 using cgal_detail::Point;
 using cgal_detail::SurfaceMesh;
 using cgal_detail::to_mesh;
@@ -94,24 +93,12 @@ Holes find_holes(const Mesh& patch) {
 
 class AlphaWrapCompleter final : public Completer {
  public:
-  Status configure(const BackendSettings& settings) override {
-    double alpha = relative_alpha_, offset = relative_offset_, distance = max_relative_distance_;
-    for (const auto& [key, value] : settings) {
-      if (key == "relative_alpha") {
-        G2P_RETURN_IF_ERROR(parse_positive("alpha-wrap", key, value, alpha));
-      } else if (key == "relative_offset") {
-        G2P_RETURN_IF_ERROR(parse_positive("alpha-wrap", key, value, offset));
-      } else if (key == "max_relative_distance") {
-        G2P_RETURN_IF_ERROR(parse_positive("alpha-wrap", key, value, distance));
-      } else {
-        return Status::InvalidArgument("alpha-wrap: unknown setting '" + key +
-                                       "' (known: relative_alpha, relative_offset, max_relative_distance)");
-      }
-    }
-    relative_alpha_ = alpha;
-    relative_offset_ = offset;
-    max_relative_distance_ = distance;
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("alpha-wrap")
+        .number("relative_alpha", relative_alpha_, Range::above(0), "", "the wrap's alpha, x the part's diagonal")
+        .number("relative_offset", relative_offset_, Range::above(0), "", "the wrap's offset, x the part's diagonal")
+        .number("max_relative_distance", max_relative_distance_, Range::above(0), "",
+                "a part whose surface strays farther from its patch (x the patch's diagonal) fails");
   }
 
   Result<Completion> complete(const CompletionInput& input) const override {

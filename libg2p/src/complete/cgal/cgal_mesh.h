@@ -29,17 +29,6 @@ inline std::string number(double v) {
   return buf;
 }
 
-// A strictly positive, finite number, or an error naming the backend and `key`.
-inline Status parse_positive(const std::string& backend, const std::string& key, const std::string& value,
-                             double& out) {
-  char* end = nullptr;
-  const double v = std::strtod(value.c_str(), &end);
-  if (end == value.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0))
-    return Status::InvalidArgument(backend + ": " + key + " needs a positive number, got '" + value + "'");
-  out = v;
-  return Status::Ok();
-}
-
 // A closed CGAL mesh as a libg2p mesh (positions and triangles only).
 inline Mesh to_mesh(const SurfaceMesh& sm) {
   Mesh m;

@@ -32,7 +32,6 @@ namespace g2p {
 namespace {
 
 using cgal_detail::number;
-using cgal_detail::parse_positive;
 using cgal_detail::Point;
 using cgal_detail::SurfaceMesh;
 using cgal_detail::to_mesh;
@@ -63,27 +62,13 @@ std::string load_patch(const Mesh& patch, SurfaceMesh& sm) {
 
 class FillCompleter final : public Completer {
  public:
-  Status configure(const BackendSettings& settings) override {
-    double hole = max_relative_hole_, distance = max_relative_distance_;
-    unsigned continuity = fairing_continuity_;
-    for (const auto& [key, value] : settings) {
-      if (key == "max_relative_hole") {
-        G2P_RETURN_IF_ERROR(parse_positive("fill", key, value, hole));
-      } else if (key == "max_relative_distance") {
-        G2P_RETURN_IF_ERROR(parse_positive("fill", key, value, distance));
-      } else if (key == "fairing_continuity") {
-        if (value != "0" && value != "1" && value != "2")
-          return Status::InvalidArgument("fill: fairing_continuity must be 0, 1 or 2, got '" + value + "'");
-        continuity = static_cast<unsigned>(value[0] - '0');
-      } else {
-        return Status::InvalidArgument("fill: unknown setting '" + key +
-                                       "' (known: max_relative_hole, fairing_continuity, max_relative_distance)");
-      }
-    }
-    max_relative_hole_ = hole;
-    max_relative_distance_ = distance;
-    fairing_continuity_ = continuity;
-    return Status::Ok();
+  SettingsSpec settings() override {
+    return SettingsSpec("fill")
+        .number("max_relative_hole", max_relative_hole_, Range::above(0), "",
+                "holes wider than this (x the part's diagonal) are not filled")
+        .integer("fairing_continuity", fairing_continuity_, 0, 2, "", "smoothness of the fill: 0, 1 or 2")
+        .number("max_relative_distance", max_relative_distance_, Range::above(0), "",
+                "a part whose surface strays farther from its patch (x the patch's diagonal) fails");
   }
 
   Result<Completion> complete(const CompletionInput& input) const override {
@@ -121,9 +106,9 @@ class FillCompleter final : public Completer {
     for (std::size_t i = 0; i < holes.size(); ++i) {
       std::vector<SurfaceMesh::Face_index> faces;
       std::vector<SurfaceMesh::Vertex_index> vertices;
-      const auto r =
-          PMP::triangulate_refine_and_fair_hole(sm, holes[i], std::back_inserter(faces), std::back_inserter(vertices),
-                                                CGAL::parameters::fairing_continuity(fairing_continuity_));
+      const auto r = PMP::triangulate_refine_and_fair_hole(
+          sm, holes[i], std::back_inserter(faces), std::back_inserter(vertices),
+          CGAL::parameters::fairing_continuity(static_cast<unsigned>(fairing_continuity_)));
       if (faces.empty())
         return Status::Unavailable("fill: CGAL found no triangulation for hole " + std::to_string(i + 1) + " of " +
                                    std::to_string(holes.size()));
@@ -153,7 +138,7 @@ class FillCompleter final : public Completer {
 
   double max_relative_hole_ = 0.3;
   double max_relative_distance_ = 0.25;
-  unsigned fairing_continuity_ = 1;
+  int fairing_continuity_ = 1;
 };
 
 }  // namespace

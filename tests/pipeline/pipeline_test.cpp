@@ -164,6 +164,54 @@ TEST(Pipeline, CompletionReportsProgressInsideTheStageAndCanBeStoppedThere) {
   EXPECT_EQ(inside.front().message, "distances");
 }
 
+TEST(Pipeline, DecompositionReportsEachPartAndCanBeStoppedThere) {
+  std::vector<Progress> parts;
+  RunContext listening([&](const Progress& p) {
+    if (p.stage == Stage::kDecompose && p.message.rfind("part ", 0) == 0) parts.push_back(p);
+  });
+  PipelineOptions o = quick_options();
+  o.completer.settings = {{"resolution", "48"}};  // coarse volumes: this is about the reports
+  Result<PipelineResult> r = Pipeline(o).run_file(hammer(), &listening);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  ASSERT_EQ(parts.size(), r->collision.size());  // one report per part, in the order they finished
+  EXPECT_DOUBLE_EQ(parts.back().stage_fraction, 1.0);
+  for (std::size_t i = 1; i < parts.size(); ++i) EXPECT_GT(parts[i].stage_fraction, parts[i - 1].stage_fraction);
+
+  RunContext* self = nullptr;
+  std::vector<Progress> inside;
+  RunContext context([&](const Progress& p) {
+    if (p.stage == Stage::kDecompose && p.message.rfind("part ", 0) == 0) {
+      inside.push_back(p);
+      self->cancel();  // Cancel pressed after the first part's hulls
+    }
+  });
+  self = &context;
+  Result<PipelineResult> stopped = Pipeline(o).run_file(hammer(), &context);
+  ASSERT_FALSE(stopped.ok());
+  EXPECT_EQ(stopped.status().code(), StatusCode::kCancelled) << stopped.status().to_string();
+  EXPECT_EQ(inside.size(), 1u);  // no part reports after the button
+}
+
+TEST(Pipeline, PropertiesReportEachPartAndCanBeStoppedThere) {
+  RunContext* self = nullptr;
+  std::vector<Progress> inside;
+  RunContext context([&](const Progress& p) {
+    if (p.stage == Stage::kProperties && p.stage_fraction > 0.0 && p.stage_fraction < 1.0) {
+      inside.push_back(p);
+      self->cancel();  // a slow estimator (a VLM per part) stopped between parts
+    }
+  });
+  self = &context;
+  PipelineOptions o = quick_options();
+  o.completer.settings = {{"resolution", "48"}};
+  Result<PipelineResult> r = Pipeline(o).run_file(hammer(), &context);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled) << r.status().to_string();
+  ASSERT_EQ(inside.size(), 1u);
+  EXPECT_EQ(inside.front().message, "part 0 weighed");
+  EXPECT_DOUBLE_EQ(inside.front().stage_fraction, 0.5);  // the hammer's two parts
+}
+
 TEST(Pipeline, StopsAfterTheLastStageAskedFor) {
   PipelineOptions o = quick_options();
   o.last_stage = Stage::kRefine;

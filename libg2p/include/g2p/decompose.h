@@ -102,12 +102,16 @@ G2P_API Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Dec
 // With the object and its parts (the completion's input), no hull gets more
 // vertices than the part's own faces have (at least 4), so that no
 // collision mesh is denser than the input it stands for, and min_depth_m
-// 0 means 1 % of the object's bounding-box diagonal.
+// 0 means 1 % of the object's bounding-box diagonal. `progress` hears of each
+// finished part (from the worker threads, one call at a time); once it
+// returns an error (a cancelled run) no further part starts, and those left
+// get no hulls and the note "not decomposed: <its message>".
 G2P_API std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
                                                          const DecomposeOptions& options = {},
                                                          const std::string& backend = "custom",
                                                          const Mesh* object = nullptr,
-                                                         const std::vector<Part>* parts = nullptr);
+                                                         const std::vector<Part>* parts = nullptr,
+                                                         const StageProgress& progress = {});
 
 // The convex hull of `points` as a closed, outward triangle mesh. With
 // max_vertices > 0 and a hull of more vertices, the hull is rebuilt from a

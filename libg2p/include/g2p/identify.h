@@ -220,7 +220,8 @@ G2P_API Result<SizePolicy> parse_size_policy(const std::string& text);  // the f
 G2P_API Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const std::vector<Part>& parts,
                                                              const Completion& completion, const MaterialTable& table,
                                                              const PropertyEstimator& estimator, const ObjectKind& kind,
-                                                             const std::vector<View>* views = nullptr);
+                                                             const std::vector<View>* views = nullptr,
+                                                             const StageProgress& progress = {});
 
 // The kind's materials by role as evidence for the image's classes (issue
 // #48): a weight per class of `table`, 1 for each class the kind lists

@@ -218,11 +218,14 @@ struct PropertiesReport {
 inline constexpr const char* kContentsLeftOut = "contents left out: ";
 
 // Estimates every completed part and combines them. Parts whose completion
-// failed (no closed mesh) are left out of the totals and noted.
+// failed (no closed mesh) are left out of the totals and noted. `progress`
+// hears of each part weighed; an error it returns (a cancelled run) ends the
+// call with it before the next part.
 G2P_API Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vector<Part>& parts,
                                                      const Completion& completion, const MaterialTable& table,
                                                      const PropertyEstimator& estimator,
-                                                     const std::vector<View>* views = nullptr);
+                                                     const std::vector<View>* views = nullptr,
+                                                     const StageProgress& progress = {});
 
 // report.json (docs/report-schema.md).
 G2P_API std::string report_json(const PropertiesReport& report, const MaterialTable& table);

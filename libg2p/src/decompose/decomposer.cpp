@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <set>
 
 #include "decompose/backends.h"
@@ -186,35 +188,66 @@ Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer&
   return out;
 }
 
+namespace {
+
+// Part i of the completion, as decompose_parts() describes.
+ConvexDecomposition decompose_one(const Completion& completion, const Decomposer& decomposer,
+                                  const DecomposeOptions& options, const std::string& backend, const Mesh* object,
+                                  const std::vector<Part>* parts, std::size_t i) {
+  ConvexDecomposition out;
+  const Mesh& closed = completion.parts[i].mesh;
+  if (closed.num_faces() == 0) {
+    out.notes.push_back("no closed volume to decompose");
+    return out;
+  }
+  DecomposeOptions own = options;
+  if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * bounds(*object).diagonal().norm();
+  if (object != nullptr && parts != nullptr && i < parts->size()) {
+    std::set<std::array<float, 3>> corners;  // the part's distinct vertex positions
+    for (int f : (*parts)[i].faces)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3f& p =
+            object->positions[static_cast<std::size_t>(object->triangles[static_cast<std::size_t>(f)][k])];
+        corners.insert({p.x(), p.y(), p.z()});
+      }
+    own.max_vertices_per_hull = std::clamp(static_cast<int>(corners.size()), 4, options.max_vertices_per_hull);
+  }
+  Result<ConvexDecomposition> d = decompose_part(closed, decomposer, own);
+  if (!d.ok()) {
+    out.notes.push_back(d.status().message());
+    return out;
+  }
+  out = std::move(*d);
+  if (out.backend.empty()) out.backend = backend;
+  return out;
+}
+
+}  // namespace
+
 std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, const Decomposer& decomposer,
                                                  const DecomposeOptions& options, const std::string& backend,
-                                                 const Mesh* object, const std::vector<Part>* parts) {
+                                                 const Mesh* object, const std::vector<Part>* parts,
+                                                 const StageProgress& progress) {
   std::vector<ConvexDecomposition> out(completion.parts.size());
+  std::mutex reporting;
+  std::size_t finished = 0;
+  Status stop;  // the first error progress returned; guarded by `reporting`
+  std::atomic<bool> stopped{false};
   tbb::parallel_for(std::size_t{0}, out.size(), [&](std::size_t i) {
-    const Mesh& closed = completion.parts[i].mesh;
-    if (closed.num_faces() == 0) {
-      out[i].notes.push_back("no closed volume to decompose");
+    if (stopped) {
+      std::lock_guard<std::mutex> lock(reporting);
+      out[i].backend = backend;
+      out[i].notes.push_back("not decomposed: " + stop.message());
       return;
     }
-    DecomposeOptions own = options;
-    if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * bounds(*object).diagonal().norm();
-    if (object != nullptr && parts != nullptr && i < parts->size()) {
-      std::set<std::array<float, 3>> corners;  // the part's distinct vertex positions
-      for (int f : (*parts)[i].faces)
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector3f& p =
-              object->positions[static_cast<std::size_t>(object->triangles[static_cast<std::size_t>(f)][k])];
-          corners.insert({p.x(), p.y(), p.z()});
-        }
-      own.max_vertices_per_hull = std::clamp(static_cast<int>(corners.size()), 4, options.max_vertices_per_hull);
-    }
-    Result<ConvexDecomposition> d = decompose_part(closed, decomposer, own);
-    if (!d.ok()) {
-      out[i].notes.push_back(d.status().message());
-      return;
-    }
-    out[i] = std::move(*d);
-    if (out[i].backend.empty()) out[i].backend = backend;
+    out[i] = decompose_one(completion, decomposer, options, backend, object, parts, i);
+    if (!progress) return;
+    std::lock_guard<std::mutex> lock(reporting);
+    ++finished;
+    if (!stop.ok()) return;
+    stop = progress(static_cast<double>(finished) / static_cast<double>(out.size()),
+                    "part " + std::to_string(i) + ": " + std::to_string(out[i].hulls.size()) + " hulls");
+    if (!stop.ok()) stopped = true;
   });
   return out;
 }

@@ -104,7 +104,7 @@ const PartReport* part_report(const PropertiesReport& r, int part) {
 Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const std::vector<Part>& parts,
                                                      const Completion& completion, const MaterialTable& table,
                                                      const PropertyEstimator& estimator, const ObjectKind& kind,
-                                                     const std::vector<View>* views) {
+                                                     const std::vector<View>* views, const StageProgress& progress) {
   // The body: the part with the largest closed volume.
   int body = -1;
   double largest = 0.0;
@@ -116,7 +116,7 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
     }
   }
   KindEstimator by_kind(estimator, kind, parts, body);
-  Result<PropertiesReport> report = estimate_properties(object, parts, completion, table, by_kind, views);
+  Result<PropertiesReport> report = estimate_properties(object, parts, completion, table, by_kind, views, progress);
   if (!report.ok() || kind.hidden.empty()) return report;
 
   double fraction = 0.0;
@@ -145,7 +145,7 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
   }
   // The cavity's volume: the contents' mass with the whole cavity at 1000 kg/m^3.
   by_kind.set_contents(1.0, 1000.0);
-  Result<PropertiesReport> probe = estimate_properties(object, parts, completion, table, by_kind, views);
+  Result<PropertiesReport> probe = estimate_properties(object, parts, completion, table, by_kind, views, progress);
   if (!probe.ok()) return probe.status();
   const PartReport* probed = part_report(*probe, body);
   const double cavity_m3 = probed != nullptr ? probed->contents.mass_kg / 1000.0 : 0.0;
@@ -161,7 +161,7 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
   }
   density = std::min(density, kMaxHiddenDensity);
   by_kind.set_contents(fill, density);
-  Result<PropertiesReport> placed = estimate_properties(object, parts, completion, table, by_kind, views);
+  Result<PropertiesReport> placed = estimate_properties(object, parts, completion, table, by_kind, views, progress);
   if (!placed.ok()) return placed.status();
   const PartReport* held_by = part_report(*placed, body);
   const double held = held_by != nullptr ? held_by->contents.mass_kg : 0.0;

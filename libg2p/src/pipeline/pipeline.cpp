@@ -440,10 +440,15 @@ Status Pipeline::Impl::estimate(RunState& s) {
     overriding = make_overriding_estimator(*estimator.get(), *s.resolved);
   const PropertyEstimator& chosen = overriding ? *overriding : *estimator.get();
   const std::vector<View>* views = r.views.empty() ? nullptr : &r.views;
+  RunContext& context = s.context;
+  const StageProgress progress = [&context](double fraction, const std::string& message) {
+    return context.report(Stage::kProperties, fraction, message);
+  };
   Result<PropertiesReport> report =
       o.kind_properties && !r.kind.name.empty()
-          ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, views)
-          : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views);
+          ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, views,
+                                        progress)
+          : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views, progress);
   if (!report.ok()) return report.status().with_context("properties");
   r.properties = std::move(*report);
   r.properties.size = object_size(r.model);
@@ -495,8 +500,16 @@ Status Pipeline::Impl::decompose_collision(RunState& s) {
   const PipelineOptions& o = options;
   detail::StageClock clock(Stage::kDecompose, decomposer.backend(o.decomposer), o.measure_stage_memory);
   G2P_RETURN_IF_ERROR(s.context.report(Stage::kDecompose, 0.0, std::to_string(r.completion.parts.size()) + " parts"));
-  r.collision = decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer),
-                                &r.model.mesh, &r.projection.parts);
+  RunContext& context = s.context;
+  Status stopped;  // the run's answer to a part's report, when it says stop
+  r.collision =
+      decompose_parts(r.completion, *decomposer.get(), o.decompose, decomposer.backend(o.decomposer), &r.model.mesh,
+                      &r.projection.parts, [&context, &stopped](double fraction, const std::string& message) {
+                        Status answer = context.report(Stage::kDecompose, fraction, message);
+                        if (!answer.ok() && stopped.ok()) stopped = answer;
+                        return answer;
+                      });
+  if (!stopped.ok()) return stopped;
   int hulls = 0, fell_back = 0, none = 0;
   for (std::size_t i = 0; i < r.collision.size(); ++i) {
     const ConvexDecomposition& d = r.collision[i];

@@ -50,7 +50,8 @@ void add_contents(PartReport& r, const Mesh& closed, bool closed_ok, std::vector
 
 Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vector<Part>& parts,
                                              const Completion& completion, const MaterialTable& table,
-                                             const PropertyEstimator& estimator, const std::vector<View>* views) {
+                                             const PropertyEstimator& estimator, const std::vector<View>* views,
+                                             const StageProgress& progress) {
   if (completion.parts.size() != parts.size())
     return Status::InvalidArgument("properties: " + std::to_string(completion.parts.size()) + " completed parts for " +
                                    std::to_string(parts.size()) + " parts");
@@ -60,6 +61,9 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
   Result<std::shared_ptr<const SurfaceRays>> object_rays = SurfaceRays::build(object);
   if (!object_rays.ok()) return object_rays.status().with_context("properties");
   for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (progress && i > 0)
+      G2P_RETURN_IF_ERROR(progress(static_cast<double>(i) / static_cast<double>(parts.size()),
+                                   "part " + std::to_string(i - 1) + " weighed"));
     const CompletedPart& completed = completion.parts[i];
     PartReport r;
     r.part = static_cast<int>(i);

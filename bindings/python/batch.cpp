@@ -145,7 +145,7 @@ py::dict remote_options(const BatchOptions& o, const py::object& tool) {
   d["timeout_s"] = o.timeout_s;
   d["memory_limit_gib"] = o.memory_limit_gib;
   d["kill_grace_s"] = o.kill_grace_s;
-  d["run_args"] = o.run_args;
+  d["options"] = options_file_json(o.run);  // as data: the worker reads it back
   d["tool"] = tool.is_none() ? py::object(py::none()) : py::object(py::str(o.tool));
   return d;
 }
@@ -156,7 +156,7 @@ py::dict run_remote(const py::dict& asset, const py::dict& options, const py::ob
   BatchAsset a;
   a.path = asset["path"].cast<std::string>();
   a.name = asset["name"].cast<std::string>();
-  a.run_args = asset["run_args"].cast<std::vector<std::string>>();
+  a.options = asset["options"].cast<std::string>();
   a.origin = asset["origin"].cast<std::string>();
   BatchOptions o;
   o.tool = find_tool(options["tool"]);  // the worker's own g2p unless the batch named one
@@ -164,7 +164,7 @@ py::dict run_remote(const py::dict& asset, const py::dict& options, const py::ob
   o.timeout_s = options["timeout_s"].cast<double>();
   o.memory_limit_gib = options["memory_limit_gib"].cast<double>();
   o.kill_grace_s = options["kill_grace_s"].cast<double>();
-  o.run_args = options["run_args"].cast<std::vector<std::string>>();
+  o.run = unwrap(parse_options_file(options["options"].cast<std::string>(), "the batch's options"));
   py::object event;
   if (!stop_event.is_none()) event = py::module_::import("distributed").attr("Event")(stop_event);
   auto last_check = std::chrono::steady_clock::now();
@@ -214,7 +214,7 @@ class DaskExecutor : public BatchExecutor {
       py::dict a;
       a["path"] = asset.path;
       a["name"] = asset.name;
-      a["run_args"] = asset.run_args;
+      a["options"] = asset.options;
       a["origin"] = asset.origin;
       futures_.emplace_back(ticket, client_.attr("submit")(task_, a, options_, event_name_, py::arg("pure") = false,
                                                            py::arg("key") = "g2p-" + asset.name + "-" + event_name_));
@@ -272,8 +272,9 @@ class DaskExecutor : public BatchExecutor {
 };
 
 py::object run(const py::object& inputs, const py::object& output_path, const py::object& manifest, int jobs,
-               double timeout, double memory_limit, const py::object& run_args, bool retry_failed,
-               const py::object& tool, const py::object& progress, bool dataframe, const py::object& client) {
+               double timeout, double memory_limit, const py::object& options, const py::object& materials,
+               bool retry_failed, const py::object& tool, const py::object& progress, bool dataframe,
+               const py::object& client) {
   if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
     throw py::type_error("progress must be callable (it receives a dict: done, total, failed, eta_s, ...)");
   std::vector<BatchAsset> assets;
@@ -292,7 +293,8 @@ py::object run(const py::object& inputs, const py::object& output_path, const py
   o.jobs = jobs;
   o.timeout_s = timeout;
   o.memory_limit_gib = memory_limit;
-  o.run_args = strings(run_args, "run_args");
+  if (!options.is_none()) o.run.pipeline = options.cast<PipelineOptions>();
+  if (!materials.is_none()) o.run.materials = materials.cast<MaterialTable>();
   o.retry_failed = retry_failed;
   py::object error;  // what the progress callback raised, or KeyboardInterrupt
   o.stop_requested = [&error]() -> int {
@@ -339,15 +341,17 @@ py::object run(const py::object& inputs, const py::object& output_path, const py
 
 void bind_batch(py::module_& m) {
   m.def("batch", &run, py::arg("inputs"), py::arg("output"), py::kw_only(), py::arg("manifest") = py::none(),
-        py::arg("jobs") = 1, py::arg("timeout") = 0.0, py::arg("memory_limit") = 0.0, py::arg("run_args") = py::none(),
-        py::arg("retry_failed") = false, py::arg("tool") = py::none(), py::arg("progress") = py::none(),
-        py::arg("dataframe") = false, py::arg("client") = py::none(),
+        py::arg("jobs") = 1, py::arg("timeout") = 0.0, py::arg("memory_limit") = 0.0, py::arg("options") = py::none(),
+        py::arg("materials") = py::none(), py::arg("retry_failed") = false, py::arg("tool") = py::none(),
+        py::arg("progress") = py::none(), py::arg("dataframe") = false, py::arg("client") = py::none(),
         R"(Runs many models through `g2p run`, each in its own worker process, into output/NAME.
 
 inputs: model files, folders (every model file below) or glob patterns; manifest: a CSV or JSON Lines
-file with a row per model (path, name, unit, up, segmenter, height, longest_side). jobs: worker
-processes; timeout: seconds per model (0 = none); memory_limit: GiB per model (0 = none); run_args:
-`g2p run` flags for every model (["--views", "6"]). A crash, hang or out-of-memory in one model is
+file with a row per model (path, name, unit, up, segmenter, height, longest_side, object; a JSON
+Lines row may add "options"). jobs: worker processes; timeout: seconds per model (0 = none);
+memory_limit: GiB per model (0 = none); options: a g2p.PipelineOptions for every model (default
+g2p.PipelineOptions()), each row's own over it; materials: a g2p.MaterialTable (default the
+paper's). Each model's options reach its `g2p run` as an options file. A crash, hang or out-of-memory in one model is
 a row with status "failed" and its cause; the batch goes on. output/index.json and index.csv hold
 every row; a rerun skips unchanged models (retry_failed=True reruns the recorded failures).
 tool: the g2p executable (default $G2P_TOOL, the built or installed one, or g2p on PATH).

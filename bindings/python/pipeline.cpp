@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "bindings.h"
+#include "g2p/options_file.h"
 
 namespace g2p::python {
 
@@ -320,6 +321,38 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("overrides", &PipelineOptions::overrides, "g2p.Overrides: corrections to apply")
       .def_readwrite("last_stage", &PipelineOptions::last_stage)
       .def_readwrite("measure_stage_memory", &PipelineOptions::measure_stage_memory);
+
+  // ---- Options files (g2p/options_file.h) ----
+  auto pair = [](RunOptions r) { return py::make_tuple(std::move(r.pipeline), std::move(r.materials)); };
+  auto base = [](const py::object& options, const py::object& materials) {
+    RunOptions r;
+    if (!options.is_none()) r.pipeline = options.cast<PipelineOptions>();
+    if (!materials.is_none()) r.materials = materials.cast<MaterialTable>();
+    return r;
+  };
+  m.def(
+      "options_file_json",
+      [base](const py::object& options, const py::object& materials) {
+        return options_file_json(base(options, materials));
+      },
+      py::arg("options") = py::none(), py::arg("materials") = py::none(),
+      "An options file's text (what `g2p run --options` reads) for g2p.PipelineOptions and a g2p.MaterialTable.");
+  m.def(
+      "parse_options_file",
+      [pair, base](const std::string& text, const py::object& options, const py::object& materials) {
+        return pair(unwrap(parse_options_file(text, "options", base(options, materials))));
+      },
+      py::arg("text"), py::arg("options") = py::none(), py::arg("materials") = py::none(),
+      "(PipelineOptions, MaterialTable) from an options file's text: the keys it gives over options and materials "
+      "(default: the library's). An unknown key or a bad value raises naming its key path.");
+  m.def(
+      "read_options_file",
+      [pair, base](const py::object& path, const py::object& options, const py::object& materials) {
+        const std::string file = py::str(py::module_::import("os").attr("fspath")(path));
+        return pair(unwrap(read_options_file(file, base(options, materials))));
+      },
+      py::arg("path"), py::arg("options") = py::none(), py::arg("materials") = py::none(),
+      "parse_options_file on a file (an output folder's options.json is one).");
 
   // ---- Result ----
   py::class_<PyPipelineResult>(

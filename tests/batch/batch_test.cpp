@@ -18,7 +18,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kQuick{"--views", "6", "--resolution", "160"};
+// Six views of 160 x 160 pixels.
+RunOptions quick_run() {
+  RunOptions r;
+  r.pipeline.views.num_views = 6;
+  r.pipeline.views.width = r.pipeline.views.height = 160;
+  return r;
+}
 
 std::string hammer() { return test::source_path("examples/data/hammer.obj"); }
 
@@ -50,7 +56,7 @@ BatchOptions quick_options(const std::string& out) {
   BatchOptions o;
   o.tool = G2P_TEST_TOOL;
   o.output_dir = out;
-  o.run_args = kQuick;
+  o.run = quick_run();
   return o;
 }
 
@@ -71,7 +77,14 @@ std::vector<std::string> hidden_leftovers(const std::string& out) {
   return left;
 }
 
-TEST(BatchManifest, CsvAndJsonLinesGiveAssetsWithTheirOwnFlags) {
+// An asset's own options over the library's defaults.
+PipelineOptions own_options(const BatchAsset& a) {
+  Result<RunOptions> r = parse_options_file(a.options, a.origin);
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  return r.ok() ? r->pipeline : PipelineOptions{};
+}
+
+TEST(BatchManifest, CsvAndJsonLinesGiveAssetsWithTheirOwnOptions) {
   const std::string dir = test::scratch_dir("BatchManifest");
   test::write_file(dir + "/assets.csv",
                    "path,name,unit,up,height\n"
@@ -85,19 +98,41 @@ TEST(BatchManifest, CsvAndJsonLinesGiveAssetsWithTheirOwnFlags) {
   EXPECT_EQ((*csv)[0].path, (fs::path(dir) / "models/a.obj").string());  // relative to the manifest
   EXPECT_EQ((*csv)[0].name, "first");
   EXPECT_EQ((*csv)[0].origin, dir + "/assets.csv:3");
-  EXPECT_EQ((*csv)[0].run_args, (std::vector<std::string>{"--name", "first", "--unit", "cm", "--up", "z"}));
+  const PipelineOptions first = own_options((*csv)[0]);
+  EXPECT_EQ(first.name, "first");
+  EXPECT_DOUBLE_EQ(first.import.unit_scale, 0.01);
+  EXPECT_EQ(first.import.up_axis, UpAxis::kZ);
+  EXPECT_EQ(first.views.num_views, PipelineOptions{}.views.num_views);  // what the row does not give: unchanged
   EXPECT_EQ((*csv)[1].path, "/abs/b, with comma.glb");
-  EXPECT_EQ((*csv)[1].run_args, (std::vector<std::string>{"--height", "0.3"}));
+  EXPECT_DOUBLE_EQ(own_options((*csv)[1]).import.height_m, 0.3);
 
   test::write_file(dir + "/assets.jsonl",
                    "{\"path\": \"x.ply\", \"segmenter\": \"learned\", \"longest_side\": 0.5}\n"
-                   "{\"path\": \"y.stl\", \"object\": \"exercise bike\"}\n");
+                   "{\"path\": \"y.stl\", \"object\": \"exercise bike\", \"options\": {\"views\": {\"count\": 4}, "
+                   "\"object\": \"chair\", \"segmenter\": {\"settings\": {\"share\": 0.5}}}}\n");
   Result<std::vector<BatchAsset>> jsonl = read_batch_manifest(dir + "/assets.jsonl");
   ASSERT_TRUE(jsonl.ok()) << jsonl.status().to_string();
   ASSERT_EQ(jsonl->size(), 2u);
-  EXPECT_EQ((*jsonl)[0].run_args, (std::vector<std::string>{"--longest-side", "0.5", "--segmenter", "learned"}));
+  const PipelineOptions x = own_options((*jsonl)[0]);
+  EXPECT_DOUBLE_EQ(x.import.longest_side_m, 0.5);
+  EXPECT_EQ(x.segmenter.name, "learned");
   EXPECT_EQ((*jsonl)[1].origin, dir + "/assets.jsonl:2");
-  EXPECT_EQ((*jsonl)[1].run_args, (std::vector<std::string>{"--object", "exercise bike"}));
+  const PipelineOptions y = own_options((*jsonl)[1]);
+  EXPECT_EQ(y.object, "exercise bike");  // the column over the row's options
+  EXPECT_EQ(y.views.num_views, 4);
+  EXPECT_EQ(y.segmenter.settings, (BackendSettings{{"share", "0.5"}}));
+
+  // Over a batch's options: the asset's keys win, the batch's others stay.
+  BatchOptions batch;
+  batch.run = quick_run();
+  batch.run.pipeline.import.height_m = 2.0;
+  batch.memory_limit_gib = 1.5;
+  Result<RunOptions> merged = batch_asset_options((*jsonl)[0], batch);
+  ASSERT_TRUE(merged.ok()) << merged.status().to_string();
+  EXPECT_DOUBLE_EQ(merged->pipeline.import.longest_side_m, 0.5);
+  EXPECT_DOUBLE_EQ(merged->pipeline.import.height_m, 0.0);  // a size given replaces the other
+  EXPECT_EQ(merged->pipeline.views.num_views, 6);
+  EXPECT_EQ(merged->pipeline.memory_limit_bytes, std::size_t{3} << 29);
 }
 
 TEST(BatchManifest, ABadRowIsAnErrorNamingFileAndLine) {
@@ -114,6 +149,11 @@ TEST(BatchManifest, ABadRowIsAnErrorNamingFileAndLine) {
            Case{"f.jsonl", "{\"path\": \"x.obj\"}\n{\"path\": \"y.obj\"\n", "f.jsonl:2: not a JSON object"},
            Case{"g.jsonl", "{\"path\": \"x.obj\"}\n\n{\"name\": \"y\"}\n", "g.jsonl:3: no path"},
            Case{"h.jsonl", "{\"path\": \"x.obj\", \"up\": [1]}\n", "h.jsonl:1: 'up' must be a string or a number"},
+           Case{"i.csv", "path,up\nx.obj,sideways\n", "i.csv:2: up 'sideways': unknown up axis"},
+           Case{"j.jsonl", "{\"path\": \"x.obj\", \"options\": {\"views\": {\"count\": \"six\"}}}\n",
+                "j.jsonl:1: options: views.count: expected an integer, got \"six\""},
+           Case{"k.jsonl", "{\"path\": \"x.obj\", \"options\": {\"view\": {}}}\n",
+                "k.jsonl:1: options: view: unknown key"},
        }) {
     test::write_file(dir + "/" + c.file, c.text);
     Result<std::vector<BatchAsset>> r = read_batch_manifest(dir + "/" + c.file);
@@ -167,11 +207,18 @@ TEST(BatchInputs, FoldersPatternsAndUniqueNames) {
 TEST(BatchRun, ARefusedRunRecordsItsReason) {
   const std::string dir = test::scratch_dir("BatchRefused");
   const std::string model = hammer_copy(dir, "tool");
+  // A flag out of range is the batch's own command line: exit 2 before any work.
   test::ToolRun r =
-      test::run_tool("batch " + test::quote(model) + " -o " + test::quote(dir + "/out") + " --views 0 -q");
+      test::run_tool("batch " + test::quote(model) + " -o " + test::quote(dir + "/flag") + " --views 0 -q");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--views: Value 0 not in range"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/flag"));
+  // A run that refuses its options is a row with the run's message.
+  r = test::run_tool("batch " + test::quote(model) + " -o " + test::quote(dir + "/out") +
+                     " --object 'flying saucer' -q");
   EXPECT_EQ(r.exit_code, 1) << r.err;
   const std::string index = test::read_file(dir + "/out/index.csv");
-  EXPECT_NE(index.find("tool,failed,--views: Value 0 not in range"), std::string::npos) << index;
+  EXPECT_NE(index.find("tool,failed,\"--object 'flying saucer' names no kind"), std::string::npos) << index;
   EXPECT_EQ(index.find("Run with --help"), std::string::npos) << index;
 }
 
@@ -248,9 +295,10 @@ TEST(BatchRun, ACrashAndAHangAmongGoodAssetsAreRecordedAndTheBatchGoesOn) {
 
 TEST(BatchRun, TheMemoryLimitReachesEveryWorker) {
   const std::string dir = test::scratch_dir("BatchMemory");
-  std::vector<BatchAsset> assets{{hammer_copy(dir, "hog"), "", {}, "hog"},
-                                 {hammer_copy(dir, "small"), "", {}, "small"},
-                                 {hammer_copy(dir, "large"), "", {"--resolution", "2048", "--views", "11"}, "large"}};
+  std::vector<BatchAsset> assets{
+      {hammer_copy(dir, "hog"), "", {}, "hog"},
+      {hammer_copy(dir, "small"), "", {}, "small"},
+      {hammer_copy(dir, "large"), "", R"({"views": {"count": 11, "width": 2048, "height": 2048}})", "large"}};
   ASSERT_TRUE(name_batch_assets(assets).ok());
   BatchOptions o = quick_options(dir + "/out");
   o.tool = misbehaving_tool(dir);
@@ -299,7 +347,7 @@ TEST(BatchRun, ARerunSkipsUnchangedAssetsAndRetriesFailuresOnRequest) {
   EXPECT_EQ(changed->skipped, 1u);  // the failure stands
   EXPECT_NE(row_named(*changed, "a").key, key_a);
   BatchOptions other = o;
-  other.run_args.insert(other.run_args.end(), {"--format", "urdf"});
+  other.run.pipeline.formats = {"urdf"};
   Result<BatchResult> reflagged = run_batch(assets, other);
   ASSERT_TRUE(reflagged.ok());
   EXPECT_EQ(reflagged->succeeded, 2u);
@@ -378,6 +426,22 @@ TEST(BatchRun, UnusableOptionsFailBeforeAnyWork) {
   const Status s = run_batch(assets, o).status();
   EXPECT_NE(s.message().find("index.json: not a g2p batch index"), std::string::npos) << s.message();
   EXPECT_FALSE(fs::exists(dir + "/junk/hammer"));
+  // An asset's own options that do not fit: refused naming the asset and the key, nothing runs.
+  std::vector<BatchAsset> bad{{hammer(), "hammer", R"({"views": {"layout": "cube"}})", "assets.jsonl:4"}};
+  const Status refused = run_batch(bad, quick_options(dir + "/refused")).status();
+  EXPECT_EQ(refused.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.message().find("assets.jsonl:4: options: views.layout: unknown view layout 'cube'"),
+            std::string::npos)
+      << refused.message();
+  EXPECT_FALSE(fs::exists(dir + "/refused/hammer"));
+  // Credentials in a URL: never written to the options file its run would read, so refused.
+  BatchOptions secret = quick_options(dir + "/secret");
+  secret.run.pipeline.estimator = {"vlm", {{"url", "http://me:pw-4711@127.0.0.1:9/v1"}, {"model", "m"}}};
+  const Status said = run_batch(assets, secret).status();
+  EXPECT_EQ(said.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(said.message().find("estimator.settings.url has credentials in its URL"), std::string::npos)
+      << said.message();
+  EXPECT_EQ(said.message().find("pw-4711"), std::string::npos);
 }
 
 }  // namespace

@@ -86,6 +86,39 @@ TEST(Exporters, MujocoCompilesTheHammerWithLibg2psMassProperties) {
     EXPECT_EQ(test::read_file(dir + "/" + f).find(dir), std::string::npos) << f;
 }
 
+// g2p validate's check of a folder: the engine's numbers beside the report's,
+// which a wrong report fails.
+TEST(Exporters, AFolderCheckComparesTheEngineWithTheReport) {
+  if (!have_mujoco()) GTEST_SKIP() << "libg2p built without MuJoCo";
+  const SimulationAsset asset = hammer_asset(kMetal);
+  const std::string dir = test::scratch_dir("ExportFolderCheck");
+  ASSERT_TRUE(write_asset(dir, asset, {"mjcf"}).ok());
+  Result<FolderCheck> alone = check_folder_in_mujoco(dir);
+  ASSERT_TRUE(alone.ok()) << alone.status().to_string();
+  EXPECT_EQ(alone->mjcf, dir + "/hammer.xml");
+  EXPECT_FALSE(alone->has_report);
+  EXPECT_TRUE(alone->pass());
+  const Eigen::Vector3d c = asset.total.center_of_mass, m = asset.total.principal_moments();
+  auto report = [&](double mass) {
+    test::write_file(dir + "/report.json", nlohmann::json{{"object",
+                                                           {{"mass_kg", mass},
+                                                            {"center_of_mass_m", {c.x(), c.y(), c.z()}},
+                                                            {"principal_moments_kg_m2", {m.x(), m.y(), m.z()}}}}}
+                                               .dump());
+    return check_folder_in_mujoco(dir);
+  };
+  Result<FolderCheck> same = report(asset.total.mass_kg);
+  ASSERT_TRUE(same.ok());
+  EXPECT_TRUE(same->has_report);
+  EXPECT_TRUE(same->numbers_match);
+  EXPECT_TRUE(same->drop_ok);
+  Result<FolderCheck> wrong = report(asset.total.mass_kg * 1.01);
+  ASSERT_TRUE(wrong.ok());
+  EXPECT_FALSE(wrong->numbers_match);
+  EXPECT_FALSE(wrong->pass());
+  EXPECT_EQ(check_folder_in_mujoco(dir + "/none").status().code(), StatusCode::kNotFound);
+}
+
 // |angular acceleration| of the hammer hinged on a horizontal axis (body y)
 // through its bounding-box centre, handle horizontal, released from rest.
 double hinge_acceleration(const SimulationAsset& asset, const std::string& dir, double& predicted) {

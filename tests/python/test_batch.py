@@ -15,7 +15,7 @@ import g2p
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HAMMER = pathlib.Path(os.environ.get("G2P_HAMMER_OBJ", str(ROOT / "examples" / "data" / "hammer.obj")))
-QUICK = ["--views", "6", "--resolution", "160"]
+QUICK = g2p.PipelineOptions(views=g2p.ViewOptions(num_views=6, width=160, height=160))
 
 try:
     import pandas
@@ -51,7 +51,7 @@ class BatchTest(unittest.TestCase):
         empty = self.dir / "empty.obj"
         empty.write_bytes(b"")
         seen = []
-        rows = g2p.batch([good, str(empty)], self.dir / "out", jobs=2, run_args=QUICK, progress=seen.append)
+        rows = g2p.batch([good, str(empty)], self.dir / "out", jobs=2, options=QUICK, progress=seen.append)
         self.assertEqual([r["name"] for r in rows], ["good", "empty"])
         ok, bad = rows
         self.assertEqual(ok["status"], "ok", ok["error"])
@@ -69,7 +69,7 @@ class BatchTest(unittest.TestCase):
 
         # Unchanged: a rerun starts nothing and returns the same rows.
         seen.clear()
-        again = g2p.batch([good, empty], self.dir / "out", run_args=QUICK, progress=seen.append)
+        again = g2p.batch([good, empty], self.dir / "out", options=QUICK, progress=seen.append)
         self.assertEqual([r["key"] for r in again], [r["key"] for r in rows])
         self.assertEqual(seen[-1]["skipped"], 2)
         self.assertEqual(g2p.read_batch_index(self.dir / "out"), again)
@@ -78,7 +78,7 @@ class BatchTest(unittest.TestCase):
     def test_a_crashing_model_is_a_row_not_a_dead_interpreter(self):
         tool = crashing_tool(self.dir, os.environ["G2P_TEST_TOOL"])
         models = [hammer_copy(self.dir, "fine"), hammer_copy(self.dir, "crash")]
-        rows = g2p.batch(models, self.dir / "out", run_args=QUICK, tool=tool)
+        rows = g2p.batch(models, self.dir / "out", options=QUICK, tool=tool)
         by_name = {r["name"]: r for r in rows}
         self.assertEqual(by_name["fine"]["status"], "ok")
         self.assertEqual(by_name["crash"]["status"], "failed")
@@ -87,11 +87,31 @@ class BatchTest(unittest.TestCase):
 
     @unittest.skipIf(pandas is None, "pandas (python3-pandas) is not installed")
     def test_a_dataframe_with_pandas(self):
-        frame = g2p.batch(hammer_copy(self.dir, "h"), self.dir / "out", run_args=QUICK, dataframe=True)
+        frame = g2p.batch(hammer_copy(self.dir, "h"), self.dir / "out", options=QUICK, dataframe=True)
         self.assertIsInstance(frame, pandas.DataFrame)
         self.assertEqual(list(frame["status"]), ["ok"])
         self.assertEqual(int(frame.loc[0, "parts"]), 2)
         self.assertEqual(list(g2p.batch_dataframe(g2p.read_batch_index(self.dir / "out"))["name"]), ["h"])
+
+    def test_options_reach_each_run_as_an_options_file(self):
+        # A JSON Lines row's own options over the batch's; the run's folder keeps what it ran with.
+        good = hammer_copy(self.dir, "h")
+        manifest = self.dir / "assets.jsonl"
+        manifest.write_text('{"path": "h.obj", "options": {"formats": ["urdf"], "views": {"count": 4}}}\n')
+        options = g2p.PipelineOptions(views=g2p.ViewOptions(num_views=6, width=160, height=160), formats=["mjcf"])
+        rows = g2p.batch(None, self.dir / "out", manifest=manifest, options=options)
+        self.assertEqual(rows[0]["status"], "ok", rows[0]["error"])
+        used, _ = g2p.read_options_file(self.dir / "out" / "h" / "options.json")
+        self.assertEqual(used.views.num_views, 4)
+        self.assertEqual(used.views.width, 160)
+        self.assertEqual(used.formats, ["urdf"])
+        self.assertTrue((self.dir / "out" / "h" / "h.urdf").exists())
+        # The text round-trips, and a bad key is named.
+        again, _ = g2p.parse_options_file(g2p.options_file_json(used))
+        self.assertEqual(again.views.num_views, 4)
+        with self.assertRaises(g2p.ParseError) as caught:
+            g2p.parse_options_file('{"views": {"count": "six"}}')
+        self.assertIn("views.count: expected an integer", str(caught.exception))
 
     def test_errors_are_g2p_exceptions(self):
         manifest = self.dir / "assets.csv"

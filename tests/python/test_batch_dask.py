@@ -24,7 +24,7 @@ except ImportError:
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HAMMER = pathlib.Path(os.environ.get("G2P_HAMMER_OBJ", str(ROOT / "examples" / "data" / "hammer.obj")))
 TOOL = os.environ.get("G2P_TEST_TOOL", "")
-QUICK = ["--views", "6", "--resolution", "160"]
+QUICK = g2p.PipelineOptions(views=g2p.ViewOptions(num_views=6, width=160, height=160))
 
 
 def hammer_copy(folder, name):
@@ -73,7 +73,7 @@ class DaskBatchTest(unittest.TestCase):
         models.append(empty)
         out = self.dir / "out"
         with get_task_stream(self.client) as tasks:
-            rows = g2p.batch(models, out, run_args=QUICK, timeout=15, tool=misbehaving_tool(self.dir),
+            rows = g2p.batch(models, out, options=QUICK, timeout=15, tool=misbehaving_tool(self.dir),
                              client=self.client)
         # Every model was a task of the cluster, on both of its workers.
         ran = [t for t in tasks.data if t["key"].startswith("g2p-")]
@@ -93,7 +93,7 @@ class DaskBatchTest(unittest.TestCase):
 
         # The same index the local pool keeps: a rerun (local or on the cluster) starts nothing.
         seen = []
-        again = g2p.batch(models, out, run_args=QUICK, timeout=15, tool=misbehaving_tool(self.dir), client=self.client,
+        again = g2p.batch(models, out, options=QUICK, timeout=15, tool=misbehaving_tool(self.dir), client=self.client,
                           progress=seen.append)
         self.assertEqual(seen[-1]["skipped"], 5)
         self.assertEqual([r["key"] for r in again], [r["key"] for r in rows])
@@ -108,7 +108,7 @@ class DaskBatchTest(unittest.TestCase):
 
         start = time.monotonic()
         with self.assertRaisesRegex(RuntimeError, "stop here"):
-            g2p.batch(models, out, run_args=QUICK, tool=misbehaving_tool(self.dir), client=self.client,
+            g2p.batch(models, out, options=QUICK, tool=misbehaving_tool(self.dir), client=self.client,
                       progress=progress)
         self.assertLess(time.monotonic() - start, 60)  # not the hanging task's 300 s
         index = {r["name"]: r for r in g2p.read_batch_index(out)}
@@ -121,13 +121,18 @@ class DaskBatchTest(unittest.TestCase):
         out = self.dir / "out"
         env = dict(os.environ)
         r = subprocess.run(
-            [TOOL, "batch", str(model), "-o", str(out), *QUICK, "--scheduler", self.cluster.scheduler_address],
+            [TOOL, "batch", str(model), "-o", str(out), "--views", "6", "--resolution", "160", "--format", "urdf",
+             "--scheduler", self.cluster.scheduler_address],
             capture_output=True, text=True, env=env, timeout=240,
         )
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
         self.assertIn("1 assets: 1 ok, 0 failed on the Dask cluster", r.stdout)
         index = json.loads((out / "index.json").read_text())["assets"]
         self.assertEqual(index[0]["status"], "ok")
+        # The flags reached the worker's run as its options file.
+        self.assertTrue((out / "cli" / "cli.urdf").exists())
+        self.assertFalse((out / "cli" / "cli.xml").exists())
+        self.assertEqual(json.loads((out / "cli" / "options.json").read_text())["views"]["count"], 6)
         # An address where no scheduler listens: a clear error, exit 1.
         r = subprocess.run(
             [TOOL, "batch", str(model), "-o", str(self.dir / "none"), "--scheduler", "tcp://me:secret@127.0.0.1:9"],

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "g2p/io.h"
+#include "g2p/options_file.h"
 #include "segment/segment_fixtures.h"
 #include "support/test_data.h"
 #include "support/tool_run.h"
@@ -33,6 +34,45 @@ const std::string kQuick = " --views 6 --resolution 160";
 const std::string kLabelsOnly = kQuick + " --complete-set resolution=48 --decomposer hull";
 
 std::string hammer() { return test::quote(test::source_path("examples/data/hammer.obj")); }
+
+// A run's folder holds its options (options.json); `g2p run --options` with
+// that file gives the same result, and flags beside it are refused.
+TEST(ToolRun, AnOptionsFileRepeatsARun) {
+  const std::string dir = test::scratch_dir("ToolRunOptions");
+  test::ToolRun first = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/first") + kLabelsOnly +
+                                       " --height 0.5 --format urdf,mjcf --json");
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const std::string file = dir + "/first/options.json";
+  Result<RunOptions> written = read_options_file(file);
+  ASSERT_TRUE(written.ok()) << written.status().to_string();
+  EXPECT_DOUBLE_EQ(written->pipeline.import.height_m, 0.5);
+  EXPECT_EQ(written->pipeline.views.num_views, 6);
+  EXPECT_EQ(written->pipeline.decomposer.name, "hull");
+  EXPECT_EQ(written->pipeline.completer.settings, (BackendSettings{{"resolution", "48"}}));
+
+  test::ToolRun again = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/again") + " --options " +
+                                       test::quote(file) + " --json");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const nlohmann::json a = nlohmann::json::parse(first.out), b = nlohmann::json::parse(again.out);
+  EXPECT_EQ(b["object"]["mass_kg"], a["object"]["mass_kg"]);
+  EXPECT_EQ(b["parts"].size(), a["parts"].size());
+  EXPECT_TRUE(fs::exists(dir + "/again/hammer.urdf"));
+  EXPECT_FALSE(fs::exists(dir + "/again/hammer.sdf"));
+  EXPECT_EQ(test::read_file(dir + "/again/options.json"), test::read_file(file));
+
+  // A flag beside --options, a bad key or value: exit 2 naming it, nothing written.
+  test::ToolRun both = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/both") + " --options " +
+                                      test::quote(file) + " --views 4");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.err.find("--views and --options exclude each other"), std::string::npos) << both.err;
+  test::write_file(dir + "/bad.json", R"({"views": {"count": "six"}})");
+  test::ToolRun bad = test::run_tool("run " + hammer() + " -o " + test::quote(dir + "/bad") + " --options " +
+                                     test::quote(dir + "/bad.json"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("bad.json: views.count: expected an integer"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir + "/both"));
+  EXPECT_FALSE(fs::exists(dir + "/bad"));
+}
 
 TEST(ToolRun, HammerToAssetsWithAJsonSummary) {
   const std::string dir = test::scratch_dir("ToolRun");

@@ -11,48 +11,14 @@
 #include <iostream>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
 #include "g2p/batch.h"
+#include "stage_flags.h"
 
 namespace g2p::cli {
 namespace {
-
-// `g2p run` flags that `g2p batch` passes on to every asset, as given.
-struct PassThrough {
-  const char* flag;
-  const char* help;
-  bool takes_value;
-  bool repeatable;
-};
-const PassThrough kPassThrough[] = {
-    {"--unit", "Length unit of the files (m, cm, mm, in, ft)", true, false},
-    {"--up", "Up axis of the files (auto, y, z, ...)", true, false},
-    {"--height", "Real height of every object, metres", true, false},
-    {"--longest-side", "Real longest side of every object, metres", true, false},
-    {"--views", "Number of views (default 11)", true, false},
-    {"--resolution", "View resolution in pixels (default 512)", true, false},
-    {"--object", "What every object is, in words (a manifest's object column gives it per model)", true, false},
-    {"--identifier", "Identifier backend (default auto)", true, false},
-    {"--size-from", "kind or file: may a normalised mesh take its kind's size (default kind)", true, false},
-    {"--kind-confidence", "The least identification confidence the run acts on", true, false},
-    {"--kind-prior", "Weight of the classes an identified kind does not list (1 = not used)", true, false},
-    {"--segmenter", "Segmenter backend (default hybrid)", true, false},
-    {"--set", "Segmenter setting KEY=VALUE (repeatable)", true, true},
-    {"--refiner", "Refiner backend (default smooth)", true, false},
-    {"--completer", "Completer backend (default partition)", true, false},
-    {"--estimator", "Property estimator backend (default table)", true, false},
-    {"--decomposer", "Decomposer backend (default voxel-cut)", true, false},
-    {"--decompose-set", "Decomposer setting KEY=VALUE (repeatable)", true, true},
-    {"--materials", "Material table JSON", true, false},
-    {"--format", "Formats: mjcf, urdf, sdf, glb (comma-separated)", true, false},
-    {"--soft", "Soft votes in the project stage", false, false},
-    {"--fixed", "MJCF: fix the body to the world", false, false},
-    {"--keep-axes", "Keep the file's axes", false, false},
-    {"--no-textures", "Ignore textures", false, false},
-    {"--lenient", "Keep the good triangles of a damaged file", false, false},
-    {"--anonymize-names", "Replace every name by a meaningless one first", false, false},
-    {"--base-color-only", "Keep only base colour, as image-to-3D generators emit it", false, false},
-};
 
 struct BatchArgs {
   std::vector<std::string> inputs;
@@ -60,8 +26,9 @@ struct BatchArgs {
   int jobs = 1;
   double timeout_s = 0.0, memory_limit_gib = 0.0;
   bool retry_failed = false, fail_on_error = false, quiet = false;
-  std::vector<std::vector<std::string>> pass_values = std::vector<std::vector<std::string>>(std::size(kPassThrough));
-  std::vector<bool> pass_flags = std::vector<bool>(std::size(kPassThrough), false);
+  PipelineArgs pipeline;  // every asset's options: `g2p run`'s flags
+  std::string options_file;
+  std::vector<CLI::Option*> pipeline_flags;  // what --options replaces
 };
 
 volatile std::sig_atomic_t g_stop = 0;
@@ -123,55 +90,6 @@ int usage(const std::string& message) {
   return kExitUsage;
 }
 
-// `g2p batch --scheduler ADDRESS`: the same batch through the Python module's
-// Dask executor (g2p.batch(..., client=Client(ADDRESS))); this process
-// becomes that Python program. The summary and the exit codes are the same.
-const char* const kDaskDriver = R"PY(
-import json, signal, sys
-a = json.loads(sys.argv[1])
-try:
-    import g2p
-    from distributed import Client
-except ImportError as e:
-    sys.stderr.write("g2p batch: --scheduler needs the g2p Python module (PYTHONPATH) and python3-distributed: %s\n" % e)
-    sys.exit(2)
-def on_term(signum, frame):
-    raise SystemExit(143)
-signal.signal(signal.SIGTERM, on_term)
-try:
-    client = Client(a["scheduler"], timeout=a["connect_timeout"])
-except Exception as e:
-    sys.stderr.write("g2p batch: error: cannot reach the Dask scheduler at %s (%s)\n" % (a["shown"], type(e).__name__))
-    sys.exit(1)
-def progress(p):
-    if p["last"] and not a["quiet"]:
-        eta = "-" if p["eta_s"] < 0 else "%.0fs" % p["eta_s"]
-        sys.stderr.write("g2p batch: [%d/%d, %d failed, ETA %s] %s\n" % (p["done"], p["total"], p["failed"], eta, p["last"]))
-try:
-    rows = g2p.batch(a["inputs"] or None, a["output"], manifest=a["manifest"] or None, timeout=a["timeout"],
-                     memory_limit=a["memory_limit"], run_args=a["run_args"], retry_failed=a["retry_failed"],
-                     progress=progress, client=client)
-except KeyboardInterrupt:
-    sys.stderr.write("g2p batch: stopped (SIGINT); finished assets and the index are kept, a rerun goes on from here\n")
-    sys.exit(130)
-except SystemExit as e:
-    if e.code == 143:
-        sys.stderr.write("g2p batch: stopped (SIGTERM); finished assets and the index are kept, a rerun goes on from here\n")
-    raise
-except g2p.Error as e:
-    sys.stderr.write("g2p batch: error: %s\n" % e)
-    sys.exit(2 if isinstance(e, g2p.InvalidArgumentError) else 1)
-finally:
-    client.close()
-ok = sum(r["status"] == "ok" for r in rows)
-failed = [r for r in rows if r["status"] == "failed"]
-for r in failed:
-    origin = "" if r["origin"] == r["input"] else " (%s)" % r["origin"]
-    sys.stderr.write("g2p batch: failed: %s%s: %s\n" % (r["name"], origin, r["error"]))
-print("%d assets: %d ok, %d failed on the Dask cluster -> %s/index.csv" % (len(rows), ok, len(failed), a["output"]))
-sys.exit(1 if ok == 0 or (a["fail_on_error"] and failed) else 0)
-)PY";
-
 // A scheduler address as it may be shown: any user:password@ part hidden.
 std::string shown_address(const std::string& address) {
   const std::size_t scheme = address.find("://");
@@ -181,49 +99,32 @@ std::string shown_address(const std::string& address) {
   return address.substr(0, start) + "***@" + address.substr(at + 1);
 }
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_list(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (const std::string& i : items) out += (out.size() > 1 ? "," : "") + json_string(i);
-  return out + "]";
-}
-
-int run_on_dask(const BatchArgs& args, const std::vector<std::string>& run_args) {
-  char number[64];
-  std::string j = "{\"scheduler\":" + json_string(args.scheduler) +
-                  ",\"shown\":" + json_string(shown_address(args.scheduler)) + ",\"inputs\":" + json_list(args.inputs) +
-                  ",\"manifest\":" + json_string(args.manifest) + ",\"output\":" + json_string(args.out) +
-                  ",\"run_args\":" + json_list(run_args);
-  std::snprintf(number, sizeof number, ",\"timeout\":%.17g,\"memory_limit\":%.17g,\"connect_timeout\":%d",
-                args.timeout_s, args.memory_limit_gib, 30);
-  j += number;
-  j += std::string(",\"retry_failed\":") + (args.retry_failed ? "true" : "false") +
-       ",\"fail_on_error\":" + (args.fail_on_error ? "true" : "false") +
-       ",\"quiet\":" + (args.quiet ? "true" : "false") + "}";
+// `g2p batch --scheduler ADDRESS`: the same batch through the Python module's
+// Dask executor (g2p.batch(..., client=Client(ADDRESS))): this process
+// becomes bindings/python/g2p_dask_batch.py, which reports as this one does.
+int run_on_dask(const BatchArgs& args, const RunOptions& options) {
+  const nlohmann::json a = {{"scheduler", args.scheduler},
+                            {"shown", shown_address(args.scheduler)},
+                            {"inputs", args.inputs},
+                            {"manifest", args.manifest},
+                            {"output", args.out},
+                            {"options", options_file_json(options)},
+                            {"timeout", args.timeout_s},
+                            {"memory_limit", args.memory_limit_gib},
+                            {"connect_timeout", 30},
+                            {"retry_failed", args.retry_failed},
+                            {"fail_on_error", args.fail_on_error},
+                            {"quiet", args.quiet}};
+  const std::string j = a.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   // The module of this build first (the installed one, or PYTHONPATH's, otherwise).
-  std::string path = G2P_CLI_PYTHON_DIR;
+  const std::string dir = G2P_CLI_PYTHON_DIR, driver = dir + "/g2p_dask_batch.py";
+  std::string path = dir;
   if (const char* old = std::getenv("PYTHONPATH"); old != nullptr && *old != '\0') path += std::string(":") + old;
   ::setenv("PYTHONPATH", path.c_str(), 1);
   const char* python = std::getenv("G2P_PYTHON");
   if (python == nullptr || *python == '\0')
     python = ::access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-  std::vector<const char*> argv{python, "-c", kDaskDriver, j.c_str(), nullptr};
+  std::vector<const char*> argv{python, driver.c_str(), j.c_str(), nullptr};
   std::fflush(nullptr);
   ::execvp(python, const_cast<char* const*>(argv.data()));
   std::cerr << "g2p batch: --scheduler needs Python 3 (" << python << ": " << std::strerror(errno) << ")\n";
@@ -264,14 +165,10 @@ int run_batch_command(const BatchArgs& args) {
   o.timeout_s = args.timeout_s;
   o.memory_limit_gib = args.memory_limit_gib;
   o.retry_failed = args.retry_failed;
-  for (std::size_t i = 0; i < std::size(kPassThrough); ++i) {
-    if (kPassThrough[i].takes_value) {
-      for (const std::string& v : args.pass_values[i]) o.run_args.insert(o.run_args.end(), {kPassThrough[i].flag, v});
-    } else if (args.pass_flags[i]) {
-      o.run_args.emplace_back(kPassThrough[i].flag);
-    }
-  }
-  if (!args.scheduler.empty()) return run_on_dask(args, o.run_args);
+  Result<RunOptions> options = run_options(args.pipeline, args.options_file, args.pipeline_flags);
+  if (!options.ok()) return usage(options.status().message());
+  o.run = std::move(*options);
+  if (!args.scheduler.empty()) return run_on_dask(args, o.run);
   BatchProgressPrinter printer(args.quiet);
   o.on_progress = [&printer](const BatchProgress& p) { printer(p); };
   o.stop_requested = [] { return static_cast<int>(g_stop); };
@@ -332,21 +229,12 @@ void add_batch_command(CLI::App& app, Command& run) {
   cmd->add_flag("--retry-failed", args->retry_failed, "Also rerun the assets the index records as failed");
   cmd->add_flag("--fail-on-error", args->fail_on_error, "Exit 1 when any asset failed");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
-  for (std::size_t i = 0; i < std::size(kPassThrough); ++i) {
-    const PassThrough& p = kPassThrough[i];
-    const std::string help = std::string(p.help) + " (passed to g2p run)";
-    if (!p.takes_value) {
-      cmd->add_flag_function(
-          p.flag, [args, i](std::int64_t) { args->pass_flags[i] = true; }, help);
-    } else if (p.repeatable) {
-      cmd->add_option(p.flag, args->pass_values[i], help)->allow_extra_args(false);
-    } else {
-      cmd->add_option_function<std::string>(
-          p.flag, [args, i](const std::string& v) { args->pass_values[i] = {v}; }, help);
-    }
-  }
+  add_options_file_flag(cmd, args->options_file);
+  args->pipeline_flags = add_pipeline_flags(cmd, args->pipeline);
+  add_settings_flag(cmd);
   cmd->footer(
-      "Each asset runs as `g2p run MODEL -o OUT/NAME` in its own process; a crash, timeout or out-of-memory is "
+      "Each asset runs as `g2p run MODEL -o OUT/NAME` in its own process, with the options `g2p run` takes "
+      "(a manifest's columns over them); a crash, timeout or out-of-memory is "
       "recorded in OUT/index.csv and the batch goes on. A rerun skips unchanged assets. Exit codes: 0 done (some "
       "assets may have failed: see the index), 1 nothing succeeded or --fail-on-error with a failure, 2 bad command "
       "line, 130 stopped (Ctrl-C), 143 stopped (SIGTERM); finished assets and the index stay.");

@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <iostream>
-#include <map>
 #include <sstream>
 
 #include "commands.h"
+#include "g2p/options_file.h"
 
 namespace g2p::cli {
 
@@ -53,10 +53,9 @@ Result<ImportOptions> import_options(const ImportArgs& args) {
     if (!scale.ok()) return scale.status();
     options.unit_scale = *scale;
   }
-  static const std::map<std::string, UpAxis> kAxes = {
-      {"auto", UpAxis::kAuto}, {"x", UpAxis::kX}, {"y", UpAxis::kY}, {"z", UpAxis::kZ}};
-  const auto axis = kAxes.find(args.up);
-  options.up_axis = axis != kAxes.end() ? axis->second : UpAxis::kAuto;
+  Result<UpAxis> up = parse_up_axis(args.up);
+  if (!up.ok()) return up.status().with_context("--up");
+  options.up_axis = *up;
   options.z_up = !args.keep_axes;
   options.load_textures = !args.no_textures;
   options.strict = !args.lenient;
@@ -106,14 +105,12 @@ std::string backend_list(const std::vector<std::string>& names) {
 }
 
 Result<ViewOptions> view_options(const ViewArgs& args) {
-  static const std::map<std::string, ViewLayout> kLayouts = {
-      {"sphere", ViewLayout::kSphere}, {"fibonacci", ViewLayout::kFibonacci}, {"turntable", ViewLayout::kTurntable}};
   ViewOptions o;
   o.num_views = args.views;
   o.width = o.height = args.resolution;
-  const auto layout = kLayouts.find(args.layout);
-  if (layout == kLayouts.end()) return Status::InvalidArgument("unknown layout '" + args.layout + "'");
-  o.layout = layout->second;
+  Result<ViewLayout> layout = parse_view_layout(args.layout);
+  if (!layout.ok()) return layout.status().with_context("--layout");
+  o.layout = *layout;
   o.fov_y_deg = args.fov;
   o.orthographic = args.ortho;
   return o;

@@ -9,6 +9,7 @@
 
 #include "g2p/io.h"
 #include "g2p/materials.h"
+#include "g2p/options_file.h"
 #include "g2p/pipeline.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
@@ -44,7 +45,7 @@ Result<Model> load_with_flags(const std::string& command, const std::string& pat
 struct ViewArgs {
   int views = ViewOptions{}.num_views;
   int resolution = ViewOptions{}.width;
-  std::string layout = "sphere";  // ViewOptions{}.layout
+  std::string layout = to_string(ViewOptions{}.layout);
   double fov = ViewOptions{}.fov_y_deg;
   bool ortho = ViewOptions{}.orthographic;
   std::string renderer = PipelineOptions{}.renderer.name;

@@ -18,8 +18,9 @@ namespace g2p::cli {
 namespace {
 
 struct RunArgs {
-  std::string model, out;
+  std::string model, out, options_file;
   PipelineArgs pipeline;
+  std::vector<CLI::Option*> pipeline_flags;  // what --options replaces
   bool overwrite = false, intermediates = false, json = false, quiet = false;
 };
 
@@ -73,7 +74,9 @@ int run_pipeline(const RunArgs& args) {
   folder.overwrite = args.overwrite;
   folder.input_path = args.model;
   if (Status s = check_output_folder(args.out, folder); !s.ok()) return usage("-o " + s.message());
-  Result<Pipeline> made = make_pipeline(args.pipeline);
+  Result<RunOptions> options = run_options(args.pipeline, args.options_file, args.pipeline_flags);
+  Result<Pipeline> made =
+      options.ok() ? make_pipeline(std::move(*options), args.pipeline.overrides) : Result<Pipeline>(options.status());
   if (!made.ok()) {
     const Status& s = made.status();
     if (s.code() == StatusCode::kInvalidArgument || s.code() == StatusCode::kNotFound ||
@@ -159,33 +162,17 @@ void add_run_command(CLI::App& app, Command& run) {
   cmd->add_option("model", args->model, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, ...)")->required();
   cmd->add_option("-o,--output", args->out, "Output folder (must not exist unless --overwrite)")->required();
   PipelineArgs& p = args->pipeline;
-  cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
   add_overrides_flag(cmd, p.overrides);
-  add_export_flags(cmd, p.export_args);
-  cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
-  cmd->add_flag("--base-color-only", p.base_color_only,
-                "Keep only base colour: metallic and roughness at glTF's default of 1, no metallic-roughness texture "
-                "or transmission (what image-to-3D generators emit; for measuring)");
-  cmd->add_flag("--soft", p.soft,
-                "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
-                "the learned and onnx segmenters)");
-  cmd->add_option("--vlm-url", p.vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
-  cmd->add_option("--vlm-model", p.vlm_model, "Model name for the vlm refiner/estimator");
+  add_options_file_flag(cmd, args->options_file);
   cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output folder (after the run succeeded)");
   cmd->add_flag("--save-intermediates", args->intermediates,
                 "Also write every view's buffers, per-view probabilities, per-face votes and part patches");
   cmd->add_flag("--json", args->json, "Print the run's summary (run.json) on stdout instead of text");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
-  cmd->add_option("--memory-limit", p.memory_limit_gib,
-                  "Refuse a run whose views and mesh would need more memory, in GiB (default 0: the machine's)");
-  add_import_flags(cmd, p.import);
-  add_view_flags(cmd, p.views);
-  add_identify_flags(cmd, p.identify);
-  add_segmenter_flags(cmd, p.segmenter);
-  add_refiner_flags(cmd, p.refiner, "smooth");
-  add_completer_flags(cmd, p.completer);
-  add_estimator_flags(cmd, p.estimator);
-  add_decomposer_flags(cmd, p.decomposer);
+  args->pipeline_flags = add_pipeline_flags(cmd, p);
+  args->pipeline_flags.push_back(
+      cmd->add_option("--memory-limit", p.memory_limit_gib,
+                      "Refuse a run whose views and mesh would need more memory, in GiB (default 0: the machine's)"));
   add_settings_flag(cmd);
   cmd->footer(
       "Exit codes: 0 success, 1 the run failed (bad input file, a stage error), 2 bad command line, 130 cancelled "

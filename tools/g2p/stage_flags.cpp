@@ -192,23 +192,76 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
   return o;
 }
 
-Result<Pipeline> make_pipeline(const PipelineArgs& args) {
-  register_optional_backends();
-  Result<PipelineOptions> options = pipeline_options(args);
-  if (!options.ok()) return options.status();
-  Pipeline pipeline(std::move(*options));
-  if (!args.materials.empty()) {
-    Result<MaterialTable> table = MaterialTable::load(args.materials);
-    if (!table.ok()) return table.status().with_context("--materials");
-    pipeline.set_material_table(std::move(*table));
+std::vector<CLI::Option*> add_pipeline_flags(CLI::App* cmd, PipelineArgs& p) {
+  const std::size_t before = cmd->get_options().size();
+  cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
+  add_export_flags(cmd, p.export_args);
+  cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
+  cmd->add_flag("--base-color-only", p.base_color_only,
+                "Keep only base colour: metallic and roughness at glTF's default of 1, no metallic-roughness texture "
+                "or transmission (what image-to-3D generators emit; for measuring)");
+  cmd->add_flag("--soft", p.soft,
+                "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
+                "the learned and onnx segmenters)");
+  cmd->add_option("--vlm-url", p.vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
+  cmd->add_option("--vlm-model", p.vlm_model, "Model name for the vlm refiner/estimator");
+  add_import_flags(cmd, p.import);
+  add_view_flags(cmd, p.views);
+  add_identify_flags(cmd, p.identify);
+  add_segmenter_flags(cmd, p.segmenter);
+  add_refiner_flags(cmd, p.refiner, PipelineOptions{}.refiner.name);
+  add_completer_flags(cmd, p.completer);
+  add_estimator_flags(cmd, p.estimator);
+  add_decomposer_flags(cmd, p.decomposer);
+  const std::vector<CLI::Option*> all = cmd->get_options();
+  return std::vector<CLI::Option*>(all.begin() + static_cast<std::ptrdiff_t>(before), all.end());
+}
+
+void add_options_file_flag(CLI::App* cmd, std::string& path) {
+  cmd->add_option("--options", path,
+                  "Every option from a JSON options file instead of flags: any subset of its keys, the rest at their "
+                  "defaults (docs/pipeline.md#options-files; each output folder's options.json is one)");
+}
+
+Result<RunOptions> run_options(const PipelineArgs& args, const std::string& options_file,
+                               const std::vector<CLI::Option*>& flags) {
+  if (options_file.empty()) {
+    Result<PipelineOptions> options = pipeline_options(args);
+    if (!options.ok()) return options.status();
+    RunOptions run{std::move(*options)};
+    if (!args.materials.empty()) {
+      Result<MaterialTable> table = MaterialTable::load(args.materials);
+      if (!table.ok()) return table.status().with_context("--materials");
+      run.materials = std::move(*table);
+    }
+    return run;
   }
-  if (!args.overrides.empty()) {
-    Result<Overrides> overrides = read_overrides(args.overrides, pipeline.material_table());
-    if (!overrides.ok()) return Status::InvalidArgument("--overrides " + overrides.status().message());
-    pipeline.options().overrides = std::move(*overrides);
+  for (const CLI::Option* f : flags)
+    if (f->count() > 0)
+      return Status::InvalidArgument(f->get_name() + " and --options exclude each other: give it in " + options_file +
+                                     " instead");
+  Result<RunOptions> run = read_options_file(options_file);
+  if (!run.ok()) return run.status().with_context("--options");
+  return run;
+}
+
+Result<Pipeline> make_pipeline(RunOptions options, const std::string& overrides) {
+  register_optional_backends();
+  Pipeline pipeline(std::move(options.pipeline));
+  pipeline.set_material_table(std::move(options.materials));
+  if (!overrides.empty()) {
+    Result<Overrides> read = read_overrides(overrides, pipeline.material_table());
+    if (!read.ok()) return Status::InvalidArgument("--overrides " + read.status().message());
+    pipeline.options().overrides = std::move(*read);
   }
   G2P_RETURN_IF_ERROR(pipeline.prepare());
   return pipeline;
+}
+
+Result<Pipeline> make_pipeline(const PipelineArgs& args) {
+  Result<RunOptions> options = run_options(args, "", {});
+  if (!options.ok()) return options.status();
+  return make_pipeline(std::move(*options), args.overrides);
 }
 
 }  // namespace g2p::cli

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common.h"
+#include "g2p/options_file.h"
 #include "g2p/pipeline.h"
 
 namespace g2p::cli {
@@ -83,11 +84,23 @@ struct PipelineArgs {
   double memory_limit_gib = 0.0;
 };
 
+// Every option flag of `g2p run` but --overrides and --memory-limit (which
+// g2p batch has as its own): the flags an options file replaces. Returns them.
+std::vector<CLI::Option*> add_pipeline_flags(CLI::App* cmd, PipelineArgs& args);
+
+// --options FILE: the options from a file (g2p/options_file.h) instead of `flags`.
+void add_options_file_flag(CLI::App* cmd, std::string& path);
+// The options of --options FILE, or of the flags; giving both is an error naming the flag.
+Result<RunOptions> run_options(const PipelineArgs& args, const std::string& options_file,
+                               const std::vector<CLI::Option*>& flags);
+
 // The options the flags ask for; a bad value fails naming its flag.
 Result<PipelineOptions> pipeline_options(const PipelineArgs& args);
 
-// A pipeline with the flags' options, --materials and --overrides loaded;
-// prepare()d, so unknown backends and settings fail here, before any work.
+// A pipeline with the options and --overrides loaded; prepare()d, so unknown
+// backends and settings fail here, before any work.
+Result<Pipeline> make_pipeline(RunOptions options, const std::string& overrides);
+// The same with the flags' options and --materials.
 Result<Pipeline> make_pipeline(const PipelineArgs& args);
 
 // KEY=VALUE pairs as BackendSettings.

@@ -1,19 +1,14 @@
 // g2p validate DIR: the MJCF in MuJoCo next to libg2p's numbers, a drop onto
 // a plane, and (--contact) probe balls dropped onto the object.
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "common.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
-#include "json_out.h"
 
 namespace g2p::cli {
 namespace {
@@ -69,103 +64,62 @@ int run_contact_check(const ValidateArgs& args, const std::string& mjcf) {
   else
     std::printf("  object not dropped (the MJCF fixes it to the world)\n");
   if (!args.json.empty()) {
-    nlohmann::json j = {{"mjcf", mjcf}, {"engine", c->engine}, {"balls", nlohmann::json::array()}};
-    j["object_bounds_m"] = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
-    for (const BallProbe& b : c->balls)
-      j["balls"].push_back({{"start_m", {b.start.x(), b.start.y()}},
-                            {"rest_m", {b.rest.x(), b.rest.y(), b.rest.z()}},
-                            {"radius_m", b.radius_m},
-                            {"height_above_floor_m", b.height_above_floor_m},
-                            {"final_speed_m_s", b.final_speed_m_s},
-                            {"at_rest", b.at_rest},
-                            {"on_object", b.on_object},
-                            {"on_floor", b.on_floor}});
-    j["drop"] = {{"dropped", c->drop.dropped},
-                 {"resting_lowest_m", c->drop.resting_lowest_m},
-                 {"final_speed_m_s", c->drop.final_speed_m_s},
-                 {"object_above_plane", c->object_above_plane}};
-    if (Status s = write_text_file(args.json, json_out(j) + "\n"); !s.ok()) {
+    if (Status s = write_text_file(args.json, contact_check_json(*c, mjcf) + "\n"); !s.ok()) {
       std::cerr << "g2p validate: error: --json: " << s.to_string() << "\n";
       return kExitFailure;
     }
   }
-  const bool stable = resting == static_cast<int>(c->balls.size()) && c->object_above_plane;
+  const bool stable = c->stable();
   if (!stable) std::printf("%s\n", args.fail_on_unstable ? "FAIL" : "note: not everything came to rest");
   return stable || !args.fail_on_unstable ? kExitOk : kExitFailure;
 }
 
 int run_validate(const ValidateArgs& args) {
-  namespace fs = std::filesystem;
-  std::string mjcf;
-  std::error_code ec;
-  if (!fs::is_directory(args.dir, ec)) {
-    std::cerr << "g2p validate: error: " << args.dir
-              << (fs::exists(args.dir, ec) ? ": not a folder (give a g2p export folder)\n" : ": no such folder\n");
-    return kExitFailure;
-  }
-  std::vector<std::string> found;
-  for (const auto& e : fs::directory_iterator(args.dir, ec))
-    if (e.path().extension() == ".xml") found.push_back(e.path().filename().string());
-  if (ec || found.empty()) {
-    std::cerr << "g2p validate: error: " << args.dir << ": no MJCF (.xml) file (is this a g2p export folder?)\n";
-    return kExitFailure;
-  }
-  if (found.size() > 1) {
-    std::sort(found.begin(), found.end());
-    std::string names;
-    for (const std::string& f : found) names += (names.empty() ? "" : ", ") + f;
-    std::cerr << "g2p validate: error: " << args.dir << ": several MJCF (.xml) files (" << names
-              << "); validate reads the one g2p export wrote: move the others out\n";
-    return kExitFailure;
-  }
-  mjcf = (fs::path(args.dir) / found.front()).string();
   if (!have_mujoco()) {
     std::cerr << "g2p validate: error: this libg2p was built without MuJoCo (G2P_WITH_MUJOCO=OFF)\n";
     return kExitFailure;
   }
-  if (args.contact) return run_contact_check(args, mjcf);
-  Result<EngineCheck> c = check_in_mujoco(mjcf, args.height, args.seconds);
-  if (!c.ok()) {
-    std::cerr << "g2p validate: error: " << c.status().to_string() << "\n";
+  if (args.contact) {
+    Result<std::string> mjcf = find_folder_mjcf(args.dir);
+    if (!mjcf.ok()) {
+      std::cerr << "g2p validate: error: " << mjcf.status().message() << "\n";
+      return kExitFailure;
+    }
+    return run_contact_check(args, *mjcf);
+  }
+  Result<FolderCheck> checked = check_folder_in_mujoco(args.dir, args.height, args.seconds);
+  if (!checked.ok()) {
+    const Status& s = checked.status();
+    const bool found = s.code() != StatusCode::kNotFound && s.code() != StatusCode::kInvalidArgument;
+    std::cerr << "g2p validate: error: " << (found ? s.to_string() : s.message()) << "\n";
     return kExitFailure;
   }
-  // Without a free joint nothing is dropped; only the numbers are compared.
-  bool pass = !c->dropped || (c->finite && c->resting_lowest_m > -0.01 && c->warnings.empty());
-  std::printf("%s: %s\n", mjcf.c_str(), c->engine.c_str());
+  const FolderCheck& f = *checked;
+  const EngineCheck& c = f.engine;
+  auto triple = [](const Eigen::Vector3d& v) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.5g %.5g %.5g", v.x(), v.y(), v.z());
+    return std::string(text);
+  };
+  std::printf("%s: %s\n", f.mjcf.c_str(), c.engine.c_str());
   std::printf("  %-24s %-36s %s\n", "", "engine", "libg2p (report.json)");
-  std::ifstream in(args.dir + "/report.json");
-  const nlohmann::json report = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
-  if (report.is_object() && report.contains("object")) {
-    const nlohmann::json& o = report["object"];
-    const double mass = o["mass_kg"].get<double>();
-    std::printf("  %-24s %-36.6g %.6g\n", "mass (kg)", c->mass_kg, mass);
-    char engine[96], ours[96];
-    std::snprintf(engine, sizeof engine, "%.5g %.5g %.5g", c->center_of_mass.x(), c->center_of_mass.y(),
-                  c->center_of_mass.z());
-    std::snprintf(ours, sizeof ours, "%.5g %.5g %.5g", o["center_of_mass_m"][0].get<double>(),
-                  o["center_of_mass_m"][1].get<double>(), o["center_of_mass_m"][2].get<double>());
-    std::printf("  %-24s %-36s %s\n", "centre of mass (m)", engine, ours);
-    std::snprintf(engine, sizeof engine, "%.5g %.5g %.5g", c->principal_moments.x(), c->principal_moments.y(),
-                  c->principal_moments.z());
-    std::snprintf(ours, sizeof ours, "%.5g %.5g %.5g", o["principal_moments_kg_m2"][0].get<double>(),
-                  o["principal_moments_kg_m2"][1].get<double>(), o["principal_moments_kg_m2"][2].get<double>());
-    std::printf("  %-24s %-36s %s\n", "principal moments", engine, ours);
-    pass = pass && std::abs(c->mass_kg - mass) <= 1e-6 * mass;
-    for (int a = 0; a < 3; ++a)
-      pass = pass && std::abs(c->center_of_mass[a] - o["center_of_mass_m"][a].get<double>()) <= 1e-6 &&
-             std::abs(c->principal_moments[a] - o["principal_moments_kg_m2"][a].get<double>()) <=
-                 1e-6 * std::abs(o["principal_moments_kg_m2"][a].get<double>()) + 1e-12;
+  if (f.has_report) {
+    std::printf("  %-24s %-36.6g %.6g\n", "mass (kg)", c.mass_kg, f.report_mass_kg);
+    std::printf("  %-24s %-36s %s\n", "centre of mass (m)", triple(c.center_of_mass).c_str(),
+                triple(f.report_center_of_mass).c_str());
+    std::printf("  %-24s %-36s %s\n", "principal moments", triple(c.principal_moments).c_str(),
+                triple(f.report_principal_moments).c_str());
   } else {
-    std::printf("  mass %.6g kg (no report.json to compare with)\n", c->mass_kg);
+    std::printf("  mass %.6g kg (no report.json to compare with)\n", c.mass_kg);
   }
-  if (c->dropped)
+  if (c.dropped)
     std::printf(
         "  drop from %.3g m for %.3g s: lowest point %.4g m, at rest %.4g m above the plane, final speed %.3g m/s%s\n",
-        args.height, args.seconds, c->lowest_point_m, c->resting_lowest_m, c->final_speed_m_s,
-        c->finite ? "" : ", NOT FINITE");
-  for (const std::string& w : c->warnings) std::printf("  MuJoCo warned during the drop: %s\n", w.c_str());
-  std::printf("%s\n", pass ? "PASS" : "FAIL");
-  return pass ? kExitOk : kExitFailure;
+        args.height, args.seconds, c.lowest_point_m, c.resting_lowest_m, c.final_speed_m_s,
+        c.finite ? "" : ", NOT FINITE");
+  for (const std::string& w : c.warnings) std::printf("  MuJoCo warned during the drop: %s\n", w.c_str());
+  std::printf("%s\n", f.pass() ? "PASS" : "FAIL");
+  return f.pass() ? kExitOk : kExitFailure;
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "g2p/options_file.h"
 #include "g2p/status.h"
 #include "g2p/visibility.h"
 
@@ -25,15 +26,19 @@ namespace g2p {
 
 // One model of a batch.
 struct BatchAsset {
-  std::string path;                   // the model file
-  std::string name;                   // its subfolder of OUT; "" = the file's stem (made unique by batch_assets)
-  std::vector<std::string> run_args;  // its own `g2p run` flags ({"--unit", "cm"}); they replace the batch's
-  std::string origin;                 // where it was listed: "assets.csv:4", or the path itself
+  std::string path;  // the model file
+  std::string name;  // its subfolder of OUT; "" = the file's stem (made unique by batch_assets)
+  // Its own options over the batch's: an options file's keys (g2p/options_file.h),
+  // {"import": {"unit_scale": 0.01}}; "" = the batch's. A manifest row's columns.
+  std::string options;
+  std::string origin;  // where it was listed: "assets.csv:4", or the path itself
 };
 
-// Per-asset columns a manifest may have besides `path` (each maps to the
-// `g2p run` flag of that name with '_' as '-'): name, unit, up, segmenter,
-// height, longest_side, object (what the object is, in words).
+// Per-asset columns a manifest may have besides `path`, each an option of
+// that asset (as the `g2p run` flag of that name with '_' as '-'): name,
+// unit, up, segmenter, height, longest_side, object (what the object is, in
+// words). A JSON Lines row may also have "options": any keys of an options
+// file (g2p/options_file.h), under the columns.
 G2P_API const std::vector<std::string>& batch_manifest_columns();
 
 // The assets of a manifest: CSV with a header row (`path` required, then any
@@ -71,14 +76,16 @@ struct BatchProgress {
 class BatchExecutor;
 
 struct BatchOptions {
-  std::string tool;                   // the g2p executable; each asset runs `TOOL run MODEL -o OUT/NAME ...` (required)
-  std::string output_dir;             // OUT: a subfolder per asset, index.json, index.csv (made if missing)
-  int jobs = 1;                       // worker processes at a time (>= 1)
-  double timeout_s = 0.0;             // wall-clock limit per asset, seconds; 0 = none
-  double memory_limit_gib = 0.0;      // per asset, GiB (the data segment limit, and `g2p run --memory-limit`); 0 = none
-  double kill_grace_s = 5.0;          // seconds between SIGTERM and SIGKILL for a stopped or timed-out asset
-  std::vector<std::string> run_args;  // `g2p run` flags for every asset ({"--views", "6"}); affect the hash
-  bool retry_failed = false;          // also rerun the assets the index records as failed with the same hash
+  std::string tool;               // the g2p executable; each asset runs `TOOL run MODEL -o OUT/NAME ...` (required)
+  std::string output_dir;         // OUT: a subfolder per asset, index.json, index.csv (made if missing)
+  int jobs = 1;                   // worker processes at a time (>= 1)
+  double timeout_s = 0.0;         // wall-clock limit per asset, seconds; 0 = none
+  double memory_limit_gib = 0.0;  // per asset, GiB (the data segment limit, and `g2p run --memory-limit`); 0 = none
+  double kill_grace_s = 5.0;      // seconds between SIGTERM and SIGKILL for a stopped or timed-out asset
+  // Every asset's options (each asset's own over them); written for each
+  // asset as OUT/.g2p-batch.tmp/NAME.options.json for its `g2p run --options`.
+  RunOptions run;
+  bool retry_failed = false;  // also rerun the assets the index records as failed with the same hash
   // Polled about every 50 ms: a nonzero return (the signal number, SIGINT or
   // SIGTERM) stops the batch: no asset starts, the running ones are sent
   // SIGTERM (their output is not written) and the index is written.
@@ -121,7 +128,12 @@ struct BatchResult {
   int stop_signal = 0;         // the signal that stopped the batch, 0 if none
 };
 
-// Runs one asset where a batch would: `TOOL run MODEL -o OUT/NAME --overwrite -q FLAGS`
+// The options one asset runs with: options.run, the asset's own over them,
+// and options.memory_limit_gib as the run's memory limit. An error names the
+// asset's origin.
+G2P_API Result<RunOptions> batch_asset_options(const BatchAsset& asset, const BatchOptions& options);
+
+// Runs one asset where a batch would: `TOOL run MODEL -o OUT/NAME --overwrite -q --options FILE`
 // as a child process in its own process group, under options.timeout_s and
 // options.memory_limit_gib, stopped (SIGTERM, then SIGKILL) when
 // options.stop_requested says so. Blocks until it ends; the row says how
@@ -145,7 +157,7 @@ class G2P_API BatchExecutor {
 
 // The content hash that decides whether an asset runs again: the model file's
 // bytes, those of its companions (files of the same stem beside it: .mtl,
-// .bin), the g2p version and every flag. 16 hex digits.
+// .bin), the g2p version and its options file (batch_asset_options). 16 hex digits.
 G2P_API Result<std::string> batch_asset_key(const BatchAsset& asset, const BatchOptions& options);
 
 // Runs the assets (named by name_batch_assets) into options.output_dir. Fails

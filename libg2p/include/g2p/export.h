@@ -177,6 +177,12 @@ struct ContactCheck {
   EngineCheck drop;                   // the free object dropped onto a plane (not run when the MJCF is --fixed)
   bool object_above_plane = false;    // after the drop, nothing of it more than 1 cm below the plane
   std::string engine;                 // "MuJoCo 2.2.2"
+  // Every ball at rest and the object above the plane.
+  bool stable() const {
+    for (const BallProbe& b : balls)
+      if (!b.at_rest) return false;
+    return object_above_plane;
+  }
 };
 
 // Loads an MJCF written by write_asset, fixes the body in place over a floor
@@ -186,5 +192,31 @@ struct ContactCheck {
 // written beside the user's files. Unavailable without MuJoCo.
 G2P_API Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path,
                                                       const ContactCheckOptions& options = {});
+// The check as JSON (`g2p validate --contact --json`).
+G2P_API std::string contact_check_json(const ContactCheck& check, const std::string& mjcf_path);
+
+// ---- A whole export folder (g2p validate DIR) ------------------------------
+
+// The folder's one MJCF file; none, or several, is an error naming them.
+G2P_API Result<std::string> find_folder_mjcf(const std::string& dir);
+
+// The folder's MJCF in MuJoCo (check_in_mujoco) beside its report.json.
+struct FolderCheck {
+  std::string mjcf;  // the file checked
+  EngineCheck engine;
+  bool has_report = false;  // report.json read; the report_ numbers below are its
+  double report_mass_kg = 0.0;
+  Eigen::Vector3d report_center_of_mass = Eigen::Vector3d::Zero();
+  Eigen::Vector3d report_principal_moments = Eigen::Vector3d::Zero();
+  // The engine's mass to 1e-6 relative, centre of mass to 1 um and principal
+  // moments to 1e-6 relative of the report's (true without a report).
+  bool numbers_match = true;
+  // Dropped: finite, resting no more than 1 cm into the plane, no engine
+  // warnings (true when the MJCF fixes the body and nothing is dropped).
+  bool drop_ok = true;
+  bool pass() const { return numbers_match && drop_ok; }
+};
+G2P_API Result<FolderCheck> check_folder_in_mujoco(const std::string& dir, double drop_height_m = 0.2,
+                                                   double drop_seconds = 2.0);
 
 }  // namespace g2p

@@ -14,6 +14,7 @@
 //   completed/           the closed parts and completion.json (complete)
 //   report.json          densities, structure, masses (properties; with the asset after export)
 //   NAME.xml/.urdf/.sdf/.glb, meshes/, run.json, summary.html (export)
+//   options.json         a whole run's options (g2p/options_file.h: `g2p run --options` repeats it)
 //
 //   g2p::Result<g2p::PipelineResult> state = g2p::read_pipeline_folder("out/chair", g2p::Stage::kComplete);
 #pragma once

@@ -13,6 +13,7 @@
 #include "g2p/materials.h"
 #include "g2p/mesh.h"
 #include "g2p/model.h"
+#include "g2p/options_file.h"
 #include "g2p/pipeline.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"

@@ -25,33 +25,6 @@ std::string number_text(double value) {
   return buffer;
 }
 
-// The flags an asset's own flag replaces (CLI11 refuses a flag given twice;
-// --height and --longest-side exclude each other).
-std::vector<std::string> replaced_by(const std::string& flag) {
-  if (flag == "--height" || flag == "--longest-side") return {"--height", "--longest-side"};
-  return {flag};
-}
-
-// The batch's flags, less those the asset gives itself, then the asset's.
-std::vector<std::string> merged_run_args(const std::vector<std::string>& batch, const std::vector<std::string>& own) {
-  std::vector<std::string> dropped;
-  for (const std::string& a : own)
-    if (a.rfind("--", 0) == 0)
-      for (const std::string& f : replaced_by(a.substr(0, a.find('=')))) dropped.push_back(f);
-  std::vector<std::string> out;
-  for (std::size_t i = 0; i < batch.size(); ++i) {
-    const std::string flag = batch[i].substr(0, batch[i].find('='));
-    if (std::find(dropped.begin(), dropped.end(), flag) == dropped.end()) {
-      out.push_back(batch[i]);
-      continue;
-    }
-    // Skip the flag and its value (a following word that is not a flag).
-    if (batch[i].find('=') == std::string::npos && i + 1 < batch.size() && batch[i + 1].rfind("--", 0) != 0) ++i;
-  }
-  out.insert(out.end(), own.begin(), own.end());
-  return out;
-}
-
 // Fills the row's results from the asset's run.json; false if it is missing or malformed.
 bool read_run_json(const fs::path& folder, BatchRow& row) {
   std::ifstream in(folder / "run.json");
@@ -112,12 +85,8 @@ bool asset_output_complete(const std::string& folder, BatchRow& row) { return re
 
 Result<AssetRun> AssetRun::start(const BatchAsset& asset, const BatchOptions& options) {
   const fs::path out(options.output_dir);
-  std::vector<std::string> argv{options.tool,  "run", asset.path, "-o", (out / asset.name).string(),
-                                "--overwrite", "-q"};
-  std::vector<std::string> flags = merged_run_args(options.run_args, asset.run_args);
-  if (options.memory_limit_gib > 0)
-    flags = merged_run_args(flags, {"--memory-limit", number_text(options.memory_limit_gib)});
-  argv.insert(argv.end(), flags.begin(), flags.end());
+  Result<RunOptions> run_options = batch_asset_options(asset, options);
+  if (!run_options.ok()) return run_options.status();
   AssetRun r;
   r.asset_ = asset;
   r.options_ = &options;
@@ -125,6 +94,17 @@ Result<AssetRun> AssetRun::start(const BatchAsset& asset, const BatchOptions& op
   fs::create_directories(out / kBatchWorkDir, ec);
   if (ec) return Status::IoError((out / kBatchWorkDir).string() + ": cannot create: " + ec.message());
   r.stderr_path_ = out / kBatchWorkDir / (asset.name + ".stderr");
+  r.options_path_ = out / kBatchWorkDir / (asset.name + ".options.json");
+  G2P_RETURN_IF_ERROR(write_options_file(r.options_path_.string(), *run_options));
+  const std::vector<std::string> argv{options.tool,
+                                      "run",
+                                      asset.path,
+                                      "-o",
+                                      (out / asset.name).string(),
+                                      "--overwrite",
+                                      "-q",
+                                      "--options",
+                                      r.options_path_.string()};
   Result<WorkerProcess> p = WorkerProcess::start(argv, r.stderr_path_.string(), options.memory_limit_gib);
   if (!p.ok()) return p.status();
   r.process_ = *p;
@@ -161,6 +141,7 @@ void AssetRun::finish(const WorkerExit& exit, BatchRow& row) {
   const std::string err = read_text(stderr_path_);
   std::error_code ec;
   fs::remove(stderr_path_, ec);
+  fs::remove(options_path_, ec);
   row = BatchRow{};
   row.name = asset_.name;
   row.input = asset_.path;
@@ -197,6 +178,18 @@ void AssetRun::finish(const WorkerExit& exit, BatchRow& row) {
 }  // namespace g2p::detail
 
 namespace g2p {
+
+Result<RunOptions> batch_asset_options(const BatchAsset& asset, const BatchOptions& options) {
+  RunOptions run = options.run;
+  if (!asset.options.empty()) {
+    Result<RunOptions> own = parse_options_file(asset.options, asset.origin + ": options", run);
+    if (!own.ok()) return own.status();
+    run = std::move(*own);
+  }
+  if (options.memory_limit_gib > 0)
+    run.pipeline.memory_limit_bytes = static_cast<std::size_t>(options.memory_limit_gib * 1024.0 * 1024.0 * 1024.0);
+  return run;
+}
 
 Result<BatchRow> run_batch_asset(const BatchAsset& asset, const BatchOptions& options) {
   if (options.tool.empty()) return Status::InvalidArgument("run_batch_asset: no g2p tool given (BatchOptions::tool)");

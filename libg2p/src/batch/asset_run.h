@@ -10,12 +10,12 @@
 
 namespace g2p::detail {
 
-// The hidden work folder in OUT: the workers' stderr while they run.
+// The hidden work folder in OUT: the workers' options files and stderr while they run.
 constexpr const char* kBatchWorkDir = ".g2p-batch.tmp";
 
 class AssetRun {
  public:
-  // Starts `TOOL run MODEL -o OUT/NAME ...` for the asset.
+  // Writes the asset's options file and starts `TOOL run MODEL -o OUT/NAME ... --options FILE`.
   static Result<AssetRun> start(const BatchAsset& asset, const BatchOptions& options);
 
   // Non-blocking: enforces the time limit; true once the process has ended,
@@ -31,7 +31,8 @@ class AssetRun {
   const BatchOptions* options_ = nullptr;
   WorkerProcess process_;
   std::filesystem::path stderr_path_;
-  double term_sent_s_ = -1.0;  // elapsed time of the SIGTERM sent, -1 = none
+  std::filesystem::path options_path_;  // its options file (`g2p run --options`)
+  double term_sent_s_ = -1.0;           // elapsed time of the SIGTERM sent, -1 = none
   bool timed_out_ = false;
   int stopped_by_ = 0;  // the batch's stop signal, when it stopped this one
 };

@@ -139,6 +139,16 @@ class BatchRunner {
     for (const BatchAsset& a : assets_)
       if (a.name.empty() || a.name[0] == '.' || a.name.find('/') != std::string::npos)
         return Status::InvalidArgument(a.origin + ": no usable folder name (name the assets with name_batch_assets)");
+    for (const BatchAsset& a : assets_) {
+      Result<RunOptions> run = batch_asset_options(a, options_);
+      if (!run.ok()) return Status::InvalidArgument(run.status().message());
+      // Each run gets its options as a file, and a file never holds a secret.
+      if (const std::vector<std::string> secret = options_file_redactions(*run); !secret.empty())
+        return Status::InvalidArgument(
+            a.origin + ": " + secret.front() +
+            " has credentials in its URL (user:password@ or ?key=), which the options file each run reads never "
+            "holds: give the API key through the environment (the api_key_env setting)");
+    }
     return Status::Ok();
   }
 

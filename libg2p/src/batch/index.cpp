@@ -140,11 +140,12 @@ std::string index_csv(const std::vector<BatchRow>& rows) {
 
 Result<std::string> batch_asset_key(const BatchAsset& asset, const BatchOptions& options) {
   Fnv64 hash;
-  hash.add("g2p-batch-key-1");
+  hash.add("g2p-batch-key-2");
   hash.add(version());
-  for (const std::string& a : options.run_args) hash.add(a);
-  hash.add("--");
-  for (const std::string& a : asset.run_args) hash.add(a);
+  Result<RunOptions> run = batch_asset_options(asset, options);
+  if (!run.ok()) return run.status();
+  run->pipeline.memory_limit_bytes = 0;  // a limit changes whether a run may start, not what it makes
+  hash.add(options_file_json(*run));
   hash.add(asset.name);
   std::error_code ec;
   const fs::path path(asset.path);

@@ -14,6 +14,7 @@
 #include "core/csv.h"
 #include "g2p/batch.h"
 #include "g2p/io.h"
+#include "g2p/options_file.h"
 
 namespace g2p {
 namespace {
@@ -40,37 +41,55 @@ Result<std::vector<std::string>> split_csv(const std::string& line) {
   return fields;
 }
 
-bool is_number(const std::string& s) {
-  if (s.empty()) return false;
+Result<double> positive_number(const std::string& s) {
   std::istringstream in(s);
   double value = 0;
   in >> value;
-  return !in.fail() && in.eof() && value > 0;
+  if (s.empty() || in.fail() || !in.eof() || !(value > 0)) return Status::ParseError("is not a positive number");
+  return value;
 }
 
-// A manifest row's values as an asset; `where` is "file:line".
-Result<BatchAsset> asset_of_row(const std::map<std::string, std::string>& row, const fs::path& manifest_dir,
-                                const std::string& where) {
+// A manifest row's values as an asset whose options are the columns over the
+// row's "options" object (JSON Lines); `where` is "file:line".
+Result<BatchAsset> asset_of_row(const std::map<std::string, std::string>& row, nlohmann::json options,
+                                const fs::path& manifest_dir, const std::string& where) {
   BatchAsset asset;
   asset.origin = where;
+  if (!options.is_object()) options = nlohmann::json::object();
   for (const auto& [column, value] : row) {
     if (value.empty()) continue;
+    const std::string bad = where + ": " + column + " '" + value + "'";
     if (column == "path") {
       const fs::path p(value);
       asset.path = p.is_absolute() ? p.string() : (manifest_dir / p).lexically_normal().string();
     } else if (column == "name") {
       asset.name = value;
-    } else {
-      if ((column == "height" || column == "longest_side") && !is_number(value))
-        return Status::ParseError(where + ": " + column + " '" + value + "' is not a positive number (metres)");
-      std::string flag = "--" + column;
-      std::replace(flag.begin(), flag.end(), '_', '-');
-      asset.run_args.push_back(flag);
-      asset.run_args.push_back(value);
+      options["name"] = value;
+    } else if (column == "unit") {
+      Result<double> scale = parse_unit(value);
+      if (!scale.ok()) return Status::ParseError(bad + ": " + scale.status().message());
+      options["import"]["unit_scale"] = *scale;
+    } else if (column == "up") {
+      Result<UpAxis> up = parse_up_axis(value);
+      if (!up.ok()) return Status::ParseError(bad + ": " + up.status().message());
+      options["import"]["up"] = to_string(*up);
+    } else if (column == "height" || column == "longest_side") {
+      Result<double> metres = positive_number(value);
+      if (!metres.ok()) return Status::ParseError(bad + " is not a positive number (metres)");
+      options["import"][column == "height" ? "height_m" : "longest_side_m"] = *metres;
+      options["import"][column == "height" ? "longest_side_m" : "height_m"] = 0.0;
+    } else if (column == "segmenter") {
+      options["segmenter"]["name"] = value;
+    } else if (column == "object") {
+      options["object"] = value;
     }
   }
   if (asset.path.empty()) return Status::ParseError(where + ": no path (every row needs the model file)");
-  if (!asset.name.empty()) asset.run_args.insert(asset.run_args.begin(), {"--name", asset.name});
+  if (!options.empty()) {
+    asset.options = options.dump();
+    Result<RunOptions> valid = parse_options_file(asset.options, where + ": options");
+    if (!valid.ok()) return valid.status();
+  }
   return asset;
 }
 
@@ -107,7 +126,7 @@ Result<std::vector<BatchAsset>> read_csv_manifest(std::istream& in, const std::s
                                 std::to_string(header.size()));
     std::map<std::string, std::string> row;
     for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = (*fields)[i];
-    Result<BatchAsset> asset = asset_of_row(row, dir, where);
+    Result<BatchAsset> asset = asset_of_row(row, nlohmann::json::object(), dir, where);
     if (!asset.ok()) return asset.status();
     assets.push_back(std::move(*asset));
   }
@@ -126,6 +145,10 @@ Result<std::vector<BatchAsset>> read_jsonl_manifest(std::istream& in, const std:
     if (j.is_discarded() || !j.is_object()) return Status::ParseError(where + ": not a JSON object");
     std::map<std::string, std::string> row;
     for (const auto& [key, value] : j.items()) {
+      if (key == "options") {
+        if (!value.is_object()) return Status::ParseError(where + ": 'options' must be an object of options-file keys");
+        continue;
+      }
       G2P_RETURN_IF_ERROR(check_column(key, where));
       if (value.is_string()) {
         row[key] = value.get<std::string>();
@@ -135,7 +158,7 @@ Result<std::vector<BatchAsset>> read_jsonl_manifest(std::istream& in, const std:
         return Status::ParseError(where + ": '" + key + "' must be a string or a number");
       }
     }
-    Result<BatchAsset> asset = asset_of_row(row, dir, where);
+    Result<BatchAsset> asset = asset_of_row(row, j.value("options", nlohmann::json::object()), dir, where);
     if (!asset.ok()) return asset.status();
     assets.push_back(std::move(*asset));
   }

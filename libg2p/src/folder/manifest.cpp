@@ -6,29 +6,15 @@
 #include <string>
 
 #include "core/json_text.h"
+#include "core/options_json.h"
 #include "folder/manifest.h"
 #include "g2p/folder.h"
+#include "g2p/options_file.h"
 
 namespace g2p {
 namespace {
 
 namespace fs = std::filesystem;
-
-const char* up_name(UpAxis up) {
-  switch (up) {
-    case UpAxis::kX: return "x";
-    case UpAxis::kY: return "y";
-    case UpAxis::kZ: return "z";
-    default: return "auto";
-  }
-}
-
-UpAxis up_from(const std::string& s) {
-  if (s == "x") return UpAxis::kX;
-  if (s == "y") return UpAxis::kY;
-  if (s == "z") return UpAxis::kZ;
-  return UpAxis::kAuto;
-}
 
 Result<Stage> stage_from(const std::string& name) {
   for (int i = 0; i < kNumStages; ++i)
@@ -66,7 +52,9 @@ FolderManifest folder_manifest(const PipelineResult& r, const PipelineOptions& o
 }  // namespace detail
 
 std::string folder_manifest_json(const FolderManifest& m) {
-  const ImportOptions& i = m.import;
+  nlohmann::json import = detail::import_json(m.import);
+  import["kind_scale"] = m.kind_scale;
+  import["warnings"] = m.import_warnings;
   nlohmann::json candidates = nlohmann::json::array();
   for (const KindGuess& g : m.identification.candidates)
     candidates.push_back(
@@ -76,16 +64,7 @@ std::string folder_manifest_json(const FolderManifest& m) {
                             {"written_by", m.written_by},
                             {"stage", to_string(m.stage)},
                             {"model", m.model},
-                            {"import",
-                             {{"unit_scale", i.unit_scale},
-                              {"height_m", i.height_m},
-                              {"longest_side_m", i.longest_side_m},
-                              {"up", up_name(i.up_axis)},
-                              {"z_up", i.z_up},
-                              {"textures", i.load_textures},
-                              {"strict", i.strict},
-                              {"kind_scale", m.kind_scale},
-                              {"warnings", m.import_warnings}}},
+                            {"import", import},
                             {"anonymize_names", m.anonymize_names},
                             {"base_color_only", m.base_color_only},
                             {"materials", m.materials},
@@ -95,13 +74,7 @@ std::string folder_manifest_json(const FolderManifest& m) {
                               {"warnings", m.identification.warnings},
                               {"kind", m.kind},
                               {"size_assumed_m", m.size_assumed_m}}},
-                            {"project",
-                             {{"vote", m.project.vote.mode == VoteMode::kSoft ? "soft" : "hard"},
-                              {"weight_angle", m.project.vote.weight_by_angle},
-                              {"weight_footprint", m.project.vote.weight_by_footprint},
-                              {"weld", m.project.weld_tolerance},
-                              {"min_part_area", m.project.partition.min_part_area_fraction},
-                              {"merge_max_confidence", m.project.partition.merge_max_confidence}}},
+                            {"project", detail::project_json(m.project)},
                             {"asset", {{"name", m.asset_name}, {"formats", m.formats}}}};
   return detail::json_text(j, 2) + "\n";
 }
@@ -138,13 +111,7 @@ Result<FolderManifest> read_folder_manifest(const std::string& dir) {
     m.stage = *stage;
     m.model = j.at("model").get<std::string>();
     const nlohmann::json& i = j.at("import");
-    m.import.unit_scale = i.at("unit_scale").get<double>();
-    m.import.height_m = i.at("height_m").get<double>();
-    m.import.longest_side_m = i.at("longest_side_m").get<double>();
-    m.import.up_axis = up_from(i.at("up").get<std::string>());
-    m.import.z_up = i.at("z_up").get<bool>();
-    m.import.load_textures = i.at("textures").get<bool>();
-    m.import.strict = i.at("strict").get<bool>();
+    if (Status s = detail::read_import_json(i, m.import); !s.ok()) return s.with_context(path);
     m.kind_scale = i.at("kind_scale").get<double>();
     m.import_warnings = i.at("warnings").get<std::vector<std::string>>();
     m.anonymize_names = j.at("anonymize_names").get<bool>();
@@ -160,12 +127,7 @@ Result<FolderManifest> read_folder_manifest(const std::string& dir) {
     m.kind = id.at("kind").get<std::string>();
     m.size_assumed_m = id.at("size_assumed_m").get<double>();
     const nlohmann::json& p = j.at("project");
-    m.project.vote.mode = p.at("vote").get<std::string>() == "soft" ? VoteMode::kSoft : VoteMode::kHard;
-    m.project.vote.weight_by_angle = p.at("weight_angle").get<bool>();
-    m.project.vote.weight_by_footprint = p.at("weight_footprint").get<bool>();
-    m.project.weld_tolerance = p.at("weld").get<double>();
-    m.project.partition.min_part_area_fraction = p.at("min_part_area").get<double>();
-    m.project.partition.merge_max_confidence = p.at("merge_max_confidence").get<double>();
+    if (Status s = detail::read_project_json(p, m.project); !s.ok()) return s.with_context(path);
     m.asset_name = j.at("asset").at("name").get<std::string>();
     m.formats = j.at("asset").at("formats").get<std::vector<std::string>>();
   } catch (const nlohmann::json::exception& e) {

@@ -12,6 +12,7 @@
 #include "folder/manifest.h"
 #include "g2p/folder.h"
 #include "g2p/io.h"
+#include "g2p/options_file.h"
 #include "g2p/pipeline.h"
 
 namespace g2p {
@@ -135,6 +136,9 @@ Status write_contents(const std::string& tmp, const PipelineResult& r, const Pip
   if (last >= Stage::kExport) {
     G2P_RETURN_IF_ERROR(write_text_file(tmp + "/run.json", pipeline_summary_json(r, o) + "\n"));
     G2P_RETURN_IF_ERROR(write_text_file(tmp + "/summary.html", summary_html(r, o)));
+    // A whole run's options, for `g2p run --options` (a stage command's hold only its stages').
+    if (r.stage(Stage::kRender) != nullptr)
+      G2P_RETURN_IF_ERROR(write_text_file(tmp + "/options.json", options_file_json(RunOptions{o, r.table})));
   }
   // Last: a folder with a manifest is complete.
   return write_text_file(tmp + "/manifest.json", folder_manifest_json(manifest));

@@ -1,0 +1,101 @@
+// An export folder checked as a whole (g2p validate DIR): its one MJCF file in
+// MuJoCo beside the report.json written with it, and the contact check as JSON.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/json_text.h"
+#include "g2p/export.h"
+
+namespace g2p {
+namespace {
+
+namespace fs = std::filesystem;
+
+Eigen::Vector3d vector_of(const nlohmann::json& j) {
+  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+// report.json's object totals; false when there is no readable report.
+bool read_report(const fs::path& path, FolderCheck& c) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (!j.is_object() || !j.contains("object")) return false;
+  try {
+    const nlohmann::json& o = j.at("object");
+    c.report_mass_kg = o.at("mass_kg").get<double>();
+    c.report_center_of_mass = vector_of(o.at("center_of_mass_m"));
+    c.report_principal_moments = vector_of(o.at("principal_moments_kg_m2"));
+  } catch (const nlohmann::json::exception&) {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Result<std::string> find_folder_mjcf(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    return Status::NotFound(dir +
+                            (fs::exists(dir, ec) ? ": not a folder (give a g2p export folder)" : ": no such folder"));
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path().extension() == ".xml") found.push_back(e.path().filename().string());
+  if (ec || found.empty()) return Status::NotFound(dir + ": no MJCF (.xml) file (is this a g2p export folder?)");
+  if (found.size() > 1) {
+    std::sort(found.begin(), found.end());
+    std::string names;
+    for (const std::string& f : found) names += (names.empty() ? "" : ", ") + f;
+    return Status::InvalidArgument(dir + ": several MJCF (.xml) files (" + names +
+                                   "); validate reads the one g2p export wrote: move the others out");
+  }
+  return (fs::path(dir) / found.front()).string();
+}
+
+Result<FolderCheck> check_folder_in_mujoco(const std::string& dir, double drop_height_m, double drop_seconds) {
+  Result<std::string> mjcf = find_folder_mjcf(dir);
+  if (!mjcf.ok()) return mjcf.status();
+  FolderCheck c;
+  c.mjcf = *mjcf;
+  Result<EngineCheck> engine = check_in_mujoco(c.mjcf, drop_height_m, drop_seconds);
+  if (!engine.ok()) return engine.status();
+  c.engine = std::move(*engine);
+  // Without a free joint nothing is dropped; only the numbers are compared.
+  c.drop_ok = !c.engine.dropped || (c.engine.finite && c.engine.resting_lowest_m > -0.01 && c.engine.warnings.empty());
+  c.has_report = read_report(fs::path(dir) / "report.json", c);
+  if (c.has_report) {
+    const double mass = c.report_mass_kg;
+    c.numbers_match = std::abs(c.engine.mass_kg - mass) <= 1e-6 * mass;
+    for (int a = 0; a < 3; ++a)
+      c.numbers_match = c.numbers_match && std::abs(c.engine.center_of_mass[a] - c.report_center_of_mass[a]) <= 1e-6 &&
+                        std::abs(c.engine.principal_moments[a] - c.report_principal_moments[a]) <=
+                            1e-6 * std::abs(c.report_principal_moments[a]) + 1e-12;
+  }
+  return c;
+}
+
+std::string contact_check_json(const ContactCheck& c, const std::string& mjcf) {
+  const Eigen::Vector3d lo = c.object_bounds.min(), hi = c.object_bounds.max();
+  nlohmann::json j = {{"mjcf", mjcf}, {"engine", c.engine}, {"balls", nlohmann::json::array()}};
+  j["object_bounds_m"] = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
+  for (const BallProbe& b : c.balls)
+    j["balls"].push_back({{"start_m", {b.start.x(), b.start.y()}},
+                          {"rest_m", {b.rest.x(), b.rest.y(), b.rest.z()}},
+                          {"radius_m", b.radius_m},
+                          {"height_above_floor_m", b.height_above_floor_m},
+                          {"final_speed_m_s", b.final_speed_m_s},
+                          {"at_rest", b.at_rest},
+                          {"on_object", b.on_object},
+                          {"on_floor", b.on_floor}});
+  j["drop"] = {{"dropped", c.drop.dropped},
+               {"resting_lowest_m", c.drop.resting_lowest_m},
+               {"final_speed_m_s", c.drop.final_speed_m_s},
+               {"object_above_plane", c.object_above_plane}};
+  return detail::json_text(j, 2);
+}
+
+}  // namespace g2p

@@ -255,6 +255,11 @@ void bind_core(py::module_& m) {
              if (face < 0 || face >= model.mesh.num_faces()) throw py::index_error("face " + std::to_string(face));
              return model.material_name(face);
            })
+      .def("summary", &model_summary_text, "what `g2p info` prints: frame, faces, bounds, materials, warnings")
+      .def(
+          "summary_json",
+          [](const Model& model) { return py::module_::import("json").attr("loads")(model_summary_json(model)); },
+          "what `g2p info --json` prints, as a dict")
       .def("anonymize_names", [](Model& model) { anonymize_names(model); })
       .def("reduce_to_base_color", [](Model& model) { reduce_to_base_color(model); })
       .def("__repr__", [](const Model& model) {

@@ -170,7 +170,10 @@ void bind_eval(py::module_& m) {
           "to_json", [](const SegmentationEval& e) { return e.to_json(); },
           "the text `g2p eval seg --json` writes (without its final newline)")
       .def(
-          "json", [](const SegmentationEval& e) { return json_loads(e.to_json()); }, "to_json() as a dict");
+          "json", [](const SegmentationEval& e) { return json_loads(e.to_json()); }, "to_json() as a dict")
+      .def("to_text", &SegmentationEval::to_text,
+           "the tables, interval and calibration `g2p eval seg` prints after the models")
+      .def("__str__", &SegmentationEval::to_text);
 
   m.def(
       "evaluate_segmentation",

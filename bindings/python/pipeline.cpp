@@ -361,6 +361,9 @@ void bind_pipeline(py::module_& m) {
       .def_readonly("model", &PipelineResult::model)
       .def_readonly("table", &PipelineResult::table)
       .def_readonly("options", &PyPipelineResult::options, "the options the run used")
+      .def(
+          "summary", [](const PyPipelineResult& r) { return pipeline_summary_text(r); },
+          "what `g2p run` prints: the object, each stage, each part, the mass")
       .def_property_readonly("views",
                              [](py::object self) { return reference_list(self.cast<PyPipelineResult&>().views, self); })
       .def_property_readonly(

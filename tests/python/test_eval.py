@@ -56,7 +56,9 @@ class EvaluateSegmentation(unittest.TestCase):
         self.assertEqual(counts.shape, (len(g2p.MaterialTable()), len(g2p.MaterialTable()) + 1))
         self.assertAlmostEqual(float(np.trace(counts[:, :-1])), result.total.total)
 
-        # The document `g2p eval seg --json` writes, schema and all.
+        # The text `g2p eval seg` prints, and the document its --json writes, schema and all.
+        self.assertIn("All 2 models, one confusion matrix", str(result))
+        self.assertIn("mIoU", result.to_text())
         doc = json.loads(result.to_json())
         self.assertEqual(doc, result.json())
         self.assertEqual(doc["segmenter"], "oracle")

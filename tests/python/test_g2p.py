@@ -7,6 +7,7 @@ import gc
 import json
 import os
 import pathlib
+import subprocess
 import tempfile
 import threading
 import unittest
@@ -176,6 +177,10 @@ class HammerPipelineTest(unittest.TestCase):
         self.assertEqual(r.kind, "hammer")  # its file and mesh names
         self.assertEqual(r.identification["source"], "names")
         self.assertEqual(r.summary_json()["identification"]["kind"], "hammer")
+        text = r.summary()  # what `g2p run` prints
+        self.assertIn("object: hammer (names,", text)
+        self.assertEqual(text.count("  part "), 2)
+        self.assertIn("  decompose ", text)
         self.assertEqual(r.warnings, [])
         self.assertGreater(r.seconds, 0.0)
         self.assertEqual(self.progress[-1].stage, g2p.Stage.EXPORT)
@@ -221,6 +226,20 @@ class HammerPipelineTest(unittest.TestCase):
             self.assertEqual(resumed.kind, "hammer")
             with self.assertRaisesRegex(g2p.Error, "manifest.json"):
                 g2p.Pipeline(quick_options()).resume(tmp, g2p.Stage.COMPLETE)
+
+
+class ModelSummaryTest(unittest.TestCase):
+    def test_the_summary_is_what_g2p_info_prints(self):
+        model = g2p.load_model(HAMMER)
+        summary = model.summary_json()
+        self.assertEqual(summary["faces"], model.num_faces)
+        self.assertEqual([m["name"] for m in summary["materials"]], model.material_names)
+        self.assertEqual(sum(m["faces"] for m in summary["materials"]), model.num_faces)
+        tool = os.environ.get("G2P_TEST_TOOL")
+        if not tool:
+            self.skipTest("no g2p tool in this build (G2P_TEST_TOOL)")
+        info = subprocess.run([tool, "info", str(HAMMER)], capture_output=True, text=True, check=True)
+        self.assertEqual(info.stdout, model.summary())
 
 
 class PythonBackendsTest(unittest.TestCase):

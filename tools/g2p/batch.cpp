@@ -15,6 +15,7 @@
 
 #include "commands.h"
 #include "g2p/batch.h"
+#include "g2p/vlm.h"
 #include "stage_flags.h"
 
 namespace g2p::cli {
@@ -90,21 +91,12 @@ int usage(const std::string& message) {
   return kExitUsage;
 }
 
-// A scheduler address as it may be shown: any user:password@ part hidden.
-std::string shown_address(const std::string& address) {
-  const std::size_t scheme = address.find("://");
-  const std::size_t start = scheme == std::string::npos ? 0 : scheme + 3;
-  const std::size_t at = address.find('@', start);
-  if (at == std::string::npos || address.find('/', start) < at) return address;
-  return address.substr(0, start) + "***@" + address.substr(at + 1);
-}
-
 // `g2p batch --scheduler ADDRESS`: the same batch through the Python module's
 // Dask executor (g2p.batch(..., client=Client(ADDRESS))): this process
 // becomes bindings/python/g2p_dask_batch.py, which reports as this one does.
 int run_on_dask(const BatchArgs& args, const RunOptions& options) {
   const nlohmann::json a = {{"scheduler", args.scheduler},
-                            {"shown", shown_address(args.scheduler)},
+                            {"shown", redact_url(args.scheduler)},
                             {"inputs", args.inputs},
                             {"manifest", args.manifest},
                             {"output", args.out},

@@ -6,8 +6,21 @@
 
 #include "commands.h"
 #include "g2p/options_file.h"
+#include "stage_flags.h"
 
 namespace g2p::cli {
+
+int fail(const std::string& command, const Status& status) {
+  std::cerr << "g2p " << command << ": error: " << status.to_string() << "\n";
+  return kExitFailure;
+}
+
+int fail_or_usage(const std::string& command, const Status& status) {
+  if (status.code() != StatusCode::kInvalidArgument && status.code() != StatusCode::kNotFound)
+    return fail(command, status);
+  std::cerr << "g2p " << command << ": " << status.message() << "\n";
+  return kExitUsage;
+}
 
 CLI::Validator finite_number(double lo, double hi, bool above_lo) {
   std::ostringstream range;
@@ -171,20 +184,13 @@ void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
 
 Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,
                                                        int& exit_code) {
-  BackendSettings settings;
-  for (const std::string& kv : args.settings) {
-    const std::size_t eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      std::cerr << "g2p " << command << ": --set expects KEY=VALUE, got '" << kv << "'\n";
-      exit_code = kExitUsage;
-      return Status::InvalidArgument("bad --set");
-    }
-    settings[kv.substr(0, eq)] = kv.substr(eq + 1);
-  }
-  Result<std::unique_ptr<Segmenter>> s = make_segmenter(args.name, settings);
+  Result<BackendSettings> settings = parse_settings(args.settings);
+  Result<std::unique_ptr<Segmenter>> s =
+      settings.ok() ? make_segmenter(args.name, *settings) : Result<std::unique_ptr<Segmenter>>(settings.status());
   if (!s.ok()) {
     const bool usage = s.status().code() == StatusCode::kInvalidArgument || s.status().code() == StatusCode::kNotFound;
-    std::cerr << "g2p " << command << ": " << (usage ? "" : "error: ") << s.status().message() << "\n";
+    std::cerr << "g2p " << command << ": " << (usage ? "" : "error: ") << (settings.ok() ? "" : "--set: ")
+              << s.status().message() << "\n";
     exit_code = usage ? kExitUsage : kExitFailure;
   }
   return s;

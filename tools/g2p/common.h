@@ -16,6 +16,13 @@
 
 namespace g2p::cli {
 
+// "g2p COMMAND: error: STATUS" on stderr; returns kExitFailure.
+int fail(const std::string& command, const Status& status);
+// A value the user gave that does not fit (InvalidArgument; NotFound: a file
+// or backend the command line names) is "g2p COMMAND: MESSAGE", exit 2;
+// anything else as fail().
+int fail_or_usage(const std::string& command, const Status& status);
+
 // How a model file is read: --unit, --up, --keep-axes, --no-textures.
 struct ImportArgs {
   std::string unit;           // "" = from the format

@@ -23,42 +23,22 @@ namespace {
 // need parsing kept as given.
 struct EvalArgs {
   SegmentationEvalOptions options;
-  std::string materials;  // --materials FILE ("" = the paper's 12 classes)
-  ViewArgs views;
-  SegmenterArgs segmenter;
-  bool soft = false;
-  RefineArgs refine;
-  std::string identifier = SegmentationEvalOptions{}.identifier.name;
+  PipelineArgs pipeline;  // --materials, the view, segmenter and refiner flags, --soft, --identifier
   std::string json_out;
 };
 
-int usage_or_failure(const Status& s) {
-  if (s.code() == StatusCode::kInvalidArgument || s.code() == StatusCode::kNotFound) {
-    std::cerr << "g2p eval seg: " << s.message() << "\n";
-    return kExitUsage;
-  }
-  std::cerr << "g2p eval seg: error: " << s.to_string() << "\n";
-  return kExitFailure;
-}
-
 int run_eval_seg(EvalArgs& args) {
   SegmentationEvalOptions& o = args.options;
-  int exit_code = kExitOk;
-  Result<MaterialTable> table = load_table_flag("eval seg", args.materials, exit_code);
-  if (!table.ok()) return exit_code;
-  o.materials = std::move(*table);
-  Result<ViewOptions> views = view_options(args.views);
-  if (!views.ok()) return usage_or_failure(views.status().with_context("--layout"));
-  o.views = *views;
-  o.renderer = {args.views.renderer, {}};
-  Result<BackendSettings> segmenter_settings = parse_settings(args.segmenter.settings);
-  if (!segmenter_settings.ok()) return usage_or_failure(segmenter_settings.status().with_context("--set"));
-  o.segmenter = {args.segmenter.name, std::move(*segmenter_settings)};
-  Result<BackendSettings> refine_settings = parse_settings(args.refine.settings);
-  if (!refine_settings.ok()) return usage_or_failure(refine_settings.status().with_context("--refine-set"));
-  o.refiner = {args.refine.name, std::move(*refine_settings)};
-  o.identifier = {args.identifier, {}};
-  o.project.vote.mode = args.soft ? VoteMode::kSoft : VoteMode::kHard;
+  Result<RunOptions> run = run_options(args.pipeline, "", {});
+  if (!run.ok()) return fail_or_usage("eval seg", run.status());
+  o.materials = std::move(run->materials);
+  const PipelineOptions& p = run->pipeline;
+  o.views = p.views;
+  o.renderer = p.renderer;
+  o.segmenter = p.segmenter;
+  o.refiner = p.refiner;
+  o.identifier = p.identifier;
+  o.project.vote.mode = p.project.vote.mode;
   // One line per model as it is scored; what degraded first.
   o.on_model = [](const SegmentationModelEval& m) {
     for (const std::string& w : m.warnings) std::cerr << "g2p eval seg: warning: " << w << "\n";
@@ -70,26 +50,10 @@ int run_eval_seg(EvalArgs& args) {
   };
 
   SegmentationEvaluator evaluator(o);
-  if (Status s = evaluator.prepare(); !s.ok()) return usage_or_failure(s);
+  if (Status s = evaluator.prepare(); !s.ok()) return fail_or_usage("eval seg", s);
   Result<SegmentationEval> eval = evaluator.run();
-  if (!eval.ok()) {
-    std::cerr << "g2p eval seg: error: " << eval.status().to_string() << "\n";
-    return kExitFailure;
-  }
-  const MaterialTable& classes = o.materials;
-  std::printf("\nAll %zu models, one confusion matrix (%.0f labelled pixels), IoU %%:\n", eval->models.size(),
-              eval->total.total());
-  std::cout << eval->total.table(classes) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
-            << eval->total_3d.table(classes) << "\nPer face (3D, after voting), each model weighing the same, IoU %:\n"
-            << eval->total_3d_per_model.table(classes);
-  if (eval->interval)
-    std::printf("mIoU %.2f %%, %.0f %% interval over models %.2f-%.2f %% (bootstrap, %d resamples of %zu models)\n",
-                100.0 * eval->interval->miou, 100.0 * eval->interval->confidence, 100.0 * eval->interval->low,
-                100.0 * eval->interval->high, eval->interval->resamples, eval->models.size());
-  const CalibrationBins& calibration = eval->calibration;
-  if (calibration.accuracy() == calibration.accuracy())  // has probabilities
-    std::printf("calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n", calibration.mean_confidence(),
-                calibration.accuracy(), calibration.expected_calibration_error());
+  if (!eval.ok()) return fail("eval seg", eval.status());
+  std::cout << "\n" << eval->to_text();
   if (!args.json_out.empty()) {
     std::ofstream out(args.json_out, std::ios::binary | std::ios::trunc);
     out << eval->to_json() << "\n";
@@ -117,10 +81,7 @@ int run_eval_mass(const MassArgs& args) {
   std::printf("%d objects: ADE %.4g kg, ALDE %.4f, APE %.4f, MnRE %.4f\n", e->objects, e->ade_kg, e->alde, e->ape,
               e->mnre);
   if (!args.json_out.empty()) {
-    if (Status s = write_text_file(args.json_out, mass_errors_json(*e) + "\n"); !s.ok()) {
-      std::cerr << "g2p eval mass: error: " << s.to_string() << "\n";
-      return kExitFailure;
-    }
+    if (Status s = write_text_file(args.json_out, mass_errors_json(*e) + "\n"); !s.ok()) return fail("eval mass", s);
   }
   return kExitOk;
 }
@@ -142,10 +103,7 @@ int run_eval_compare(const CompareArgs& args) {
     std::cerr << "g2p eval compare: note: the files were scored differently: " << c->differing_conditions << "\n";
   std::cout << c->to_text() << std::flush;
   if (!args.json_out.empty()) {
-    if (Status s = write_text_file(args.json_out, c->to_json() + "\n"); !s.ok()) {
-      std::cerr << "g2p eval compare: error: " << s.to_string() << "\n";
-      return kExitFailure;
-    }
+    if (Status s = write_text_file(args.json_out, c->to_json() + "\n"); !s.ok()) return fail("eval compare", s);
   }
   return kExitOk;
 }
@@ -159,7 +117,9 @@ void add_eval_command(CLI::App& app, Command& run) {
       "seg", "Material segmentation accuracy over a labelled set: per pixel (2D) and per face after voting (3D)");
   seg->add_option("--assets", o.assets, "Folder with labels.json and NAME/NAME.glb")->capture_default_str();
   seg->add_option("--models", o.models, "Only these models (keys of labels.json)")->delimiter(',');
-  seg->add_option("--materials", args->materials, "Material table JSON (default: the paper's 12 classes)");
+  PipelineArgs& p = args->pipeline;
+  p.identify.name = SegmentationEvalOptions{}.identifier.name;
+  seg->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
   seg->add_flag("--anonymize-names", o.anonymize_names, "Replace every name by a meaningless one before segmenting");
   seg->add_flag("--base-color-only", o.base_color_only,
                 "Reduce every material to its base colour (metallic and roughness at glTF's defaults), as "
@@ -167,11 +127,11 @@ void add_eval_command(CLI::App& app, Command& run) {
   seg->add_option("--truth", o.truth, "labels.json (default: ASSETS/labels.json); keys may be model paths");
   seg->add_option("--split", o.split, "Only the models whose labels.json entry has this \"split\"");
   seg->add_option("--json", args->json_out, "Also write the results as JSON to this file");
-  add_view_flags(seg, args->views);
-  add_segmenter_flags(seg, args->segmenter);
-  seg->add_flag("--soft", args->soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
-  add_refiner_flags(seg, args->refine, SegmentationEvalOptions{}.refiner.name);
-  seg->add_option("--identifier", args->identifier,
+  add_view_flags(seg, p.views);
+  add_segmenter_flags(seg, p.segmenter);
+  seg->add_flag("--soft", p.soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
+  add_refiner_flags(seg, p.refiner, SegmentationEvalOptions{}.refiner.name);
+  seg->add_option("--identifier", p.identify.name,
                   "Identify each object as g2p run does (auto, names, detector, ...); a confident kind's materials "
                   "weigh the classes read from the image (--kind-prior). none: not identified")
       ->capture_default_str();

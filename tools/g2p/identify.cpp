@@ -6,7 +6,6 @@
 #include "commands.h"
 #include "common.h"
 #include "g2p/pipeline.h"
-#include "json_out.h"
 #include "stage_flags.h"
 
 namespace g2p::cli {
@@ -14,10 +13,7 @@ namespace {
 
 struct IdentifyCommandArgs {
   std::string model;
-  ImportArgs import;
-  ViewArgs views;
-  IdentifyArgs identify;
-  bool anonymize = false;
+  PipelineArgs pipeline;  // its import, view and identify flags and --anonymize-names
   bool list = false;
   bool json = false;
 };
@@ -30,15 +26,7 @@ int usage(const std::string& message) {
 int list_kinds(bool as_json) {
   const ObjectTable& table = ObjectTable::shipped();
   if (as_json) {
-    nlohmann::json kinds = nlohmann::json::array();
-    for (const ObjectKind& k : table.kinds())
-      kinds.push_back({{"name", k.name},
-                       {"group", k.group},
-                       {"coco", k.coco},
-                       {"typical_longest_side_m", k.typical_longest_side_m},
-                       {"mass_kg", {k.mass_kg[0], k.mass_kg[1]}},
-                       {"structure", k.structure}});
-    std::cout << json_out(kinds) << "\n";
+    std::cout << object_kinds_json(table) << "\n";
     return kExitOk;
   }
   std::printf("%-24s %-12s %10s %18s  %s\n", "kind", "group", "longest m", "mass kg", "structure");
@@ -53,33 +41,12 @@ int list_kinds(bool as_json) {
 int run_identify(const IdentifyCommandArgs& args) {
   if (args.list) return list_kinds(args.json);
   if (args.model.empty()) return usage("give a MODEL file, or --list");
-  PipelineOptions o;
-  Result<ImportOptions> import = import_options(args.import);
-  if (!import.ok()) return usage(import.status().message());
-  o.import = *import;
-  o.anonymize_names = args.anonymize;
-  Result<ViewOptions> views = view_options(args.views);
-  if (!views.ok()) return usage(views.status().message());
-  o.views = *views;
-  o.renderer.name = args.views.renderer;
-  Result<BackendSettings> settings = parse_settings(args.identify.settings);
-  if (!settings.ok()) return usage("--identify-set: " + settings.status().message());
-  o.identifier = BackendChoice{args.identify.name, *settings};
-  o.object = args.identify.object;
-  Result<SizePolicy> policy = parse_size_policy(args.identify.size_from);
-  if (!policy.ok()) return usage(policy.status().message());
-  o.size_policy = *policy;
-  o.kind_confidence = args.identify.kind_confidence;
-  o.kind_prior = args.identify.kind_prior;
-  o.last_stage = Stage::kIdentify;
-  Pipeline pipeline(o);
+  Result<PipelineOptions> o = pipeline_options(args.pipeline);
+  if (!o.ok()) return usage(o.status().message());
+  o->last_stage = Stage::kIdentify;
+  Pipeline pipeline(std::move(*o));
   Result<PipelineResult> r = pipeline.run_file(args.model);
-  if (!r.ok()) {
-    if (r.status().code() == StatusCode::kInvalidArgument || r.status().code() == StatusCode::kNotFound)
-      return usage(r.status().message());
-    std::cerr << "g2p identify: error: " << r.status().to_string() << "\n";
-    return kExitFailure;
-  }
+  if (!r.ok()) return fail_or_usage("identify", r.status());
   const Identification& id = r->identification;
   if (args.json) {
     std::cout << identification_json(id, ObjectTable::shipped(), r->size_assumed_m) << "\n";
@@ -117,10 +84,10 @@ void add_identify_command(CLI::App& app, Command& run) {
   cmd->add_option("model", args->model, "Model file (glTF/GLB, OBJ, PLY, STL, FBX, ...)");
   cmd->add_flag("--list", args->list, "List the kinds of the object table instead");
   cmd->add_flag("--json", args->json, "Print JSON (report.json's \"identification\") instead of text");
-  cmd->add_flag("--anonymize-names", args->anonymize, "Replace every name by a meaningless one first");
-  add_import_flags(cmd, args->import);
-  add_view_flags(cmd, args->views);
-  add_identify_flags(cmd, args->identify);
+  cmd->add_flag("--anonymize-names", args->pipeline.anonymize, "Replace every name by a meaningless one first");
+  add_import_flags(cmd, args->pipeline.import);
+  add_view_flags(cmd, args->pipeline.views);
+  add_identify_flags(cmd, args->pipeline.identify);
   cmd->callback([args, &run] { run = [args] { return run_identify(*args); }; });
 }
 

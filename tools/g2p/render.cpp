@@ -37,10 +37,7 @@ int run_benchmark(Renderer& renderer, const std::vector<Camera>& cameras) {
     for (int repeat = 0; repeat < 3; ++repeat) {
       const auto start = std::chrono::steady_clock::now();
       for (const Camera& c : cameras) {
-        if (Status s = renderer.render_into(c, options, view); !s.ok()) {
-          std::cerr << "g2p render: error: " << s.to_string() << "\n";
-          return kExitFailure;
-        }
+        if (Status s = renderer.render_into(c, options, view); !s.ok()) return fail("render", s);
       }
       best = std::min(best, seconds_since(start));
     }
@@ -71,10 +68,7 @@ int run_render(const RenderArgs& args) {
     return kExitUsage;
   }
   const auto start = std::chrono::steady_clock::now();
-  if (Status s = (*renderer)->set_model(*model); !s.ok()) {
-    std::cerr << "g2p render: error: " << s.to_string() << "\n";
-    return kExitFailure;
-  }
+  if (Status s = (*renderer)->set_model(*model); !s.ok()) return fail("render", s);
   const double build_s = seconds_since(start);
   if (args.benchmark) {
     std::cout << model->mesh.num_faces() << " triangles, scene build " << build_s * 1e3 << " ms\n";
@@ -83,18 +77,12 @@ int run_render(const RenderArgs& args) {
   std::vector<View> views;
   for (const Camera& c : *cameras) {
     Result<View> v = (*renderer)->render(c);
-    if (!v.ok()) {
-      std::cerr << "g2p render: error: " << v.status().to_string() << "\n";
-      return kExitFailure;
-    }
+    if (!v.ok()) return fail("render", v.status());
     views.push_back(std::move(*v));
   }
   ViewFileOptions file_options;
   file_options.buffers = args.buffers;
-  if (Status s = write_views(args.out, views, file_options); !s.ok()) {
-    std::cerr << "g2p render: error: " << s.to_string() << "\n";
-    return kExitFailure;
-  }
+  if (Status s = write_views(args.out, views, file_options); !s.ok()) return fail("render", s);
   std::cout << "rendered " << views.size() << " views of " << model->mesh.num_faces() << " triangles at "
             << args.views.resolution << "x" << args.views.resolution << " in " << seconds_since(start) << " s -> "
             << args.out << "\n";

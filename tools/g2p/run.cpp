@@ -114,18 +114,8 @@ int run_pipeline(const RunArgs& args) {
     std::cerr << "g2p run: interrupted after the run; the output is complete\n";
   if (!written.ok()) {
     printer.end_line();
-    // A file that does not fit the run (a missing part, a failed "was" check)
-    // is the user's input, like a bad flag.
-    const std::string& m = written.message();
-    std::size_t at = m.find(": overrides entry ");
-    if (at == std::string::npos) at = m.find(": overrides: ");
-    if (!args.pipeline.overrides.empty() && written.code() == StatusCode::kInvalidArgument && at != std::string::npos) {
-      std::cerr << "g2p run: --overrides " << args.pipeline.overrides << ": " << m.substr(at + 2)
-                << "; nothing was written\n";
-      return kExitUsage;
-    }
-    std::cerr << "g2p run: error: " << written.to_string() << "\n";
-    return kExitFailure;
+    if (report_overrides_error("run", args.pipeline.overrides, written)) return kExitUsage;
+    return fail("run", written);
   }
   const PipelineResult& r = *result;
   for (const std::string& w : r.warnings) std::cerr << "g2p run: warning: " << w << "\n";
@@ -137,18 +127,7 @@ int run_pipeline(const RunArgs& args) {
   std::printf("%s: %d triangles -> %zu parts, %.4g kg (range %.3g-%.3g kg) in %.2f s -> %s\n", args.model.c_str(),
               r.model.mesh.num_faces(), r.projection.parts.size(), r.properties.object.mass_kg,
               r.properties.mass_min_kg, r.properties.mass_max_kg, r.seconds, args.out.c_str());
-  const Identification& id = r.identification;
-  if (id.known())
-    std::printf("  object: %s (%s, %.0f %% confident)%s\n", id.kind().c_str(), id.source().c_str(),
-                100.0 * id.confidence(),
-                r.kind.name.empty()    ? ", below --kind-confidence: nothing assumed from it"
-                : r.size_assumed_m > 0 ? ", its typical size assumed"
-                                       : "");
-  else
-    std::printf("  object: unknown (give it with --object)\n");
-  for (const StageReport& s : r.stages)
-    std::printf("  %-10s %-10s %6.2f s %7.0f MiB%s\n", to_string(s.stage), s.backend.c_str(), s.seconds,
-                static_cast<double>(s.peak_rss_bytes) / 1048576.0, s.ok ? "" : "  FAILED (skipped)");
+  std::cout << pipeline_summary_text(r);
   std::printf("  open %s/summary.html\n", args.out.c_str());
   return kExitOk;
 }

@@ -45,10 +45,7 @@ int run_segment(const SegmentArgs& args) {
   }
   Status s = write_views(args.out, *views);
   if (s.ok()) s = write_label_maps(args.out, maps, *table);
-  if (!s.ok()) {
-    std::cerr << "g2p segment: error: " << s.to_string() << "\n";
-    return kExitFailure;
-  }
+  if (!s.ok()) return fail("segment", s);
   std::cout << "segmented " << maps.size() << " views with '" << args.segmenter.name << "' into " << table->size()
             << " classes -> " << args.out << "\n";
   return kExitOk;

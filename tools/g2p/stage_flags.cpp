@@ -120,6 +120,16 @@ void add_overrides_flag(CLI::App* cmd, std::string& path) {
                   "solid/hollow, wall thickness, density, contents per part or face");
 }
 
+bool report_overrides_error(const std::string& command, const std::string& overrides, const Status& s) {
+  const std::string& m = s.message();
+  std::size_t at = m.find(": overrides entry ");
+  if (at == std::string::npos) at = m.find(": overrides: ");
+  if (overrides.empty() || s.code() != StatusCode::kInvalidArgument || at == std::string::npos) return false;
+  std::cerr << "g2p " << command << ": --overrides " << overrides << ": " << m.substr(at + 2)
+            << "; nothing was written\n";
+  return true;
+}
+
 Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs) {
   BackendSettings s;
   for (const std::string& p : pairs) {
@@ -192,10 +202,8 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
   return o;
 }
 
-std::vector<CLI::Option*> add_pipeline_flags(CLI::App* cmd, PipelineArgs& p) {
-  const std::size_t before = cmd->get_options().size();
+void add_labelling_flags(CLI::App* cmd, PipelineArgs& p) {
   cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
-  add_export_flags(cmd, p.export_args);
   cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
   cmd->add_flag("--base-color-only", p.base_color_only,
                 "Keep only base colour: metallic and roughness at glTF's default of 1, no metallic-roughness texture "
@@ -203,12 +211,18 @@ std::vector<CLI::Option*> add_pipeline_flags(CLI::App* cmd, PipelineArgs& p) {
   cmd->add_flag("--soft", p.soft,
                 "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
                 "the learned and onnx segmenters)");
-  cmd->add_option("--vlm-url", p.vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
-  cmd->add_option("--vlm-model", p.vlm_model, "Model name for the vlm refiner/estimator");
   add_import_flags(cmd, p.import);
   add_view_flags(cmd, p.views);
   add_identify_flags(cmd, p.identify);
   add_segmenter_flags(cmd, p.segmenter);
+}
+
+std::vector<CLI::Option*> add_pipeline_flags(CLI::App* cmd, PipelineArgs& p) {
+  const std::size_t before = cmd->get_options().size();
+  add_labelling_flags(cmd, p);
+  add_export_flags(cmd, p.export_args);
+  cmd->add_option("--vlm-url", p.vlm_url, "OpenAI-compatible endpoint for the vlm refiner/estimator");
+  cmd->add_option("--vlm-model", p.vlm_model, "Model name for the vlm refiner/estimator");
   add_refiner_flags(cmd, p.refiner, PipelineOptions{}.refiner.name);
   add_completer_flags(cmd, p.completer);
   add_estimator_flags(cmd, p.estimator);

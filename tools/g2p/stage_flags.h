@@ -84,6 +84,10 @@ struct PipelineArgs {
   double memory_limit_gib = 0.0;
 };
 
+// The flags of the stages up to the labels: --materials, --anonymize-names,
+// --base-color-only, --soft and the import, view, identify and segmenter flags.
+void add_labelling_flags(CLI::App* cmd, PipelineArgs& args);
+
 // Every option flag of `g2p run` but --overrides and --memory-limit (which
 // g2p batch has as its own): the flags an options file replaces. Returns them.
 std::vector<CLI::Option*> add_pipeline_flags(CLI::App* cmd, PipelineArgs& args);
@@ -102,6 +106,12 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args);
 Result<Pipeline> make_pipeline(RunOptions options, const std::string& overrides);
 // The same with the flags' options and --materials.
 Result<Pipeline> make_pipeline(const PipelineArgs& args);
+
+// A corrections file that does not fit the run (a missing part, a failed
+// "was" check) is the user's input, like a bad flag: prints "g2p COMMAND:
+// --overrides FILE: ...; nothing was written" and returns true when `s` (an
+// InvalidArgument) says so.
+bool report_overrides_error(const std::string& command, const std::string& overrides, const Status& s);
 
 // KEY=VALUE pairs as BackendSettings.
 Result<BackendSettings> parse_settings(const std::vector<std::string>& pairs);

@@ -35,15 +35,7 @@ struct StageCommand {
 int fail(const StageCommand& c, const Status& s, bool setup = false) {
   // Flags: a bad value, and in setting up the pipeline an unknown backend name.
   const bool usage = s.code() == StatusCode::kInvalidArgument || (setup && s.code() == StatusCode::kNotFound);
-  // A corrections file that does not fit the object is the user's input, like a bad flag.
-  const std::string& m = s.message();
-  std::size_t at = m.find(": overrides entry ");
-  if (at == std::string::npos) at = m.find(": overrides: ");
-  if (!c.pipeline.overrides.empty() && usage && at != std::string::npos) {
-    std::cerr << "g2p " << c.name << ": --overrides " << c.pipeline.overrides << ": " << m.substr(at + 2)
-              << "; nothing was written\n";
-    return kExitUsage;
-  }
+  if (usage && report_overrides_error(c.name, c.pipeline.overrides, s)) return kExitUsage;
   std::cerr << "g2p " << c.name << ": error: " << (usage ? s.message() : s.to_string()) << "\n";
   return usage ? kExitUsage : kExitFailure;
 }
@@ -51,28 +43,7 @@ int fail(const StageCommand& c, const Status& s, bool setup = false) {
 void print_result(const StageCommand& c, const PipelineResult& r, const std::string& out) {
   for (const std::string& w : r.warnings) std::cerr << "g2p " << c.name << ": warning: " << w << "\n";
   for (const std::string& n : r.overrides_applied) std::cout << "correction: " << n << "\n";
-  for (const StageReport& s : r.stages)
-    std::printf("  %-10s %-10s %6.2f s%s\n", to_string(s.stage), s.backend.c_str(), s.seconds,
-                s.ok ? "" : "  FAILED (skipped)");
-  const MaterialTable& table = r.table;
-  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) {
-    const Part& p = r.projection.parts[i];
-    std::printf("  part %zu: %s, %zu faces, %.6g m^2", i,
-                table.valid_label(p.label) ? table[p.label].name.c_str() : "(unknown)", p.faces.size(), p.area_m2);
-    if (i < r.completion.parts.size())
-      std::printf(", %s %.6g cm^3", r.completion.parts[i].ok ? "closed" : "NOT CLOSED",
-                  r.completion.parts[i].checks.volume_m3 * 1e6);
-    if (i < r.properties.parts.size()) {
-      const PartReport& pr = r.properties.parts[i];
-      std::printf(", %s, %.4g kg/m^3 (%s), %.4g kg", to_string(pr.properties.structure), pr.properties.density_kg_m3,
-                  to_string(pr.properties.density_source), pr.mass.mass_kg);
-    }
-    std::printf("\n");
-  }
-  if (r.last_stage >= Stage::kProperties)
-    std::printf("object: %.4g kg (range %.3g - %.3g), centre of mass (%.4g %.4g %.4g) m\n", r.properties.object.mass_kg,
-                r.properties.mass_min_kg, r.properties.mass_max_kg, r.properties.object.center_of_mass.x(),
-                r.properties.object.center_of_mass.y(), r.properties.object.center_of_mass.z());
+  std::cout << pipeline_summary_text(r);
   std::printf("g2p %s: %zu parts -> %s\n", c.name.c_str(), r.projection.parts.size(), out.c_str());
 }
 
@@ -183,15 +154,7 @@ void add_project_command(CLI::App& app, Command& run) {
   cmd->add_option("model", c->source, "Model file")->required();
   cmd->add_option("-o,--output", c->out, "Output folder (must not exist unless --overwrite)")->required();
   cmd->add_flag("--overwrite", c->overwrite, "Replace an existing output folder (only once the new one is complete)");
-  cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
-  cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
-  cmd->add_flag("--base-color-only", p.base_color_only,
-                "Keep only base colour, metallic and roughness at glTF's default of 1 (what generators emit)");
-  cmd->add_flag("--soft", p.soft, "Soft votes: add the segmenter's class probabilities instead of one vote");
-  add_import_flags(cmd, p.import);
-  add_view_flags(cmd, p.views);
-  add_identify_flags(cmd, p.identify);
-  add_segmenter_flags(cmd, p.segmenter);
+  add_labelling_flags(cmd, p);
   add_refiner_flags(cmd, p.refiner, "none");
   cmd->callback([c, &run] {
     c->last = c->pipeline.refiner.name == "none" ? Stage::kProject : Stage::kRefine;

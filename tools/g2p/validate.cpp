@@ -37,32 +37,10 @@ int run_contact_check(const ValidateArgs& args, const std::string& mjcf) {
   options.drop_height_m = args.height;
   Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, options);
   if (!c.ok()) {
-    std::cerr << "g2p validate: error: " << c.status().to_string() << "\n";
-    return c.status().code() == StatusCode::kInvalidArgument ? kExitUsage : kExitFailure;
+    const int code = fail("validate", c.status());
+    return c.status().code() == StatusCode::kInvalidArgument ? kExitUsage : code;
   }
-  const Eigen::Vector3d lo = c->object_bounds.min(), hi = c->object_bounds.max();
-  int resting = 0, on_object = 0;
-  for (const BallProbe& b : c->balls) resting += b.at_rest ? 1 : 0, on_object += b.on_object ? 1 : 0;
-  std::printf("%s: %s, object fixed, collision geometry x %.4g..%.4g y %.4g..%.4g z %.4g..%.4g m\n", mjcf.c_str(),
-              c->engine.c_str(), lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z());
-  std::printf("  %zu balls of radius %.4g m dropped from %.4g m for %.3g s\n", c->balls.size(),
-              c->balls.empty() ? 0.0 : c->balls[0].radius_m,
-              hi.z() + 2 * (c->balls.empty() ? 0.0 : c->balls[0].radius_m), args.contact_options.seconds);
-  std::printf("  %9s %9s %12s %12s %11s  %s\n", "start x", "start y", "rests at z", "above floor", "speed m/s",
-              "where");
-  for (const BallProbe& b : c->balls)
-    std::printf("  %9.4f %9.4f %12.4f %12.4f %11.2e  %s%s\n", b.start.x(), b.start.y(), b.rest.z(),
-                b.height_above_floor_m, b.final_speed_m_s,
-                b.on_object  ? "on the object"
-                : b.on_floor ? "on the floor"
-                             : "touching nothing",
-                b.at_rest ? "" : ", still moving");
-  std::printf("  %d of %zu at rest, %d on the object\n", resting, c->balls.size(), on_object);
-  if (c->drop.dropped)
-    std::printf("  object dropped from %.3g m: rests %.4g m above the plane (%s)\n", args.height,
-                c->drop.resting_lowest_m, c->object_above_plane ? "above it" : "sunk into it");
-  else
-    std::printf("  object not dropped (the MJCF fixes it to the world)\n");
+  std::cout << contact_check_text(*c, mjcf, options);
   if (!args.json.empty()) {
     if (Status s = write_text_file(args.json, contact_check_json(*c, mjcf) + "\n"); !s.ok()) {
       std::cerr << "g2p validate: error: --json: " << s.to_string() << "\n";
@@ -94,32 +72,8 @@ int run_validate(const ValidateArgs& args) {
     std::cerr << "g2p validate: error: " << (found ? s.to_string() : s.message()) << "\n";
     return kExitFailure;
   }
-  const FolderCheck& f = *checked;
-  const EngineCheck& c = f.engine;
-  auto triple = [](const Eigen::Vector3d& v) {
-    char text[96];
-    std::snprintf(text, sizeof text, "%.5g %.5g %.5g", v.x(), v.y(), v.z());
-    return std::string(text);
-  };
-  std::printf("%s: %s\n", f.mjcf.c_str(), c.engine.c_str());
-  std::printf("  %-24s %-36s %s\n", "", "engine", "libg2p (report.json)");
-  if (f.has_report) {
-    std::printf("  %-24s %-36.6g %.6g\n", "mass (kg)", c.mass_kg, f.report_mass_kg);
-    std::printf("  %-24s %-36s %s\n", "centre of mass (m)", triple(c.center_of_mass).c_str(),
-                triple(f.report_center_of_mass).c_str());
-    std::printf("  %-24s %-36s %s\n", "principal moments", triple(c.principal_moments).c_str(),
-                triple(f.report_principal_moments).c_str());
-  } else {
-    std::printf("  mass %.6g kg (no report.json to compare with)\n", c.mass_kg);
-  }
-  if (c.dropped)
-    std::printf(
-        "  drop from %.3g m for %.3g s: lowest point %.4g m, at rest %.4g m above the plane, final speed %.3g m/s%s\n",
-        args.height, args.seconds, c.lowest_point_m, c.resting_lowest_m, c.final_speed_m_s,
-        c.finite ? "" : ", NOT FINITE");
-  for (const std::string& w : c.warnings) std::printf("  MuJoCo warned during the drop: %s\n", w.c_str());
-  std::printf("%s\n", f.pass() ? "PASS" : "FAIL");
-  return f.pass() ? kExitOk : kExitFailure;
+  std::cout << folder_check_text(*checked);
+  return checked->pass() ? kExitOk : kExitFailure;
 }
 
 }  // namespace

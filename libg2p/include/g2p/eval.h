@@ -225,6 +225,10 @@ struct G2P_API SegmentationEval {
   // "calibration" and per model its "2d", "3d", "kind", "kind_prior_applied"
   // and "refine" (with a refiner); indented, without a final newline.
   std::string to_json() const;
+  // What `g2p eval seg` prints after the models: the three IoU tables (per
+  // pixel, per face by area, per face each model weighing the same), the mIoU
+  // interval and the calibration, each line ending in a newline.
+  std::string to_text() const;
 };
 
 // Runs one set evaluation: prepare() checks everything the options name

@@ -192,8 +192,12 @@ struct ContactCheck {
 // written beside the user's files. Unavailable without MuJoCo.
 G2P_API Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path,
                                                       const ContactCheckOptions& options = {});
-// The check as JSON (`g2p validate --contact --json`).
+// The check as JSON (`g2p validate --contact --json`), and as the table
+// `g2p validate --contact` prints (lines ending in a newline; `options` as
+// the check ran with).
 G2P_API std::string contact_check_json(const ContactCheck& check, const std::string& mjcf_path);
+G2P_API std::string contact_check_text(const ContactCheck& check, const std::string& mjcf_path,
+                                       const ContactCheckOptions& options);
 
 // ---- A whole export folder (g2p validate DIR) ------------------------------
 
@@ -214,8 +218,12 @@ struct FolderCheck {
   // Dropped: finite, resting no more than 1 cm into the plane, no engine
   // warnings (true when the MJCF fixes the body and nothing is dropped).
   bool drop_ok = true;
+  double drop_height_m = 0.0, drop_seconds = 0.0;  // as asked
   bool pass() const { return numbers_match && drop_ok; }
 };
+// What `g2p validate` prints: the engine's numbers beside the report's, the
+// drop, the engine's warnings, then PASS or FAIL.
+G2P_API std::string folder_check_text(const FolderCheck& check);
 G2P_API Result<FolderCheck> check_folder_in_mujoco(const std::string& dir, double drop_height_m = 0.2,
                                                    double drop_seconds = 2.0);
 

@@ -244,4 +244,8 @@ G2P_API std::vector<float> kind_class_prior(const ObjectKind& kind, const Materi
 G2P_API std::string identification_json(const Identification& id, const ObjectTable& table,
                                         double size_assumed_m = 0.0);
 
+// The table's kinds (`g2p identify --list --json`): [{"name", "group", "coco",
+// "typical_longest_side_m", "mass_kg": [lo, hi], "structure"}, ...], indented.
+G2P_API std::string object_kinds_json(const ObjectTable& table);
+
 }  // namespace g2p

@@ -60,6 +60,13 @@ G2P_API Result<Model> load_model(const std::string& path, const ImportOptions& o
 G2P_API Result<Model> load_model_from_memory(const void* data, std::size_t size, const std::string& format_hint,
                                              const ImportOptions& options = {});
 
+// What was read, as `g2p info` shows it: the file, its frame, meshes, faces,
+// bounds, area and every source material with its face count, PBR values and
+// textures, and the import's warnings. Text (lines ending in a newline) and
+// JSON (indented, without a final newline).
+G2P_API std::string model_summary_text(const Model& model);
+G2P_API std::string model_summary_json(const Model& model);
+
 // Writes a mesh's triangles by extension: .obj (text), .ply (binary
 // little-endian) or .stl (binary), in metres. Written under a temporary name
 // and renamed, so an existing file is never left half-overwritten.

@@ -346,6 +346,12 @@ G2P_API Status check_output_folder(const std::string& dir, const OutputOptions& 
 // time and memory, parts with class, mass and volume, totals, warnings.
 G2P_API std::string pipeline_summary_json(const PipelineResult& result, const PipelineOptions& options = {});
 
+// The same for a terminal, as far as the result goes, each line ending in a
+// newline: what the object was identified as, one line per stage (backend,
+// seconds, peak MiB), per part its class, faces and area, closed volume,
+// structure, density and mass, and the object's mass and centre of mass.
+G2P_API std::string pipeline_summary_text(const PipelineResult& result);
+
 // A one-page HTML summary for a person (docs/pipeline.md#summaryhtml): a
 // banner for what needs checking, an interactive 3D view (WebGL; the geometry,
 // at most 200,000 triangles of it, and the viewer script are in the page, about

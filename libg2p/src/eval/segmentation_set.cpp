@@ -2,6 +2,7 @@
 // paper's Table 2; `g2p eval seg`). Each model runs through Pipeline from
 // render to project or refine; labels.json is read once per set.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -354,6 +355,30 @@ Result<SegmentationEval> SegmentationEvaluator::run(RunContext* context) {
 
 Result<SegmentationEval> evaluate_segmentation(const SegmentationEvalOptions& options, RunContext* context) {
   return SegmentationEvaluator(options).run(context);
+}
+
+std::string SegmentationEval::to_text() const {
+  const MaterialTable& classes = options.materials;
+  std::ostringstream out;
+  char line[256];
+  std::snprintf(line, sizeof line, "All %zu models, one confusion matrix (%.0f labelled pixels), IoU %%:\n",
+                models.size(), total.total());
+  out << line << total.table(classes) << "\nPer face (3D, weighted by area, after voting), IoU %:\n"
+      << total_3d.table(classes) << "\nPer face (3D, after voting), each model weighing the same, IoU %:\n"
+      << total_3d_per_model.table(classes);
+  if (interval) {
+    std::snprintf(line, sizeof line,
+                  "mIoU %.2f %%, %.0f %% interval over models %.2f-%.2f %% (bootstrap, %d resamples of %zu models)\n",
+                  100.0 * interval->miou, 100.0 * interval->confidence, 100.0 * interval->low, 100.0 * interval->high,
+                  interval->resamples, models.size());
+    out << line;
+  }
+  if (calibration.accuracy() == calibration.accuracy()) {  // has probabilities
+    std::snprintf(line, sizeof line, "calibration: mean confidence %.3f, accuracy %.3f, ECE %.3f (10 bins)\n",
+                  calibration.mean_confidence(), calibration.accuracy(), calibration.expected_calibration_error());
+    out << line;
+  }
+  return out.str();
 }
 
 std::string SegmentationEval::to_json() const {

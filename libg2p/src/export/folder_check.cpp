@@ -2,6 +2,7 @@
 // MuJoCo beside the report.json written with it, and the contact check as JSON.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -61,6 +62,8 @@ Result<FolderCheck> check_folder_in_mujoco(const std::string& dir, double drop_h
   if (!mjcf.ok()) return mjcf.status();
   FolderCheck c;
   c.mjcf = *mjcf;
+  c.drop_height_m = drop_height_m;
+  c.drop_seconds = drop_seconds;
   Result<EngineCheck> engine = check_in_mujoco(c.mjcf, drop_height_m, drop_seconds);
   if (!engine.ok()) return engine.status();
   c.engine = std::move(*engine);
@@ -96,6 +99,73 @@ std::string contact_check_json(const ContactCheck& c, const std::string& mjcf) {
                {"final_speed_m_s", c.drop.final_speed_m_s},
                {"object_above_plane", c.object_above_plane}};
   return detail::json_text(j, 2);
+}
+
+std::string folder_check_text(const FolderCheck& f) {
+  const EngineCheck& c = f.engine;
+  auto triple = [](const Eigen::Vector3d& v) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.5g %.5g %.5g", v.x(), v.y(), v.z());
+    return std::string(text);
+  };
+  std::string out;
+  char line[512];
+  auto add = [&](int n) {
+    out.append(line, static_cast<std::size_t>(std::clamp(n, 0, static_cast<int>(sizeof line) - 1)));
+  };
+  add(std::snprintf(line, sizeof line, "%s: %s\n  %-24s %-36s %s\n", f.mjcf.c_str(), c.engine.c_str(), "", "engine",
+                    "libg2p (report.json)"));
+  if (f.has_report) {
+    add(std::snprintf(line, sizeof line, "  %-24s %-36.6g %.6g\n", "mass (kg)", c.mass_kg, f.report_mass_kg));
+    add(std::snprintf(line, sizeof line, "  %-24s %-36s %s\n", "centre of mass (m)", triple(c.center_of_mass).c_str(),
+                      triple(f.report_center_of_mass).c_str()));
+    add(std::snprintf(line, sizeof line, "  %-24s %-36s %s\n", "principal moments", triple(c.principal_moments).c_str(),
+                      triple(f.report_principal_moments).c_str()));
+  } else {
+    add(std::snprintf(line, sizeof line, "  mass %.6g kg (no report.json to compare with)\n", c.mass_kg));
+  }
+  if (c.dropped)
+    add(std::snprintf(line, sizeof line,
+                      "  drop from %.3g m for %.3g s: lowest point %.4g m, at rest %.4g m above the plane, final "
+                      "speed %.3g m/s%s\n",
+                      f.drop_height_m, f.drop_seconds, c.lowest_point_m, c.resting_lowest_m, c.final_speed_m_s,
+                      c.finite ? "" : ", NOT FINITE"));
+  for (const std::string& w : c.warnings) out += "  MuJoCo warned during the drop: " + w + "\n";
+  return out + (f.pass() ? "PASS\n" : "FAIL\n");
+}
+
+std::string contact_check_text(const ContactCheck& c, const std::string& mjcf, const ContactCheckOptions& options) {
+  const Eigen::Vector3d lo = c.object_bounds.min(), hi = c.object_bounds.max();
+  const double radius = c.balls.empty() ? 0.0 : c.balls[0].radius_m;
+  int resting = 0, on_object = 0;
+  for (const BallProbe& b : c.balls) resting += b.at_rest ? 1 : 0, on_object += b.on_object ? 1 : 0;
+  std::string out;
+  char line[512];
+  auto add = [&](int n) {
+    out.append(line, static_cast<std::size_t>(std::clamp(n, 0, static_cast<int>(sizeof line) - 1)));
+  };
+  add(std::snprintf(line, sizeof line,
+                    "%s: %s, object fixed, collision geometry x %.4g..%.4g y %.4g..%.4g z %.4g..%.4g m\n", mjcf.c_str(),
+                    c.engine.c_str(), lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z()));
+  add(std::snprintf(line, sizeof line, "  %zu balls of radius %.4g m dropped from %.4g m for %.3g s\n", c.balls.size(),
+                    radius, hi.z() + 2 * radius, options.seconds));
+  add(std::snprintf(line, sizeof line, "  %9s %9s %12s %12s %11s  %s\n", "start x", "start y", "rests at z",
+                    "above floor", "speed m/s", "where"));
+  for (const BallProbe& b : c.balls)
+    add(std::snprintf(line, sizeof line, "  %9.4f %9.4f %12.4f %12.4f %11.2e  %s%s\n", b.start.x(), b.start.y(),
+                      b.rest.z(), b.height_above_floor_m, b.final_speed_m_s,
+                      b.on_object  ? "on the object"
+                      : b.on_floor ? "on the floor"
+                                   : "touching nothing",
+                      b.at_rest ? "" : ", still moving"));
+  add(std::snprintf(line, sizeof line, "  %d of %zu at rest, %d on the object\n", resting, c.balls.size(), on_object));
+  if (c.drop.dropped)
+    add(std::snprintf(line, sizeof line, "  object dropped from %.3g m: rests %.4g m above the plane (%s)\n",
+                      options.drop_height_m, c.drop.resting_lowest_m,
+                      c.object_above_plane ? "above it" : "sunk into it"));
+  else
+    out += "  object not dropped (the MJCF fixes it to the world)\n";
+  return out;
 }
 
 }  // namespace g2p

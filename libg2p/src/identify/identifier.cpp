@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/json_text.h"
 #include "g2p/identify.h"
 #include "g2p/segment.h"
 #include "identify/backends.h"
@@ -222,6 +223,18 @@ Result<SizePolicy> parse_size_policy(const std::string& text) {
   if (text == "kind") return SizePolicy::kKind;
   if (text == "file") return SizePolicy::kFile;
   return Status::InvalidArgument("--size-from must be kind or file, got '" + text + "'");
+}
+
+std::string object_kinds_json(const ObjectTable& table) {
+  nlohmann::json kinds = nlohmann::json::array();
+  for (const ObjectKind& k : table.kinds())
+    kinds.push_back({{"name", k.name},
+                     {"group", k.group},
+                     {"coco", k.coco},
+                     {"typical_longest_side_m", k.typical_longest_side_m},
+                     {"mass_kg", {k.mass_kg[0], k.mass_kg[1]}},
+                     {"structure", k.structure}});
+  return detail::json_text(kinds, 2);
 }
 
 std::string identification_json(const Identification& id, const ObjectTable& table, double size_assumed_m) {

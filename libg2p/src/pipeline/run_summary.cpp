@@ -1,5 +1,6 @@
 // run.json: the machine-readable summary of a run (pipeline_summary_json),
 // and what it and summary.html say about each part.
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -44,6 +45,54 @@ nlohmann::json part_summary_json(const PipelineResult& r, std::size_t i) {
 }
 
 }  // namespace detail
+
+std::string pipeline_summary_text(const PipelineResult& r) {
+  std::string out;
+  char line[512];
+  const Identification& id = r.identification;
+  if (r.stage(Stage::kIdentify) != nullptr) {
+    if (id.known())
+      std::snprintf(line, sizeof line, "object: %s (%s, %.0f %% confident)%s\n", id.kind().c_str(), id.source().c_str(),
+                    100.0 * id.confidence(),
+                    r.kind.name.empty()    ? ", below --kind-confidence: nothing assumed from it"
+                    : r.size_assumed_m > 0 ? ", its typical size assumed"
+                                           : "");
+    else
+      std::snprintf(line, sizeof line, "object: unknown (give it with --object)\n");
+    out += line;
+  }
+  for (const StageReport& s : r.stages) {
+    std::snprintf(line, sizeof line, "  %-10s %-10s %6.2f s %7.0f MiB%s\n", to_string(s.stage), s.backend.c_str(),
+                  s.seconds, static_cast<double>(s.peak_rss_bytes) / 1048576.0, s.ok ? "" : "  FAILED (skipped)");
+    out += line;
+  }
+  for (std::size_t i = 0; i < r.projection.parts.size(); ++i) {
+    const Part& p = r.projection.parts[i];
+    std::snprintf(line, sizeof line, "  part %zu: %s, %zu faces, %.6g m^2", i,
+                  r.table.valid_label(p.label) ? r.table[p.label].name.c_str() : "(unknown)", p.faces.size(),
+                  p.area_m2);
+    out += line;
+    if (i < r.completion.parts.size()) {
+      std::snprintf(line, sizeof line, ", %s %.6g cm^3", r.completion.parts[i].ok ? "closed" : "NOT CLOSED",
+                    r.completion.parts[i].checks.volume_m3 * 1e6);
+      out += line;
+    }
+    if (i < r.properties.parts.size()) {
+      const PartReport& pr = r.properties.parts[i];
+      std::snprintf(line, sizeof line, ", %s, %.4g kg/m^3 (%s), %.4g kg", to_string(pr.properties.structure),
+                    pr.properties.density_kg_m3, to_string(pr.properties.density_source), pr.mass.mass_kg);
+      out += line;
+    }
+    out += "\n";
+  }
+  if (r.last_stage >= Stage::kProperties && !r.properties.parts.empty()) {
+    const Eigen::Vector3d& c = r.properties.object.center_of_mass;
+    std::snprintf(line, sizeof line, "mass: %.4g kg (range %.3g - %.3g), centre of mass (%.4g %.4g %.4g) m\n",
+                  r.properties.object.mass_kg, r.properties.mass_min_kg, r.properties.mass_max_kg, c.x(), c.y(), c.z());
+    out += line;
+  }
+  return out;
+}
 
 std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions& o) {
   nlohmann::json stages = nlohmann::json::array();

@@ -227,12 +227,18 @@ TEST(Pipeline, StopsAfterTheLastStageAskedFor) {
   EXPECT_TRUE(fs::exists(dir + "/out/faces.csv"));
   EXPECT_FALSE(fs::exists(dir + "/out/report.json"));
   EXPECT_NE(test::read_file(dir + "/out/manifest.json").find("\"stage\": \"refine\""), std::string::npos);
-  // One that stopped before the labels were on the faces has nothing to write.
+  // One that stopped before the labels were on the faces is its views and label maps (g2p segment's folder).
   o.last_stage = Stage::kSegment;
   Result<PipelineResult> segmented = Pipeline(o).run_file(hammer());
   ASSERT_TRUE(segmented.ok());
-  EXPECT_FALSE(write_pipeline_output(dir + "/segmented", *segmented, o).ok());
-  EXPECT_FALSE(fs::exists(dir + "/segmented"));
+  ASSERT_TRUE(write_pipeline_output(dir + "/segmented", *segmented, o).ok());
+  EXPECT_TRUE(fs::exists(dir + "/segmented/views/cameras.json"));
+  EXPECT_TRUE(fs::exists(dir + "/segmented/segmented/view_00_labels_index.png"));
+  EXPECT_FALSE(fs::exists(dir + "/segmented/faces.csv"));
+  EXPECT_NE(test::read_file(dir + "/segmented/manifest.json").find("\"stage\": \"segment\""), std::string::npos);
+  // A result with no views has nothing to write.
+  EXPECT_EQ(write_pipeline_output(dir + "/empty", PipelineResult{}, o).code(), StatusCode::kInvalidArgument);
+  EXPECT_FALSE(fs::exists(dir + "/empty"));
 }
 
 // A user's segmenter: every surface pixel is plastic.

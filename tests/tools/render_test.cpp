@@ -13,9 +13,9 @@ namespace g2p {
 namespace {
 
 TEST(ToolRender, WritesViewsCamerasAndContactSheet) {
-  const std::string out = test::scratch_dir("ToolRender.Writes") + "/views";
+  const std::string folder = test::scratch_dir("ToolRender.Writes") + "/out", out = folder + "/views";
   test::ToolRun r = test::run_tool("render " + test::quote(test::source_path("examples/data/hammer.obj")) + " -o " +
-                                   test::quote(out) + " --views 3 --resolution 48 --buffers");
+                                   test::quote(folder) + " --views 3 --resolution 48 --buffers");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("rendered 3 views of 104 triangles"), std::string::npos) << r.out;
   for (const char* f :
@@ -34,6 +34,17 @@ TEST(ToolRender, WritesViewsCamerasAndContactSheet) {
     hits += ids->data()[i] >= 0;
   }
   EXPECT_GT(hits, 20);
+  EXPECT_TRUE(std::filesystem::is_regular_file(folder + "/manifest.json"));
+  // A rerun with fewer views replaces the folder whole (with --overwrite): no view of the first is left.
+  EXPECT_EQ(test::run_tool("render " + test::quote(test::source_path("examples/data/hammer.obj")) + " -o " +
+                           test::quote(folder) + " --views 1 --resolution 48")
+                .exit_code,
+            2);
+  r = test::run_tool("render " + test::quote(test::source_path("examples/data/hammer.obj")) + " -o " +
+                     test::quote(folder) + " --views 1 --resolution 48 --overwrite");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out + "/view_02_rgb.png"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/view_01_depth.npy"));
 }
 
 TEST(ToolRender, BenchmarkModePrintsThroughput) {
@@ -55,7 +66,7 @@ TEST(ToolRender, BadArgumentsAndInputs) {
   const std::string dir = test::scratch_dir("ToolRender.Bad");
   test::write_file(dir + "/file", "keep me");
   r = test::run_tool("render " + hammer + " -o " + test::quote(dir + "/file") + " --views 1 --resolution 16");
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("not a folder"), std::string::npos) << r.err;
   EXPECT_EQ(test::read_file(dir + "/file"), "keep me");
   r = test::run_tool("render " + test::quote(dir + "/missing.glb") + " -o " + test::quote(dir + "/o"));

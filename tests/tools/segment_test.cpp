@@ -27,15 +27,29 @@ TEST(ToolSegment, WritesLabelMapsForEachBackend) {
   for (const std::string& backend : {"pbr", "oracle"}) {
     const std::string out = dir + "/" + backend;
     const std::string set = backend == "oracle" ? " --set labels=" + quote(dir + "/labels.json") : "";
-    test::ToolRun r =
-        run_tool("segment " + hammer + " -o " + quote(out) + " --views 2 --resolution 48 --segmenter " + backend + set);
+    test::ToolRun r = run_tool("segment " + hammer + " -o " + quote(out) + " --views 2 --resolution 48 --segmenter " +
+                               backend + set + " --save-intermediates");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    for (const char* f : {"view_00_labels.png", "view_01_labels_index.png", "view_01_probs.npy", "view_00_rgb.png",
-                          "legend.png", "classes.json", "cameras.json"})
+    for (const char* f : {"segmented/view_00_labels.png", "segmented/view_01_labels_index.png",
+                          "segmented/view_01_probs.npy", "views/view_00_rgb.png", "segmented/legend.png",
+                          "segmented/classes.json", "views/cameras.json", "manifest.json"})
       EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << backend << ": " << f;
+    EXPECT_NE(r.out.find("g2p segment: 2 views -> "), std::string::npos) << r.out;
   }
+  // A folder of one stage, written whole: a rerun with fewer views leaves none of the earlier ones,
+  // and the stage commands that start from face labels say what the folder holds.
+  const std::string out = dir + "/pbr";
+  test::ToolRun again = run_tool("segment " + hammer + " -o " + quote(out) + " --views 1 --resolution 48");
+  EXPECT_EQ(again.exit_code, 2) << again.err;  // exists: --overwrite replaces it
+  again = run_tool("segment " + hammer + " -o " + quote(out) + " --views 1 --resolution 48 --overwrite");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_FALSE(std::filesystem::exists(out + "/segmented/view_01_labels.png"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/views/view_01_rgb.png"));
+  test::ToolRun refine = run_tool("refine " + quote(out));
+  EXPECT_EQ(refine.exit_code, 2);
+  EXPECT_NE(refine.err.find("holds the stages up to segment"), std::string::npos) << refine.err;
   // Seen from below (view 1), the oracle labels the handle Wood and the head Metal.
-  Result<ImageU8> index = read_image(dir + "/oracle/view_01_labels_index.png");
+  Result<ImageU8> index = read_image(dir + "/oracle/segmented/view_01_labels_index.png");
   ASSERT_TRUE(index.ok());
   int wood = 0, metal = 0;
   for (int y = 0; y < 48; ++y)
@@ -66,7 +80,7 @@ TEST(ToolSegment, ADegradedBackendSaysSoInSegmentAndEval) {
   test::ToolRun r =
       run_tool("segment " + trellis + " -o " + quote(dir + "/out") + " --views 1 --resolution 32" + no_card);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("g2p segment: warning: hybrid: the network cannot run"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("g2p segment: warning: segment: hybrid: the network cannot run"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("missing/g2p-materials.json"), std::string::npos) << r.err;
   // The hammer's named materials never wanted it: no warning.
   const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));

@@ -202,15 +202,16 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
   return o;
 }
 
-void add_labelling_flags(CLI::App* cmd, PipelineArgs& p) {
+void add_labelling_flags(CLI::App* cmd, PipelineArgs& p, bool votes) {
   cmd->add_option("--materials", p.materials, "Material table JSON (default: the paper's 12 classes)");
   cmd->add_flag("--anonymize-names", p.anonymize, "Replace every name by a meaningless one first");
   cmd->add_flag("--base-color-only", p.base_color_only,
                 "Keep only base colour: metallic and roughness at glTF's default of 1, no metallic-roughness texture "
                 "or transmission (what image-to-3D generators emit; for measuring)");
-  cmd->add_flag("--soft", p.soft,
-                "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
-                "the learned and onnx segmenters)");
+  if (votes)
+    cmd->add_flag("--soft", p.soft,
+                  "Soft votes: each pixel adds the segmenter's class probabilities instead of one vote (better with "
+                  "the learned and onnx segmenters)");
   add_import_flags(cmd, p.import);
   add_view_flags(cmd, p.views);
   add_identify_flags(cmd, p.identify);

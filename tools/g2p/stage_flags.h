@@ -85,8 +85,9 @@ struct PipelineArgs {
 };
 
 // The flags of the stages up to the labels: --materials, --anonymize-names,
-// --base-color-only, --soft and the import, view, identify and segmenter flags.
-void add_labelling_flags(CLI::App* cmd, PipelineArgs& args);
+// --base-color-only, --soft (with `votes`) and the import, view, identify and
+// segmenter flags.
+void add_labelling_flags(CLI::App* cmd, PipelineArgs& args, bool votes = true);
 
 // Every option flag of `g2p run` but --overrides and --memory-limit (which
 // g2p batch has as its own): the flags an options file replaces. Returns them.

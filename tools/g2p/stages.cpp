@@ -27,7 +27,7 @@ struct StageCommand {
   Stage last = Stage::kRefine;   // where it stops
   std::string source, out;       // SOURCE (folder or model file), -o
   std::string truth, key;        // a model file's ground truth (--truth, --key)
-  bool overwrite = false;
+  bool overwrite = false, intermediates = false;
   std::vector<std::string> mesh_formats{"obj"};  // completed/ (g2p complete --format)
   PipelineArgs pipeline;
 };
@@ -44,7 +44,10 @@ void print_result(const StageCommand& c, const PipelineResult& r, const std::str
   for (const std::string& w : r.warnings) std::cerr << "g2p " << c.name << ": warning: " << w << "\n";
   for (const std::string& n : r.overrides_applied) std::cout << "correction: " << n << "\n";
   std::cout << pipeline_summary_text(r);
-  std::printf("g2p %s: %zu parts -> %s\n", c.name.c_str(), r.projection.parts.size(), out.c_str());
+  if (r.last_stage < Stage::kProject)
+    std::printf("g2p %s: %zu views -> %s\n", c.name.c_str(), r.views.size(), out.c_str());
+  else
+    std::printf("g2p %s: %zu parts -> %s\n", c.name.c_str(), r.projection.parts.size(), out.c_str());
 }
 
 int run_stage_command(const StageCommand& c) {
@@ -74,6 +77,7 @@ int run_stage_command(const StageCommand& c) {
   OutputOptions output;
   output.written_by = "g2p " + c.name;
   output.mesh_formats = c.mesh_formats;
+  output.intermediates = c.intermediates;
   std::error_code same_error;
   const bool in_place = folder && fs::exists(out, ec) && fs::equivalent(out, c.source, same_error);
   output.overwrite = c.overwrite || in_place;
@@ -142,7 +146,26 @@ CLI::App* add_stage(CLI::App& app, Command& run, const std::string& name, const 
   return cmd;
 }
 
+// MODEL, -o and --overwrite of the commands that start from a model file.
+void add_model_flags(CLI::App* cmd, StageCommand& c) {
+  cmd->add_option("model", c.source, "Model file")->required();
+  cmd->add_option("-o,--output", c.out, "Output folder (must not exist unless --overwrite)")->required();
+  cmd->add_flag("--overwrite", c.overwrite, "Replace an existing output folder (only once the new one is complete)");
+}
+
 }  // namespace
+
+void add_segment_command(CLI::App& app, Command& run) {
+  std::shared_ptr<StageCommand> c;
+  CLI::App* cmd = add_stage(app, run, "segment",
+                            "Render a model and label every pixel with a material class: the views/ and segmented/ "
+                            "of a g2p run folder",
+                            Stage::kRender, Stage::kSegment, c);
+  add_model_flags(cmd, *c);
+  cmd->add_flag("--save-intermediates", c->intermediates,
+                "Also every view's buffers and the segmenter's class probabilities (segmented/view_XX_probs.npy)");
+  add_labelling_flags(cmd, c->pipeline, /*votes=*/false);
+}
 
 void add_project_command(CLI::App& app, Command& run) {
   std::shared_ptr<StageCommand> c;
@@ -151,9 +174,7 @@ void add_project_command(CLI::App& app, Command& run) {
                             "--refiner, refine them too)",
                             Stage::kRender, Stage::kProject, c);
   PipelineArgs& p = c->pipeline;
-  cmd->add_option("model", c->source, "Model file")->required();
-  cmd->add_option("-o,--output", c->out, "Output folder (must not exist unless --overwrite)")->required();
-  cmd->add_flag("--overwrite", c->overwrite, "Replace an existing output folder (only once the new one is complete)");
+  add_model_flags(cmd, *c);
   add_labelling_flags(cmd, p);
   add_refiner_flags(cmd, p.refiner, "none");
   cmd->callback([c, &run] {

@@ -6,8 +6,8 @@ card's "decode" section says, and votes over several views of one object.
     python3 tools/training/detect_objects.py IMAGE... [--card libg2p/data/models/g2p-objects-nanodet.json]
         [--threshold 0.35] [--background 128,128,128] [--top 3] [--json OUT.json] [--draw DIR]
 
-    g2p render MODEL -o VIEWS --layout turntable --views 8
-    python3 tools/training/detect_objects.py VIEWS/view_*_rgb.png --background 128,128,128
+    g2p render MODEL -o OUT --layout turntable --views 8
+    python3 tools/training/detect_objects.py OUT/views/view_*_rgb.png --background 128,128,128
 
 Decoding (NanoDet's GFL head): for stride s (8, 16, 32) the grid is (416 / s) x (416 / s); cell i sits at
 row = i // grid, column = i % grid, centre ((column + 0.5) s, (row + 0.5) s). Each side's distance is s times the

@@ -321,7 +321,7 @@ struct OutputOptions {
 };
 
 // Writes the run into `dir`, as far as it went (PipelineResult::last_stage,
-// project at least): manifest.json (folder.h), views/ (renders, face IDs,
+// render at least): manifest.json (folder.h), views/ (renders, face IDs,
 // contact sheet), segmented/ and projected/ (label maps, contact sheets),
 // faces.csv, labelled.ply, parts.json, refine.json; after complete
 // completed/ (closed parts; for a whole run only with intermediates); after

@@ -280,6 +280,10 @@ Result<FolderState> read_pipeline_folder(const std::string& dir, Stage first, co
   if (!manifest.ok()) return manifest.status();
   out.manifest = std::move(*manifest);
   const FolderManifest& m = out.manifest;
+  if (m.stage < Stage::kProject)
+    return Status::InvalidArgument(dir + ": holds the stages up to " + to_string(m.stage) +
+                                   " (views and label maps, no face labels); the stage commands start from a folder "
+                                   "of g2p project or g2p run");
   if (first < Stage::kRefine) first = Stage::kRefine;
   // A stage whose input the folder lacks runs again.
   if (first > next(m.stage)) {

@@ -97,6 +97,7 @@ Status write_labels(const std::string& tmp, const PipelineResult& r, const Outpu
     }
     G2P_RETURN_IF_ERROR(write_text_file(tmp + "/segmented/image_decided.csv", image_decided_csv(r.image_decided)));
   }
+  if (r.last_stage < Stage::kProject) return Status::Ok();  // g2p render, g2p segment: the images only
   G2P_RETURN_IF_ERROR(write_projection(tmp, r.model, r.views, r.projection, r.table));
   return write_text_file(tmp + "/refine.json", refine_json(r));
 }
@@ -132,7 +133,7 @@ Status write_contents(const std::string& tmp, const PipelineResult& r, const Pip
     G2P_RETURN_IF_ERROR(write_asset_files(tmp, r, o));
   else if (last >= Stage::kProperties)
     G2P_RETURN_IF_ERROR(write_report(tmp + "/report.json", r.properties, r.table));
-  if (out.intermediates) G2P_RETURN_IF_ERROR(write_intermediates(tmp + "/intermediates", r));
+  if (out.intermediates && last >= Stage::kProject) G2P_RETURN_IF_ERROR(write_intermediates(tmp + "/intermediates", r));
   if (last >= Stage::kExport) {
     G2P_RETURN_IF_ERROR(write_text_file(tmp + "/run.json", pipeline_summary_json(r, o) + "\n"));
     G2P_RETURN_IF_ERROR(write_text_file(tmp + "/summary.html", summary_html(r, o)));
@@ -149,10 +150,13 @@ Status write_contents(const std::string& tmp, const PipelineResult& r, const Pip
 Status write_pipeline_output(const std::string& dir, const PipelineResult& result, const PipelineOptions& options,
                              const OutputOptions& output) {
   if (dir.empty()) return Status::InvalidArgument("write_pipeline_output: no output folder given");
-  if (result.last_stage < Stage::kProject || result.model.mesh.num_faces() == 0 ||
-      result.projection.labels.label.size() != static_cast<std::size_t>(result.model.mesh.num_faces()))
+  if (result.last_stage < Stage::kRender || result.model.mesh.num_faces() == 0 ||
+      (result.last_stage < Stage::kProject && result.views.empty()))
     return Status::InvalidArgument(
-        "write_pipeline_output: the result holds no face labels (it stopped before the project stage, or failed)");
+        "write_pipeline_output: the result holds no views (it stopped before the render stage, or failed)");
+  if (result.last_stage >= Stage::kProject &&
+      result.projection.labels.label.size() != static_cast<std::size_t>(result.model.mesh.num_faces()))
+    return Status::InvalidArgument("write_pipeline_output: the result holds no face labels (did the run succeed?)");
   if (result.last_stage >= Stage::kExport && result.asset.parts.empty())
     return Status::InvalidArgument("write_pipeline_output: the result is incomplete (did the run succeed?)");
   OutputOptions checked = output;

@@ -59,8 +59,11 @@ if [ "$run_tests" = 1 ]; then
   # `ulimit -v`, where ASan cannot reserve its shadow memory; TheMemoryLimit...:
   # runs g2p under a 0.5 GiB RLIMIT_DATA, which ASan's own mappings exceed. The
   # main job runs all three.
+  # scripts/sanitizers/release-only.txt: the slowest tests, whose code runs
+  # here in smaller tests; the main job runs them.
+  release_only=$(sed -e 's/#.*//' -e 's/[[:space:]]*$//' -e '/^$/d' scripts/sanitizers/release-only.txt | paste -sd'|')
   ctest --test-dir "$build" --output-on-failure -j2 \
-    -E '^package\.|^ToolRun\.TooLittleMemoryIsACleanErrorNotACrash$|^batch\.BatchRun\.TheMemoryLimitReachesEveryWorker$'
+    -E "^package\\.|^ToolRun\\.TooLittleMemoryIsACleanErrorNotACrash\$|^batch\\.BatchRun\\.TheMemoryLimitReachesEveryWorker\$|$release_only"
   stamp "test suite passed under ASan+UBSan"
 fi
 

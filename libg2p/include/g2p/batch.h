@@ -115,6 +115,9 @@ struct BatchRow {
   double seconds = 0.0;                         // wall-clock seconds of the asset's process
   std::map<std::string, double> stage_seconds;  // "render" -> seconds, from run.json
   std::size_t peak_rss_bytes = 0;               // the process's peak resident memory
+  // What the run warns about (run.json's warnings): a part whose volume
+  // disagrees with the input's, a mass outside the kind's range, ...
+  std::vector<std::string> warnings;
   std::string output;                           // OUT/NAME when ok, else ""
   std::string finished_at;                      // UTC, ISO 8601
 };

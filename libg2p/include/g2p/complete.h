@@ -9,6 +9,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,10 +35,18 @@ struct CompletionInput {
   const Mesh* mesh = nullptr;                // the whole object's surface (metres)
   const std::vector<Part>* parts = nullptr;  // from the project stage; Part::faces index mesh->triangles
   const MaterialTable* table = nullptr;      // optional: class names in messages and files
+  // Optional, per part: the closed surface complete() keeps as given
+  // (closed_part_surface; empty where the part is to be completed). A backend
+  // need not close those parts (complete() replaces whatever it returns for
+  // them); `partition` gives their solids to them and splits only the rest.
+  const std::vector<Mesh>* kept = nullptr;
   // Optional: checked between the steps of a backend and between parts; a
   // status other than OK (cancellation) ends complete() with it.
   StageProgress progress;
 
+  bool is_kept(std::size_t part) const {
+    return kept != nullptr && part < kept->size() && (*kept)[part].num_faces() > 0;
+  }
   Status report(double fraction, const std::string& message) const {
     return progress ? progress(fraction, message) : Status::Ok();
   }
@@ -86,9 +95,16 @@ struct CompletedPart {
   MeshChecks checks;
   std::string backend;             // which backend produced `mesh` (after any fallback)
   std::vector<std::string> notes;  // fallbacks, warnings
-  // Checks passed and the distance to the patch is within the completer's
-  // tolerance. A part that fails is kept but flagged; later stages say so.
+  // Checks passed, the distance to the patch is within the completer's
+  // tolerance and the volume agrees with the input's (below). A part that
+  // fails is kept but flagged; later stages say so.
   bool ok = false;
+  // The independent volume check (estimate_volumes): the volume the input's
+  // faces enclose that falls to this part, m^3 (-1: no estimate), and how far
+  // `checks.volume_m3` lies from it, relative ((ours - input) / input; NaN
+  // where the estimate could not judge this part, see CompletionOptions).
+  double input_volume_m3 = -1.0;
+  double volume_difference = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Completion {
@@ -99,6 +115,10 @@ struct Completion {
   // the overlap where part borders meet the object's skin.
   double parts_volume_m3 = 0.0;
   double grid_spacing_m = 0.0;  // partition: the grid's cell size; 0 for other backends
+  // The volume the input's faces enclose (estimate_volumes), m^3; -1 where
+  // they are too open to tell.
+  double input_volume_m3 = -1.0;
+  int kept_parts = 0;  // parts whose own faces were already closed, kept as they are
   std::vector<std::string> notes;
 };
 
@@ -128,10 +148,63 @@ inline Result<std::unique_ptr<Completer>> make_completer(const std::string& name
   return completer_registry().make(name, settings);
 }
 
+struct CompletionOptions {
+  // A part whose own faces already bound a solid (closed_part_surface) is
+  // kept as it is, so its volume, mass and inertia are the input's exactly;
+  // the completer closes the others. false: the completer closes every part.
+  bool keep_closed_parts = true;
+  // Vertices closer than this (x the object's bounding-box diagonal) are one
+  // vertex when deciding whether a part is closed (as ProjectOptions).
+  double weld_tolerance = 1e-6;
+  // The independent volume check: a part whose closed volume differs from
+  // the input's by more than this fraction fails (ok = false, a note saying
+  // by how much). It judges a part whose estimate is its own: at least
+  // `volume_check_own_fraction` of it lies between two of the part's faces
+  // (a thin board, a rod, a closed shell), not between faces of different
+  // parts, where the estimate's split (halfway along each ray) and the
+  // completer's (nearest surface) differ by design. <= 0: no check.
+  double volume_tolerance = 0.05;
+  double volume_check_own_fraction = 0.8;
+  int volume_rays = 192;  // rays per side of each of the three ray grids (estimate_volumes)
+};
+
 // Runs `completer`; parts it failed (not ok) are redone by `fallback` (if
-// given) and noted. The result always has one entry per part.
+// given) and noted. Parts already closed are kept (options.keep_closed_parts;
+// when every part is, the completer is not called), and every part's volume
+// is checked against the input's (options.volume_tolerance). The result
+// always has one entry per part.
 G2P_API Result<Completion> complete(const CompletionInput& input, const Completer& completer,
-                                    const Completer* fallback = nullptr);
+                                    const Completer* fallback = nullptr, const CompletionOptions& options = {});
+
+// The part's faces as a closed solid, when they already are one: vertices
+// within `weld_tolerance` (x the bounding-box diagonal of `mesh`) merged,
+// degenerate triangles dropped, and the result closed, consistently oriented,
+// vertex-manifold and free of self-intersections, with every component
+// outward except those inside another (cavities, wound inward). A component
+// inside out that no other contains is turned. Empty when the faces are not
+// a solid, or not clearly one: open, non-manifold, self-intersecting,
+// overlapping components, a nested component wound like the one around it.
+G2P_API Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance = 1e-6);
+
+// The volume inside the input's faces, estimated without closing them: rays
+// cast along each axis through a grid of `rays_per_side` x `rays_per_side`
+// points over the bounding box, the crossings paired by winding number (by
+// parity where orientation is inconsistent), and every inside interval split
+// halfway between the parts of the two faces that bound it. Exact for a
+// closed surface up to the grid's sampling; thin parts lose nothing, since
+// every ray measures its own thickness. Rays whose crossings do not pair
+// (holes, open sheets) are left out and counted.
+struct VolumeEstimate {
+  double object_m3 = 0.0;
+  std::vector<double> part_m3;            // per part
+  std::vector<double> part_own_fraction;  // per part: share of part_m3 between two faces of the part itself
+  std::vector<int> part_intervals;        // per part: inside intervals that gave it volume
+  int rays_hit = 0;                       // rays that crossed the surface
+  int rays_paired = 0;                    // of those, rays whose crossings pair up
+  // Enough rays paired (90 %) for the estimate to judge.
+  bool usable() const { return rays_hit > 0 && rays_paired >= 0.9 * rays_hit; }
+};
+G2P_API VolumeEstimate estimate_volumes(const Mesh& mesh, const std::vector<Part>& parts, int rays_per_side = 192);
 
 // For completers that close each part on its own from its patch (alpha-wrap,
 // fill, external, a learned model such as HoloPart): calls `close` for every

@@ -56,6 +56,10 @@ bool read_run_json(const fs::path& folder, BatchRow& row) {
     if (id.contains("mass_in_kind_range") && id["mass_in_kind_range"].is_boolean())
       row.mass_in_kind_range = id["mass_in_kind_range"].get<bool>() ? "yes" : "no";
   }
+  row.warnings.clear();
+  if (j.contains("warnings") && j["warnings"].is_array())
+    for (const nlohmann::json& w : j["warnings"])
+      if (w.is_string()) row.warnings.push_back(w.get<std::string>());
   row.stage_seconds.clear();
   if (j.contains("stages") && j["stages"].is_array())
     for (const nlohmann::json& s : j["stages"])

@@ -75,6 +75,7 @@ nlohmann::json row_json(const BatchRow& r) {
           {"mass_in_kind_range", r.mass_in_kind_range},
           {"seconds", r.seconds},
           {"stage_seconds", stages},
+          {"warnings", r.warnings},
           {"peak_rss_mib", static_cast<double>(r.peak_rss_bytes) / (1024.0 * 1024.0)},
           {"output", r.output},
           {"finished_at", r.finished_at}};
@@ -102,6 +103,9 @@ BatchRow row_of_json(const nlohmann::json& j) {
     for (const auto& [stage, seconds] : j["stage_seconds"].items())
       if (seconds.is_number()) r.stage_seconds[stage] = seconds.get<double>();
   r.peak_rss_bytes = static_cast<std::size_t>(j.value("peak_rss_mib", 0.0) * 1024.0 * 1024.0);
+  if (j.contains("warnings") && j["warnings"].is_array())
+    for (const nlohmann::json& w : j["warnings"])
+      if (w.is_string()) r.warnings.push_back(w.get<std::string>());
   r.output = j.value("output", "");
   r.finished_at = j.value("finished_at", "");
   return r;
@@ -118,7 +122,7 @@ std::string index_csv(const std::vector<BatchRow>& rows) {
   out << "name,status,error,exit_code,input,parts,materials,mass_kg,mass_min_kg,mass_max_kg,kind,kind_confidence,"
          "mass_in_kind_range,seconds,peak_rss_mib";
   for (int s = 0; s < kNumStages; ++s) out << ",seconds_" << to_string(static_cast<Stage>(s));
-  out << ",output,key,finished_at\n";
+  out << ",warnings,output,key,finished_at\n";
   for (const BatchRow& r : rows) {
     std::string materials;
     for (const std::string& m : r.materials) materials += (materials.empty() ? "" : ";") + m;
@@ -131,7 +135,9 @@ std::string index_csv(const std::vector<BatchRow>& rows) {
       auto it = r.stage_seconds.find(to_string(static_cast<Stage>(s)));
       out << "," << (it == r.stage_seconds.end() ? std::string() : number(it->second));
     }
-    out << "," << csv_field(r.output) << "," << r.key << "," << r.finished_at << "\n";
+    std::string warnings;  // one field, the warnings separated by " | "
+    for (const std::string& w : r.warnings) warnings += (warnings.empty() ? "" : " | ") + w;
+    out << "," << csv_field(warnings) << "," << csv_field(r.output) << "," << r.key << "," << r.finished_at << "\n";
   }
   return out.str();
 }

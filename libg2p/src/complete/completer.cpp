@@ -1,5 +1,6 @@
 // The Completer base class, the registry, the fallback driver and the files
 // the stage writes.
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -26,8 +27,23 @@ Registry<Completer>& completer_registry() {
   return *registry;
 }
 
-Result<Completion> complete(const CompletionInput& input, const Completer& completer, const Completer* fallback) {
-  if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
+namespace {
+
+std::string percent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f %%", 100.0 * fraction);
+  return text;
+}
+
+std::string cm3(double m3) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g cm^3", m3 * 1e6);
+  return text;
+}
+
+// Runs the completer and, for the parts it failed, the fallback.
+Result<Completion> complete_with_fallback(const CompletionInput& input, const Completer& completer,
+                                          const Completer* fallback) {
   const std::size_t np = input.parts->size();
   Result<Completion> first = completer.complete(input);
   if (!first.ok() && first.status().code() == StatusCode::kCancelled) return first.status();
@@ -47,7 +63,7 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
     }
   }
   bool any_failed = false;
-  for (const CompletedPart& p : out.parts) any_failed |= !p.ok;
+  for (std::size_t p = 0; p < np; ++p) any_failed |= !out.parts[p].ok && !input.is_kept(p);
   if (any_failed && fallback != nullptr) {
     Result<Completion> second = fallback->complete(input);
     if (!second.ok() && second.status().code() == StatusCode::kCancelled) return second.status();
@@ -58,7 +74,7 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
       if (out.grid_spacing_m == 0.0) out.grid_spacing_m = second->grid_spacing_m;
       for (std::size_t p = 0; p < np && p < second->parts.size(); ++p) {
         CompletedPart& mine = out.parts[p];
-        if (mine.ok) continue;
+        if (mine.ok || input.is_kept(p)) continue;
         CompletedPart& theirs = second->parts[p];
         std::vector<std::string> notes = std::move(mine.notes);
         notes.push_back("fell back to '" + theirs.backend + "'");
@@ -69,8 +85,86 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
       for (auto& n : second->notes) out.notes.push_back("fallback: " + n);
     }
   }
+  return out;
+}
+
+// Holds every part to the input's own volume (estimate_volumes).
+void check_volumes(const CompletionInput& input, const CompletionOptions& options, Completion& out) {
+  if (!(options.volume_tolerance > 0)) return;
+  const VolumeEstimate estimate = estimate_volumes(*input.mesh, *input.parts, options.volume_rays);
+  if (!estimate.usable()) {
+    out.notes.push_back("volume check: the input's faces are too open to estimate their volume (" +
+                        std::to_string(estimate.rays_paired) + " of " + std::to_string(estimate.rays_hit) +
+                        " rays paired their crossings); no part was checked");
+    return;
+  }
+  out.input_volume_m3 = estimate.object_m3;
+  for (std::size_t p = 0; p < out.parts.size() && p < estimate.part_m3.size(); ++p) {
+    CompletedPart& part = out.parts[p];
+    part.input_volume_m3 = estimate.part_m3[p];
+    // Enough rays through the part for a sampled estimate (sampling error
+    // well under the tolerance), and a volume bounded by its own faces.
+    if (estimate.part_intervals[p] < 100 || estimate.part_own_fraction[p] < options.volume_check_own_fraction ||
+        !(estimate.part_m3[p] > 0) || part.mesh.num_faces() == 0)
+      continue;
+    part.volume_difference = (part.checks.volume_m3 - estimate.part_m3[p]) / estimate.part_m3[p];
+    if (std::abs(part.volume_difference) <= options.volume_tolerance) continue;
+    part.ok = false;
+    part.notes.push_back("volume check: the closed part holds " + cm3(part.checks.volume_m3) + ", its input faces " +
+                         cm3(estimate.part_m3[p]) + " (" + (part.volume_difference > 0 ? "+" : "") +
+                         percent(part.volume_difference) + ", more than the " + percent(options.volume_tolerance) +
+                         " allowed)");
+  }
+}
+
+}  // namespace
+
+Result<Completion> complete(const CompletionInput& input, const Completer& completer, const Completer* fallback,
+                            const CompletionOptions& options) {
+  if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
+  if (input.mesh == nullptr) return Status::InvalidArgument("complete: no mesh");
+  const std::size_t np = input.parts->size();
+  // Parts already closed are kept as they are.
+  std::vector<Mesh> kept(np);
+  std::size_t num_kept = 0;
+  if (options.keep_closed_parts) {
+    for (std::size_t p = 0; p < np; ++p) {
+      kept[p] = closed_part_surface(*input.mesh, (*input.parts)[p], options.weld_tolerance);
+      num_kept += kept[p].num_faces() > 0;
+    }
+  }
+  Completion out;
+  if (num_kept < np || np == 0) {
+    CompletionInput with_kept = input;
+    with_kept.kept = &kept;
+    Result<Completion> done = complete_with_fallback(with_kept, completer, fallback);
+    if (!done.ok()) return done.status();
+    out = std::move(*done);
+  } else {
+    out.parts.resize(np);
+    out.notes.push_back("every part's faces already bound a solid: nothing to complete");
+  }
+  for (std::size_t p = 0; p < np; ++p) {
+    if (kept[p].num_faces() == 0) continue;
+    CompletedPart& part = out.parts[p];
+    part = CompletedPart();
+    part.part = static_cast<int>(p);
+    part.label = (*input.parts)[p].label;
+    part.backend = "input";
+    part.mesh = std::move(kept[p]);
+    const Mesh patch = part_patch(*input.mesh, (*input.parts)[p]);
+    part.checks = check_closed_mesh(part.mesh, &patch);
+    part.ok = part.checks.watertight();
+    part.notes.push_back("kept as given: its faces already bound a solid");
+  }
+  out.kept_parts = static_cast<int>(num_kept);
+  if (num_kept > 0 && num_kept < np)
+    out.notes.push_back(std::to_string(num_kept) + " of " + std::to_string(np) +
+                        " parts kept as given (their faces already bound a solid)");
+  check_volumes(input, options, out);
   out.parts_volume_m3 = 0.0;
   for (const CompletedPart& p : out.parts) out.parts_volume_m3 += p.checks.volume_m3;
+  if (num_kept == np) out.object_volume_m3 = out.parts_volume_m3;
   return out;
 }
 
@@ -85,6 +179,7 @@ Result<Completion> complete_each_part(const CompletionInput& input, const std::s
     out.part = static_cast<int>(p);
     out.label = part.label;
     out.backend = backend;
+    if (input.is_kept(p)) continue;  // complete() keeps it as given
     const Mesh patch = part_patch(*input.mesh, part);
     Status closed;
     try {
@@ -150,6 +245,8 @@ Status write_completion(const std::string& dir, const Completion& completion, co
   doc["object_volume_m3"] = completion.object_volume_m3;
   doc["parts_volume_m3"] = completion.parts_volume_m3;
   doc["grid_spacing_m"] = completion.grid_spacing_m;
+  doc["input_volume_m3"] = completion.input_volume_m3;
+  doc["kept_parts"] = completion.kept_parts;
   doc["notes"] = completion.notes;
   nlohmann::json parts = nlohmann::json::array();
   for (const CompletedPart& p : completion.parts) {
@@ -160,6 +257,8 @@ Status write_completion(const std::string& dir, const Completion& completion, co
     j["backend"] = p.backend;
     j["ok"] = p.ok;
     j["checks"] = checks_json(p.checks);
+    j["input_volume_m3"] = p.input_volume_m3;
+    j["volume_difference"] = std::isfinite(p.volume_difference) ? nlohmann::json(p.volume_difference) : nlohmann::json();
     j["notes"] = p.notes;
     j["vertices"] = p.mesh.num_vertices();
     j["triangles"] = p.mesh.num_faces();

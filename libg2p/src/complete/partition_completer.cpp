@@ -448,8 +448,10 @@ std::vector<int> interior_labels_from_skin(const Grid& g, const std::vector<std:
           if (coord[axis] + 1 < g.dim(axis)) skin |= (state[a + g.stride(axis)] == kOutside) != out_a;
         }
         if (!skin) continue;
+        const int part = face_part[static_cast<std::size_t>(band.nearest[a])];
+        if (part < 0) continue;  // a kept part's face: its solid is its own (give_kept_solids)
         seed[a] = band.dist2[a];
-        label[a] = face_part[static_cast<std::size_t>(band.nearest[a])];
+        label[a] = part;
       }
   distance_transform(g, seed, &label);
   return label;
@@ -457,6 +459,63 @@ std::vector<int> interior_labels_from_skin(const Grid& g, const std::vector<std:
 
 // The object's signed field in cells, positive outside, negative
 // inside, -0.25 at slab points; never exactly zero so no vertex sits on a grid point.
+// Every grid point inside a kept part's closed surface goes to that part:
+// crossings along the grid's x lines (nudged off the grid by 1e-4 of a cell
+// so that they miss the edges of faces lying on grid planes), paired by
+// parity (a kept surface bounds a solid, cavities wound inward).
+void give_kept_solids(const Grid& g, const CompletionInput& input, std::vector<int>& label) {
+  const double nudge = 1e-4 * g.h;
+  for (std::size_t p = 0; p < input.parts->size(); ++p) {
+    if (!input.is_kept(p)) continue;
+    const Mesh& solid = (*input.kept)[p];
+    const Eigen::AlignedBox3d box = bounds(solid);
+    auto line_range = [&](int axis, int& lo, int& hi) {
+      lo = std::max(0, static_cast<int>(std::ceil((box.min()[axis] - g.origin[axis] - nudge) / g.h)));
+      hi = std::min(g.dim(axis) - 1, static_cast<int>(std::floor((box.max()[axis] - g.origin[axis] - nudge) / g.h)));
+    };
+    int j0, j1, k0, k1;
+    line_range(1, j0, j1);
+    line_range(2, k0, k1);
+    if (j1 < j0 || k1 < k0) continue;
+    const int nj = j1 - j0 + 1;
+    std::vector<std::vector<double>> crossings(static_cast<std::size_t>(nj) * (k1 - k0 + 1));
+    for (const Eigen::Vector3i& t : solid.triangles) {
+      const Eigen::Vector3d a = solid.positions[static_cast<std::size_t>(t[0])].cast<double>();
+      const Eigen::Vector3d b = solid.positions[static_cast<std::size_t>(t[1])].cast<double>();
+      const Eigen::Vector3d c = solid.positions[static_cast<std::size_t>(t[2])].cast<double>();
+      const double area = (b.y() - a.y()) * (c.z() - a.z()) - (b.z() - a.z()) * (c.y() - a.y());
+      if (area == 0.0) continue;
+      const int tj0 = std::max(j0, static_cast<int>(std::ceil((std::min({a.y(), b.y(), c.y()}) - g.origin.y() - nudge) / g.h)));
+      const int tj1 = std::min(j1, static_cast<int>(std::floor((std::max({a.y(), b.y(), c.y()}) - g.origin.y() - nudge) / g.h)));
+      const int tk0 = std::max(k0, static_cast<int>(std::ceil((std::min({a.z(), b.z(), c.z()}) - g.origin.z() - nudge) / g.h)));
+      const int tk1 = std::min(k1, static_cast<int>(std::floor((std::max({a.z(), b.z(), c.z()}) - g.origin.z() - nudge) / g.h)));
+      for (int k = tk0; k <= tk1; ++k)
+        for (int j = tj0; j <= tj1; ++j) {
+          const double y = g.origin.y() + j * g.h + nudge, z = g.origin.z() + k * g.h + nudge;
+          auto edge = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+            return (q.y() - p.y()) * (z - p.z()) - (q.z() - p.z()) * (y - p.y());
+          };
+          const double w0 = edge(b, c), w1 = edge(c, a), w2 = edge(a, b);
+          const bool inside = area > 0 ? (w0 >= 0 && w1 >= 0 && w2 >= 0) : (w0 <= 0 && w1 <= 0 && w2 <= 0);
+          if (!inside) continue;
+          crossings[static_cast<std::size_t>(k - k0) * nj + (j - j0)].push_back(
+              a.x() + (w1 * (b.x() - a.x()) + w2 * (c.x() - a.x())) / area);
+        }
+    }
+    for (int k = k0; k <= k1; ++k)
+      for (int j = j0; j <= j1; ++j) {
+        std::vector<double>& x = crossings[static_cast<std::size_t>(k - k0) * nj + (j - j0)];
+        if (x.size() < 2 || x.size() % 2 != 0) continue;
+        std::sort(x.begin(), x.end());
+        for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+          const int i0 = std::max(0, static_cast<int>(std::ceil((x[m] - g.origin.x()) / g.h)));
+          const int i1 = std::min(g.nx - 1, static_cast<int>(std::floor((x[m + 1] - g.origin.x()) / g.h)));
+          for (int i = i0; i <= i1; ++i) label[g.at(i, j, k)] = static_cast<int>(p);
+        }
+      }
+  }
+}
+
 std::vector<float> signed_field(const std::vector<float>& dist2, const std::vector<std::uint8_t>& state) {
   constexpr float kMinMagnitude = 0.02f;
   std::vector<float> field(dist2.size());
@@ -537,8 +596,9 @@ class PartitionCompleter final : public Completer {
   Result<Completion> complete(const CompletionInput& input) const override;
 
  private:
-  Result<GridChoice> size_grid(const Mesh& mesh, const std::vector<Part>& parts) const;
-  double thin_part_cell_size(const Mesh& mesh, const std::vector<Part>& parts, double h, int& thin_part) const;
+  Result<GridChoice> size_grid(const Mesh& mesh, const std::vector<Part>& parts, const CompletionInput& input) const;
+  double thin_part_cell_size(const Mesh& mesh, const std::vector<Part>& parts, const CompletionInput& input, double h,
+                             int& thin_part) const;
   bool simplify_part(CompletedPart& out, const Mesh& patch, double h) const;
   void close_small_parts(const CompletionInput& input, const PartBoxes& boxes, Completion& result) const;
 
@@ -569,7 +629,7 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
   G2P_RETURN_IF_ERROR(validate(mesh));
   Result<std::vector<int>> face_part = face_parts(mesh, parts);
   if (!face_part.ok()) return face_part.status();
-  Result<GridChoice> choice = size_grid(mesh, parts);
+  Result<GridChoice> choice = size_grid(mesh, parts, input);
   if (!choice.ok()) return choice.status();
   const Grid& g = choice->grid;
   const double h = choice->h;
@@ -608,7 +668,11 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
                            " grid points kept as slabs of open sheets (surfaces with outside on both sides)");
   timing << ", surface layer " << lap() << " ms";
   G2P_RETURN_IF_ERROR(input.report(0.6, "surface layer"));
-  const std::vector<int> label = interior_labels_from_skin(g, state, band, *face_part);
+  std::vector<int> seed_part = *face_part;  // kept parts do not claim the interior near them
+  for (std::size_t f = 0; f < seed_part.size(); ++f)
+    if (seed_part[f] >= 0 && input.is_kept(static_cast<std::size_t>(seed_part[f]))) seed_part[f] = -1;
+  std::vector<int> label = interior_labels_from_skin(g, state, band, seed_part);
+  give_kept_solids(g, input, label);
   timing << ", labels " << lap() << " ms";
   G2P_RETURN_IF_ERROR(input.report(0.7, "interior labels"));
   const std::vector<float> field = signed_field(dist2, state);
@@ -629,6 +693,7 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
     out.part = p;
     out.label = parts[static_cast<std::size_t>(p)].label;
     out.backend = "partition";
+    if (input.is_kept(static_cast<std::size_t>(p))) return;     // complete() keeps it as given
     if (boxes.hi[static_cast<std::size_t>(p)].x() < 0) return;  // smaller than a cell: closed on its own below
     out.mesh = part_surface(g, field, label, boxes, p);
     const Mesh patch = part_patch(mesh, parts[static_cast<std::size_t>(p)]);
@@ -647,7 +712,8 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
 // thin, stick-like part (fragments such as screws and labels do not set the
 // resolution), padded by `gap` + 2 cells and coarsened until it has at most
 // max_cells points.
-Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::vector<Part>& parts) const {
+Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::vector<Part>& parts,
+                                                 const CompletionInput& input) const {
   Eigen::AlignedBox3d box;
   for (const auto& p : mesh.positions) box.extend(p.cast<double>());
   const Eigen::Vector3d ext = box.sizes();
@@ -655,7 +721,8 @@ Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::ve
   if (!(longest > 0)) return Status::InvalidArgument("partition: the mesh has no extent");
   GridChoice choice;
   double h =
-      std::max(thin_part_cell_size(mesh, parts, longest / resolution_, choice.thin_part), longest / max_resolution_);
+      std::max(thin_part_cell_size(mesh, parts, input, longest / resolution_, choice.thin_part),
+               longest / max_resolution_);
   const int pad = gap_ + 2;
   Grid& g = choice.grid;
   for (int attempt = 0; attempt < 64; ++attempt) {
@@ -673,15 +740,17 @@ Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::ve
 }
 
 // The cell size `h`, made finer where a part with at least
-// refine_min_area_fraction of the area has a second-largest extent of fewer
-// than min_cells_across cells; `thin_part` is the last part that refined it.
-double PartitionCompleter::thin_part_cell_size(const Mesh& mesh, const std::vector<Part>& parts, double h,
-                                               int& thin_part) const {
+// refine_min_area_fraction of the area (and not kept as given) has a
+// second-largest extent of fewer than min_cells_across cells; `thin_part` is
+// the last part that refined it.
+double PartitionCompleter::thin_part_cell_size(const Mesh& mesh, const std::vector<Part>& parts,
+                                               const CompletionInput& input, double h, int& thin_part) const {
   double total_area = 0.0;
   for (const Part& p : parts) total_area += p.area_m2;
   for (int p = 0; p < static_cast<int>(parts.size()); ++p) {
     // Fragments (screws, labels) do not set the resolution of the whole object.
     if (parts[static_cast<std::size_t>(p)].area_m2 < refine_min_area_fraction_ * total_area) continue;
+    if (input.is_kept(static_cast<std::size_t>(p))) continue;  // kept as given: needs no grid
     Eigen::AlignedBox3d pb;
     for (int f : parts[static_cast<std::size_t>(p)].faces)
       for (int c = 0; c < 3; ++c)
@@ -740,7 +809,7 @@ void PartitionCompleter::close_small_parts(const CompletionInput& input, const P
   single.resolution_ = single.max_resolution_ = 32;  // small parts need volume, not detail
   for (int p = 0; p < static_cast<int>(parts.size()); ++p) {
     CompletedPart& out = result.parts[static_cast<std::size_t>(p)];
-    if (boxes.hi[static_cast<std::size_t>(p)].x() >= 0) continue;
+    if (boxes.hi[static_cast<std::size_t>(p)].x() >= 0 || input.is_kept(static_cast<std::size_t>(p))) continue;
     const Mesh patch = part_patch(*input.mesh, parts[static_cast<std::size_t>(p)]);
     const std::vector<Part> alone = {whole_patch_part(patch, parts[static_cast<std::size_t>(p)])};
     Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table, nullptr});

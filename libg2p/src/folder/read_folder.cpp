@@ -146,6 +146,10 @@ Status read_completion(const std::string& dir, PipelineResult& r) {
                                      " parts, and faces.csv has " + std::to_string(np));
     r.completion = Completion{};
     r.completion.object_volume_m3 = doc->at("object_volume_m3").get<double>();
+    r.completion.grid_spacing_m = doc->value("grid_spacing_m", 0.0);
+    r.completion.input_volume_m3 = doc->value("input_volume_m3", -1.0);
+    r.completion.kept_parts = doc->value("kept_parts", 0);
+    r.completion.notes = doc->value("notes", std::vector<std::string>{});
     for (std::size_t i = 0; i < np; ++i) {
       const nlohmann::json& c = parts[i];
       CompletedPart part;
@@ -166,6 +170,10 @@ Status read_completion(const std::string& dir, PipelineResult& r) {
       }
       part.checks.volume_m3 = c.at("checks").at("volume_m3").get<double>();
       part.checks.area_m2 = c.at("checks").at("area_m2").get<double>();
+      part.input_volume_m3 = c.value("input_volume_m3", -1.0);
+      if (c.contains("volume_difference") && c["volume_difference"].is_number())
+        part.volume_difference = c["volume_difference"].get<double>();
+      part.notes = c.value("notes", std::vector<std::string>{});
       r.completion.parts_volume_m3 += part.checks.volume_m3;
       r.completion.parts.push_back(std::move(part));
     }

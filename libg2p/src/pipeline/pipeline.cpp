@@ -416,11 +416,21 @@ Status Pipeline::Impl::complete_parts(RunState& s) {
   input.progress = [&context](double fraction, const std::string& message) {
     return context.report(Stage::kComplete, fraction, message);
   };
-  Result<Completion> done = complete(input, *completer.get(), fallback.get());
+  CompletionOptions completion_options;
+  completion_options.weld_tolerance = options.project.weld_tolerance;
+  Result<Completion> done = complete(input, *completer.get(), fallback.get(), completion_options);
   if (!done.ok()) return done.status().with_context("complete");
   r.completion = std::move(*done);
   int closed = 0;
-  for (const CompletedPart& p : r.completion.parts) closed += p.ok ? 1 : 0;
+  for (const CompletedPart& p : r.completion.parts) {
+    closed += p.ok ? 1 : 0;
+    // A volume the input disagrees with is a mass the user must not trust.
+    for (const std::string& n : p.notes)
+      if (n.rfind("volume check: ", 0) == 0)
+        r.warnings.push_back("complete: part " + std::to_string(p.part) + " (" +
+                             (r.table.valid_label(p.label) ? r.table[p.label].name : std::string("Unknown")) +
+                             "): " + n.substr(14) + "; its mass follows its closed volume");
+  }
   clock.report().notes = r.completion.notes;
   clock.report().notes.push_back(std::to_string(closed) + " of " + std::to_string(r.completion.parts.size()) +
                                  " parts closed and checked");

@@ -94,7 +94,12 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
     r.mass_min_kg = m->mass_kg * pp.density_min_kg_m3 / pp.density_kg_m3;
     r.mass_max_kg = m->mass_kg * pp.density_max_kg_m3 / pp.density_kg_m3;
     if (pp.contents_fill != 0.0) add_contents(r, completed.mesh, completed.ok, report.notes);
-    if (!completed.ok) report.notes.push_back("part " + std::to_string(i) + " failed its completion checks");
+    if (!completed.ok) {
+      std::string why;  // the volume check's verdict, the one a user acts on
+      for (const std::string& n : completed.notes)
+        if (n.rfind("volume check: ", 0) == 0) why = " (" + n + ")";
+      report.notes.push_back("part " + std::to_string(i) + " failed its completion checks" + why);
+    }
     masses.push_back(r.mass);
     report.mass_min_kg += r.mass_min_kg;
     report.mass_max_kg += r.mass_max_kg;

@@ -1,0 +1,248 @@
+// closed_part_surface: a part whose own faces already bound a solid needs no
+// completion. Closing it anyway (on a grid, by wrapping) can only lose what
+// the input says exactly: a 2 mm board on a grid of 4 mm cells keeps a tenth
+// of its volume (#50). Such a part is kept face for face.
+//
+// The faces are welded (UV seams and split normals duplicate vertices), then
+// must form a closed, consistently oriented, vertex-manifold surface without
+// self-intersections. Its components may be nested (a cavity: an inward
+// component inside an outward one); the winding number just inside and just
+// outside every component must be 0 or 1, so that the divergence theorem
+// gives the solid's volume and inertia. A component inside out that no other
+// contains is turned; any other arrangement (overlapping solids, doubled
+// shells, a nested component wound like the one around it, which could be a
+// cavity or a second solid) is left to the completer.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <unordered_map>
+
+#include "g2p/complete.h"
+
+namespace g2p {
+namespace {
+
+int find_root(std::vector<int>& parent, int x) {
+  while (parent[static_cast<std::size_t>(x)] != x) {
+    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    x = parent[static_cast<std::size_t>(x)];
+  }
+  return x;
+}
+
+// The welded, compacted faces of `part`, without triangles that welding
+// collapsed.
+Mesh welded_part(const Mesh& mesh, const Part& part, const std::vector<int>& rep) {
+  Mesh out;
+  std::unordered_map<int, int> index;
+  index.reserve(part.faces.size() * 2);
+  auto vertex = [&](int v) {
+    const int r = rep[static_cast<std::size_t>(v)];
+    auto [it, inserted] = index.emplace(r, static_cast<int>(out.positions.size()));
+    if (inserted) out.positions.push_back(mesh.positions[static_cast<std::size_t>(r)]);
+    return it->second;
+  };
+  for (int f : part.faces) {
+    if (f < 0 || f >= mesh.num_faces()) continue;
+    const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
+    const Eigen::Vector3i w(vertex(t[0]), vertex(t[1]), vertex(t[2]));
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
+    out.triangles.push_back(w);
+  }
+  return out;
+}
+
+// Vertex representatives: each vertex's first earlier vertex within `eps`
+// (a hash grid of cells 2 eps wide, its 27 neighbours searched).
+std::vector<int> weld(const Mesh& mesh, const Part& part, double eps) {
+  std::vector<int> rep(mesh.positions.size());
+  std::iota(rep.begin(), rep.end(), 0);
+  if (!(eps > 0)) return rep;
+  const double cell = 2.0 * eps;
+  auto key = [](long long x, long long y, long long z) {
+    return (static_cast<std::uint64_t>(x) & 0x1FFFFF) | ((static_cast<std::uint64_t>(y) & 0x1FFFFF) << 21) |
+           ((static_cast<std::uint64_t>(z) & 0x1FFFFF) << 42);
+  };
+  std::unordered_map<std::uint64_t, std::vector<int>> cells;
+  std::vector<char> seen(mesh.positions.size(), 0);
+  for (int f : part.faces) {
+    if (f < 0 || f >= mesh.num_faces()) continue;
+    for (int c = 0; c < 3; ++c) {
+      const int v = mesh.triangles[static_cast<std::size_t>(f)][c];
+      if (seen[static_cast<std::size_t>(v)]) continue;
+      seen[static_cast<std::size_t>(v)] = 1;
+      const Eigen::Vector3d p = mesh.positions[static_cast<std::size_t>(v)].cast<double>() / cell;
+      const long long x = static_cast<long long>(std::floor(p.x())), y = static_cast<long long>(std::floor(p.y())),
+                      z = static_cast<long long>(std::floor(p.z()));
+      int found = -1;
+      for (int dz = -1; dz <= 1 && found < 0; ++dz)
+        for (int dy = -1; dy <= 1 && found < 0; ++dy)
+          for (int dx = -1; dx <= 1 && found < 0; ++dx) {
+            auto it = cells.find(key(x + dx, y + dy, z + dz));
+            if (it == cells.end()) continue;
+            for (int r : it->second)
+              if ((mesh.positions[static_cast<std::size_t>(r)] - mesh.positions[static_cast<std::size_t>(v)])
+                      .cast<double>()
+                      .norm() <= eps) {
+                found = r;
+                break;
+              }
+          }
+      if (found >= 0) {
+        rep[static_cast<std::size_t>(v)] = found;
+      } else {
+        cells[key(x, y, z)].push_back(v);
+      }
+    }
+  }
+  return rep;
+}
+
+// Signed crossings of the ray from `p` along a fixed, slightly skewed
+// direction with the triangles of one component: the winding number of the
+// component about `p` (+1 inside an outward component, -1 inside an inward
+// one, 0 outside).
+int winding_number(const Mesh& m, const std::vector<int>& faces, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d dir = Eigen::Vector3d(1.0, 0.0123456789, 0.00314159265).normalized();
+  int w = 0;
+  for (int f : faces) {
+    const Eigen::Vector3i& t = m.triangles[static_cast<std::size_t>(f)];
+    const Eigen::Vector3d a = m.positions[static_cast<std::size_t>(t[0])].cast<double>();
+    const Eigen::Vector3d e1 = m.positions[static_cast<std::size_t>(t[1])].cast<double>() - a;
+    const Eigen::Vector3d e2 = m.positions[static_cast<std::size_t>(t[2])].cast<double>() - a;
+    const Eigen::Vector3d q = dir.cross(e2);
+    const double det = e1.dot(q);
+    if (det == 0.0) continue;
+    const Eigen::Vector3d s = p - a;
+    const double u = s.dot(q) / det;
+    if (u < 0.0 || u > 1.0) continue;
+    const Eigen::Vector3d r = s.cross(e1);
+    const double v = dir.dot(r) / det;
+    if (v < 0.0 || u + v > 1.0) continue;
+    if (e2.dot(r) / det <= 0.0) continue;  // behind p
+    // The ray leaves through a face whose normal (e1 x e2) points along it.
+    w += e1.cross(e2).dot(dir) > 0.0 ? 1 : -1;
+  }
+  return w;
+}
+
+double signed_volume_of(const Mesh& m, const std::vector<int>& faces) {
+  double six_v = 0.0;
+  for (int f : faces) {
+    const Eigen::Vector3i& t = m.triangles[static_cast<std::size_t>(f)];
+    const Eigen::Vector3d a = m.positions[static_cast<std::size_t>(t[0])].cast<double>();
+    const Eigen::Vector3d b = m.positions[static_cast<std::size_t>(t[1])].cast<double>();
+    const Eigen::Vector3d c = m.positions[static_cast<std::size_t>(t[2])].cast<double>();
+    six_v += a.dot(b.cross(c));
+  }
+  return six_v / 6.0;
+}
+
+// Whether every directed edge occurs once and its reverse once: the cheap
+// test that turns most open parts away before the full checks.
+bool edges_pair_up(const Mesh& m) {
+  std::vector<std::uint64_t> edges;
+  edges.reserve(static_cast<std::size_t>(m.num_faces()) * 3);
+  for (const auto& t : m.triangles)
+    for (int e = 0; e < 3; ++e)
+      edges.push_back((static_cast<std::uint64_t>(static_cast<std::uint32_t>(t[e])) << 32) |
+                      static_cast<std::uint32_t>(t[(e + 1) % 3]));
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    if (i + 1 < edges.size() && edges[i + 1] == edges[i]) return false;
+    const std::uint64_t reverse = (edges[i] << 32) | (edges[i] >> 32);
+    if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
+  }
+  return true;
+}
+
+// Orients every component so that the winding number is 0 or 1 on both
+// sides of it; false when no orientation does (overlapping solids).
+// `turned` says whether any component was turned.
+bool orient_components(Mesh& m, bool& turned) {
+  const int nv = m.num_vertices();
+  std::vector<int> parent(static_cast<std::size_t>(nv));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& t : m.triangles) {
+    parent[static_cast<std::size_t>(find_root(parent, t[0]))] = find_root(parent, t[1]);
+    parent[static_cast<std::size_t>(find_root(parent, t[1]))] = find_root(parent, t[2]);
+  }
+  std::unordered_map<int, int> component_of_root;
+  std::vector<std::vector<int>> faces;
+  for (int f = 0; f < m.num_faces(); ++f) {
+    const int root = find_root(parent, m.triangles[static_cast<std::size_t>(f)][0]);
+    auto [it, inserted] = component_of_root.emplace(root, static_cast<int>(faces.size()));
+    if (inserted) faces.emplace_back();
+    faces[static_cast<std::size_t>(it->second)].push_back(f);
+  }
+  const std::size_t nc = faces.size();
+  std::vector<int> sign(nc);
+  std::vector<Eigen::AlignedBox3d> box(nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    sign[c] = signed_volume_of(m, faces[c]) >= 0.0 ? 1 : -1;
+    for (int f : faces[c])
+      for (int k = 0; k < 3; ++k)
+        box[c].extend(m.positions[static_cast<std::size_t>(m.triangles[static_cast<std::size_t>(f)][k])].cast<double>());
+  }
+  // The winding number just outside each component, from the others: it
+  // does not depend on how the component itself is turned.
+  std::vector<int> outside(nc, 0);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const Eigen::Vector3d p =
+        m.positions[static_cast<std::size_t>(m.triangles[static_cast<std::size_t>(faces[c][0])][0])].cast<double>();
+    for (std::size_t d = 0; d < nc; ++d)
+      if (d != c && box[d].contains(p)) outside[c] += winding_number(m, faces[d], p);
+  }
+  // Turning a component flips its contribution to every other's `outside`,
+  // so components are decided outermost first (fewest enclosing).
+  std::vector<std::size_t> order(nc);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return std::abs(outside[a]) < std::abs(outside[b]); });
+  bool any_turned = false;
+  turned = false;
+  for (std::size_t c : order) {
+    int w = 0;  // recomputed from the current orientation of the others
+    const Eigen::Vector3d p =
+        m.positions[static_cast<std::size_t>(m.triangles[static_cast<std::size_t>(faces[c][0])][0])].cast<double>();
+    if (any_turned) {
+      for (std::size_t d = 0; d < nc; ++d)
+        if (d != c && box[d].contains(p)) w += winding_number(m, faces[d], p);
+    } else {
+      w = outside[c];
+    }
+    if (w != 0 && w != 1) return false;
+    const int wanted = w == 0 ? 1 : -1;  // outward in empty space, inward inside a solid (a cavity)
+    if (sign[c] != wanted) {
+      // Inside another component, the wrong way round is ambiguous: a cavity
+      // wound the wrong way, or a second solid overlapping the first.
+      if (w != 0) return false;
+      for (int f : faces[c]) std::swap(m.triangles[static_cast<std::size_t>(f)][1], m.triangles[static_cast<std::size_t>(f)][2]);
+      sign[c] = wanted;
+      any_turned = turned = true;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance) {
+  if (part.faces.empty() || mesh.num_faces() == 0) return {};
+  const double eps = std::max(0.0, weld_tolerance) * bounds(mesh).diagonal().norm();
+  Mesh closed = welded_part(mesh, part, weld(mesh, part, eps));
+  if (closed.num_faces() < 4 || !edges_pair_up(closed)) return {};
+  MeshChecks checks = check_closed_mesh(closed);
+  // Closed and oriented within each component; orientation between
+  // components is decided below.
+  if (!checks.closed || !checks.manifold || (checks.self_intersections_checked && !checks.self_intersection_free))
+    return {};
+  bool turned = false;
+  if (!orient_components(closed, turned)) return {};
+  if (turned) checks = check_closed_mesh(closed);
+  if (!checks.watertight()) return {};
+  return closed;
+}
+
+}  // namespace g2p

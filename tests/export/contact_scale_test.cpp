@@ -18,13 +18,13 @@
 namespace g2p {
 namespace {
 
-// A solid cube of side `side_m` (one part, `material`, 1000 kg/m^3) that
-// collides as itself, written as MJCF with `options`.
-std::string cube_mjcf(double side_m, const std::string& material, const ExportOptions& options,
-                      const std::string& dir) {
+// A solid box of `size_m` (one part, `material`, 1000 kg/m^3) that collides
+// as itself, written as MJCF with `options`.
+std::string box_mjcf(const Eigen::Vector3f& size_m, const std::string& material, const ExportOptions& options,
+                     const std::string& dir) {
   std::vector<Eigen::Vector3f> p;
   std::vector<std::array<unsigned, 3>> t;
-  test::box_geometry(Eigen::Vector3f::Zero(), Eigen::Vector3f::Constant(static_cast<float>(side_m)), p, t);
+  test::box_geometry(Eigen::Vector3f::Zero(), size_m, p, t);
   const Mesh cube = test::mesh_from_geometry(p, t);
   SimulationAsset asset;
   asset.name = "cube";
@@ -42,15 +42,25 @@ std::string cube_mjcf(double side_m, const std::string& material, const ExportOp
   return dir + "/cube.xml";
 }
 
-// Dropped from its own height for 1.5 s: how deep it sank at most, how deep it
-// rests and how fast it moves at the end.
-EngineCheck drop(double side_m, const ExportOptions& options, const std::string& name) {
-  Result<EngineCheck> c = check_in_mujoco(cube_mjcf(side_m, "Plastic", options, test::scratch_dir(name)), side_m, 1.5);
+std::string cube_mjcf(double side_m, const std::string& material, const ExportOptions& options,
+                      const std::string& dir) {
+  return box_mjcf(Eigen::Vector3f::Constant(static_cast<float>(side_m)), material, options, dir);
+}
+
+// Dropped from its own height for `seconds`: how deep it sank at most, how
+// deep it rests and how fast it moves at the end.
+EngineCheck drop(const Eigen::Vector3f& size_m, const ExportOptions& options, const std::string& name,
+                 double seconds = 1.5) {
+  Result<EngineCheck> c =
+      check_in_mujoco(box_mjcf(size_m, "Plastic", options, test::scratch_dir(name)), size_m.z(), seconds);
   EXPECT_TRUE(c.ok()) << c.status().to_string();
   return c.ok() ? *c : EngineCheck{};
 }
+EngineCheck drop(double side_m, const ExportOptions& options, const std::string& name) {
+  return drop(Eigen::Vector3f::Constant(static_cast<float>(side_m)), options, name);
+}
 
-TEST(ContactScale, CubesFrom1cmTo5mLandWithoutSinking) {
+TEST(ContactScale, ObjectsFrom1cmTo5mLandWithoutSinking) {
   for (const double side : {0.01, 0.1, 1.0, 5.0}) {
     char name[32];
     std::snprintf(name, sizeof name, "ContactScaleCube%gm", side);
@@ -65,6 +75,19 @@ TEST(ContactScale, CubesFrom1cmTo5mLandWithoutSinking) {
     EXPECT_LT(c.final_speed_m_s, 0.01) << side << " m cube";
     std::printf("[ scale   ] %g m cube: sank %.3g m (%.2f %% of its side), rests %.3g m, %.3g m/s\n", side,
                 -c.lowest_point_m, -100.0 * c.lowest_point_m / side, c.resting_lowest_m, c.final_speed_m_s);
+  }
+  // A plank lying flat (1 m x 10 cm x 2 cm) and a 2 cm post standing 50 cm
+  // tall, which lands on its end (the time constant held at 0.5 ms) and
+  // topples: each sinks less than 5 % of its 2 cm.
+  for (const Eigen::Vector3f& size : {Eigen::Vector3f(1.0f, 0.1f, 0.02f), Eigen::Vector3f(0.02f, 0.02f, 0.5f)}) {
+    const EngineCheck c = drop(size, ExportOptions{}, "ContactScaleBox" + std::to_string(size.z()), 3.0);
+    ASSERT_TRUE(c.dropped && c.finite);
+    EXPECT_GT(c.lowest_point_m, -0.05 * 0.02) << size.transpose();
+    EXPECT_GT(c.resting_lowest_m, -0.01 * 0.02) << size.transpose();
+    EXPECT_LT(c.final_speed_m_s, 0.01) << size.transpose();
+    std::printf("[ scale   ] %g x %g x %g m box: sank %.3g m (%.2f %% of 2 cm), rests %.3g m, %.3g m/s\n", size.x(),
+                size.y(), size.z(), -c.lowest_point_m, -100.0 * c.lowest_point_m / 0.02, c.resting_lowest_m,
+                c.final_speed_m_s);
   }
   // MuJoCo's defaults (no scaling): the 1 cm cube sinks a third of its side.
   ExportOptions unscaled;

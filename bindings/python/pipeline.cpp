@@ -246,7 +246,10 @@ void bind_pipeline(py::module_& m) {
   py::class_<ExportOptions>(m, "ExportOptions")
       .def(py::init([](const py::kwargs& kw) { return from_kwargs<ExportOptions>(kw); }))
       .def_readwrite("free_joint", &ExportOptions::free_joint)
-      .def_readwrite("use_static_friction", &ExportOptions::use_static_friction);
+      .def_readwrite("use_static_friction", &ExportOptions::use_static_friction)
+      .def_readwrite("scale_contacts", &ExportOptions::scale_contacts)
+      .def_readwrite("contact_sink", &ExportOptions::contact_sink)
+      .def_readwrite("timestep_s", &ExportOptions::timestep_s);
 
   py::class_<Overrides>(m, "Overrides",
                         "A person's corrections (summary.html's 3D view, docs/pipeline.md#overrides): classes, "

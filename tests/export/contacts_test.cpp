@@ -46,8 +46,10 @@ std::string export_fixture(const Mesh& closed, const std::string& name, const st
   return dir + "/" + name + ".xml";
 }
 
-ContactCheck check(const std::string& mjcf, std::vector<Eigen::Vector2d> points, int grid = 0, double radius = 0) {
+ContactCheck check(const std::string& mjcf, std::vector<Eigen::Vector2d> points, int grid = 0, double radius = 0,
+                   double seconds = 3.0) {
   ContactCheckOptions options;
+  options.seconds = seconds;
   options.grid = grid;
   options.points = std::move(points);
   options.ball_radius_m = radius;
@@ -56,7 +58,7 @@ ContactCheck check(const std::string& mjcf, std::vector<Eigen::Vector2d> points,
   return c.ok() ? *c : ContactCheck{};
 }
 
-// Every ball at rest after 3 s and the dropped object above the plane.
+// Every ball at rest at the end and the dropped object above the plane.
 void expect_settled(const ContactCheck& c) {
   for (const BallProbe& b : c.balls)
     EXPECT_LT(b.final_speed_m_s, 0.005) << "ball from (" << b.start.x() << ", " << b.start.y() << ")";
@@ -69,9 +71,11 @@ TEST(Contacts, BallRestsInsideTheBowl) {
   const Mesh bowl = test::bowl_mesh(0.1, 0.012);  // inner bottom at z = 0.012, rim at 0.1
   const ContactCheck c = check(export_fixture(bowl, "bowl", "voxel-cut"), {{0, 0}, {0.03, 0.01}});
   ASSERT_EQ(c.balls.size(), 2u);
-  // The ball over the middle rests within one radius of the inner bottom...
+  // The ball over the middle rests within 1.5 radii of the inner bottom (on
+  // the hulls' flat faces, which contacts scaled to the bowl no longer let
+  // it sink into)...
   EXPECT_TRUE(c.balls[0].on_object);
-  EXPECT_LT(c.balls[0].rest.z() - c.balls[0].radius_m - 0.012, c.balls[0].radius_m) << c.balls[0].rest.z();
+  EXPECT_LT(c.balls[0].rest.z() - c.balls[0].radius_m - 0.012, 1.5 * c.balls[0].radius_m) << c.balls[0].rest.z();
   // ...and the one off the middle within a centimetre of the inner surface
   // below where it stopped: 16 flat-faced hulls follow the curved inside to
   // a few millimetres and may hold a ball on the slope (one hull leaves it
@@ -133,7 +137,9 @@ TEST(Contacts, BallRestsInTheChannel) {
 }
 
 TEST(Contacts, GridOfBallsOverTheBowlAllSettle) {
-  const ContactCheck c = check(export_fixture(test::bowl_mesh(0.1, 0.012), "bowl", "voxel-cut"), {}, 4);
+  // 5 s: on contacts scaled to the bowl (#50) a 5 mm ball rolls about its
+  // plastic inside for 3 to 5 s before it stops.
+  const ContactCheck c = check(export_fixture(test::bowl_mesh(0.1, 0.012), "bowl", "voxel-cut"), {}, 4, 0, 5.0);
   ASSERT_EQ(c.balls.size(), 16u);
   EXPECT_NEAR(c.balls[0].radius_m, 0.005, 1e-9);  // 2 % of 0.2 m is under the 5 mm floor
   expect_settled(c);

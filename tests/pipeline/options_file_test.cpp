@@ -57,6 +57,9 @@ RunOptions unusual() {
   o.formats = {"urdf", "glb"};
   o.export_options.free_joint = false;
   o.export_options.use_static_friction = true;
+  o.export_options.scale_contacts = false;
+  o.export_options.contact_sink = 0.05;
+  o.export_options.timestep_s = 0.001;
   o.memory_limit_bytes = std::size_t{3} << 30;
   std::vector<MaterialClass> classes = MaterialTable::paper_default().classes();
   classes[0].density_kg_m3 = classes[0].density_max_kg_m3;
@@ -136,6 +139,8 @@ TEST(OptionsFile, ARefusedValueIsNamedByItsKeyPath) {
            Case{"{\"size_from\": \"guess\"}", "f.json: size_from:"},
            Case{"{\"import\": {\"height_m\": 1, \"longest_side_m\": 2}}", "f.json: import: give height_m or"},
            Case{"{\"memory_limit_gib\": -1}", "f.json: memory_limit_gib: must be 0"},
+           Case{"{\"contact_sink\": 0}", "f.json: contact_sink: must lie in (0, 0.5]"},
+           Case{"{\"timestep_s\": -1}", "f.json: timestep_s: must lie in [0, 0.1] s"},
            Case{"{\"segmenter\": {\"settings\": {\"share\": [1]}}}", "f.json: segmenter.settings.share: expected"},
            Case{"{\"version\": 9}", "f.json: options file version 9, and this libg2p reads version 1"},
            Case{"{\"format\": \"g2p-folder\"}", "f.json: format \"g2p-folder\" is not \"g2p-options\""},

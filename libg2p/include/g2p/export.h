@@ -68,7 +68,51 @@ struct ExportOptions {
   // dense (a grid-based completion of a 12-triangle cube has a million
   // triangles) and no format references it; for inspection only.
   bool write_closed_volumes = false;
+  // MuJoCo contacts scaled to the object (mujoco_contacts(), docs/formats.md#contacts-scaled-to-the-object):
+  // the contact time constant and the time step from the object's
+  // smallest side and its speed when dropped from its own height, and soft
+  // classes' rolling and torsional friction. false: every geom gets the
+  // properties' solref and solimp as they are, and MuJoCo's own time step.
+  bool scale_contacts = true;
+  // The largest share of the object's smallest side it may sink into a
+  // floor when dropped from its own height (the rule's target, 0 to 0.5).
+  double contact_sink = 0.02;
+  // MJCF <option timestep>, s; 0: from the contacts (half the shortest
+  // contact time constant, at most MuJoCo's 0.002).
+  double timestep_s = 0.0;
 };
+
+// What the MJCF writer gives MuJoCo for contacts: the time step and each
+// part's contact parameters, from mujoco_contacts().
+struct PartContact {
+  std::array<double, 2> solref{0.02, 1.0};                   // time constant s, damping ratio
+  std::array<double, 5> solimp{0.9, 0.95, 0.001, 0.5, 2.0};  // dmin dmax width (m) midpoint power
+  std::array<double, 3> friction{0.5, 0.005, 0.0001};        // sliding; torsional and rolling, m
+  int condim = 3;                                            // 3: sliding only; 6: torsional and rolling too
+  double solmix = 1.0;  // weight of this geom's solref/solimp against the other geom's
+  bool soft = false;    // a soft class (Fabric, Leather, Rubber, Foam)
+  bool scaled = false;  // solref/solimp from the rule (false: the properties' own)
+};
+struct MujocoContacts {
+  double timestep_s = 0.002;       // MJCF <option timestep>
+  double smallest_side_m = 0.0;    // of the collision geometry's bounds
+  double height_m = 0.0;           // its extent along +Z: the drop height of the rule
+  double impact_speed_m_s = 0.0;   // sqrt(2 g height)
+  double timeconst_s = 0.02;       // the rule's contact time constant, s
+  std::vector<PartContact> parts;  // one per SimulationAsset::parts, same order
+};
+// The contact rule (docs/formats.md#contacts-scaled-to-the-object). With the object's smallest
+// side s, height h and impact speed v = sqrt(2 g h), a critically damped
+// contact of time constant tc sinks about v tc sqrt(dmax) / e on landing, so
+// tc = e * contact_sink * s / (v sqrt(dmax)), between 0.5 ms and MuJoCo's
+// 0.02 s; the time step is tc / 2 (MuJoCo: the time constant at least twice
+// the time step), at most 0.002 s. Margins stay 0 (MuJoCo's default).
+// Soft classes add torsional and rolling friction (condim 6). A part whose
+// contact values came from an estimator or a person (contact_source not
+// kTable) keeps its solref and solimp. The rule's geoms carry solmix 1000, so
+// their solref and solimp win over a floor's MuJoCo defaults (MuJoCo mixes the
+// two geoms' values weighted by solmix; friction and condim take the larger).
+G2P_API MujocoContacts mujoco_contacts(const SimulationAsset& asset, const ExportOptions& options = {});
 
 // The properties report as written beside an asset (report.json): the
 // estimate's notes plus the export's (parts left out, decompositions that

@@ -182,8 +182,16 @@ std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
     << "       as a set of convex hulls (class g2p_collision, group 3) and is drawn with its own surface\n"
     << "       (class g2p_visual, group 2), which does not collide. -->\n";
   for (const std::string& n : a.notes) x << "  <!-- " << xml_escape(n) << " -->\n";
+  const MujocoContacts contacts = mujoco_contacts(a, options);
+  if (options.scale_contacts)
+    x << "  <!-- Contacts scaled to the object (libg2p docs/formats.md#contacts-scaled-to-the-object): smallest side "
+      << num(contacts.smallest_side_m) << " m, dropped from its height " << num(contacts.height_m) << " m at "
+      << num(contacts.impact_speed_m_s) << " m/s: contact time constant " << num(contacts.timeconst_s)
+      << " s, time step " << num(contacts.timestep_s) << " s. -->\n";
   x << "  <compiler angle=\"radian\" meshdir=\"meshes\" inertiafromgeom=\"false\"/>\n"
-    << "  <option gravity=\"0 0 -9.81\"/>\n"
+    << "  <option gravity=\"0 0 -9.81\""
+    << (options.scale_contacts || options.timestep_s > 0 ? " timestep=\"" + num(contacts.timestep_s) + "\"" : "")
+    << "/>\n"
     << "  <default>\n"
     << "    <default class=\"g2p_collision\"><geom type=\"mesh\" group=\"3\" contype=\"1\" "
        "conaffinity=\"1\"/></default>\n"
@@ -200,18 +208,22 @@ std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
   x << "      <inertial pos=\"" << vec3(m.center_of_mass) << "\" mass=\"" << num(m.mass_kg) << "\" fullinertia=\""
     << num(I(0, 0)) << " " << num(I(1, 1)) << " " << num(I(2, 2)) << " " << num(I(0, 1)) << " " << num(I(0, 2)) << " "
     << num(I(1, 2)) << "\"/>\n";
-  for (const AssetPart& p : a.parts) {
+  for (std::size_t i = 0; i < a.parts.size(); ++i) {
+    const AssetPart& p = a.parts[i];
     const PartProperties& pp = p.properties;
-    const double mu = options.use_static_friction ? pp.friction_static : pp.friction_dynamic;
+    const PartContact& c = contacts.parts[i];
+    std::string contact =
+        "friction=\"" + num(c.friction[0]) + " " + num(c.friction[1]) + " " + num(c.friction[2]) + "\"";
+    if (c.condim != 3) contact += " condim=\"" + std::to_string(c.condim) + "\"";
+    contact += " solref=\"" + num(c.solref[0]) + " " + num(c.solref[1]) + "\" solimp=\"" + num(c.solimp[0]) + " " +
+               num(c.solimp[1]) + " " + num(c.solimp[2]) + " " + num(c.solimp[3]) + " " + num(c.solimp[4]) + "\"";
+    if (c.solmix != 1.0) contact += " solmix=\"" + num(c.solmix) + "\"";
     const std::string rgba = num(p.rgba[0]) + " " + num(p.rgba[1]) + " " + num(p.rgba[2]) + " " + num(p.rgba[3]);
     x << "      <!-- " << p.name << ": " << to_string(pp.structure) << ", " << num(pp.density_kg_m3) << " kg/m^3, "
       << num(p.mass.mass_kg) << " kg, " << p.collision.hulls.size() << " convex hulls -->\n";
     for (std::size_t k = 0; k < p.collision.hulls.size(); ++k)
       x << "      <geom name=\"" << detail::hull_name(p, k) << "\" class=\"g2p_collision\" mesh=\""
-        << detail::hull_name(p, k) << "\" rgba=\"" << rgba << "\" friction=\"" << num(mu) << " 0.005 0.0001\" solref=\""
-        << num(pp.solref[0]) << " " << num(pp.solref[1]) << "\" solimp=\"" << num(pp.solimp[0]) << " "
-        << num(pp.solimp[1]) << " " << num(pp.solimp[2]) << " " << num(pp.solimp[3]) << " " << num(pp.solimp[4])
-        << "\"/>\n";
+        << detail::hull_name(p, k) << "\" rgba=\"" << rgba << "\" " << contact << "/>\n";
     x << "      <geom name=\"" << p.name << "_visual\" class=\"g2p_visual\" mesh=\"" << p.name << "_visual\" rgba=\""
       << rgba << "\"/>\n";
   }
@@ -248,6 +260,11 @@ std::string sdf_text(const SimulationAsset& a) {
 
 Status write_asset(const std::string& dir, const SimulationAsset& a, const std::vector<std::string>& formats,
                    const ExportOptions& options) {
+  if (!(options.contact_sink > 0 && options.contact_sink <= 0.5))
+    return Status::InvalidArgument("write_asset: contact_sink must lie in (0, 0.5], got " + num(options.contact_sink));
+  if (!(options.timestep_s >= 0 && options.timestep_s <= 0.1))
+    return Status::InvalidArgument("write_asset: timestep_s must lie in [0, 0.1] s (0: from the contacts), got " +
+                                   num(options.timestep_s));
   for (const std::string& f : formats)
     if (f != "mjcf" && f != "urdf" && f != "sdf")
       return Status::InvalidArgument("write_asset: unknown format '" + f + "' (mjcf, urdf, sdf)");

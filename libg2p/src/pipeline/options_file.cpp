@@ -84,6 +84,9 @@ json full_json(const RunOptions& r) {
             {"formats", o.formats},
             {"free_joint", o.export_options.free_joint},
             {"use_static_friction", o.export_options.use_static_friction},
+            {"scale_contacts", o.export_options.scale_contacts},
+            {"contact_sink", o.export_options.contact_sink},
+            {"timestep_s", o.export_options.timestep_s},
             {"memory_limit_gib", static_cast<double>(o.memory_limit_bytes) / (1024.0 * 1024.0 * 1024.0)}};
   return j;
 }
@@ -189,6 +192,13 @@ Result<RunOptions> options_of(const json& j, RunOptions r) {
   o.formats = j.at("formats").get<std::vector<std::string>>();
   o.export_options.free_joint = j.at("free_joint").get<bool>();
   o.export_options.use_static_friction = j.at("use_static_friction").get<bool>();
+  o.export_options.scale_contacts = j.at("scale_contacts").get<bool>();
+  o.export_options.contact_sink = j.at("contact_sink").get<double>();
+  o.export_options.timestep_s = j.at("timestep_s").get<double>();
+  if (!(o.export_options.contact_sink > 0.0 && o.export_options.contact_sink <= 0.5))
+    return Status::InvalidArgument("contact_sink: must lie in (0, 0.5] (a share of the object's smallest side)");
+  if (!(o.export_options.timestep_s >= 0.0 && o.export_options.timestep_s <= 0.1))
+    return Status::InvalidArgument("timestep_s: must lie in [0, 0.1] s (0: from the contacts)");
   const double gib = j.at("memory_limit_gib").get<double>();
   if (!(gib >= 0.0) || gib > 1e6) return Status::InvalidArgument("memory_limit_gib: must be 0 (none) or more GiB");
   o.memory_limit_bytes = static_cast<std::size_t>(gib * 1024.0 * 1024.0 * 1024.0);

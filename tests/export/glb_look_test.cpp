@@ -163,11 +163,13 @@ TEST_P(GlbLook, TheGlbCarriesEveryTextureWithItsUvSetTransformAndFactors) {
 
 // WaterBottle: normal, occlusion and emissive textures and an emissive factor.
 // SheenChair: KHR_texture_transform on colour and normal textures, occlusion
-// through the second UV set. TextureTransformTest (assimp-testmodels): offset,
+// through the second UV set. GlamVelvetSofa: rotated normal maps with their
+// scales, one occlusion image for every material. TextureTransformTest (assimp-testmodels): offset,
 // rotation, scale and texCoord overrides on base-colour textures.
 INSTANTIATE_TEST_SUITE_P(RealFiles, GlbLook,
                          testing::Values(Look{"WaterBottle", test::asset_path("WaterBottle"), 5},
                                          Look{"SheenChair", test::asset_path("SheenChair"), 9},
+                                         Look{"GlamVelvetSofa", test::asset_path("GlamVelvetSofa"), 4},
                                          Look{"TextureTransformTest",
                                               test::assimp_model("glTF2/textureTransform/TextureTransformTest.gltf"),
                                               9}),

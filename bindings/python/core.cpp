@@ -188,6 +188,7 @@ void bind_core(py::module_& m) {
       .value("MIRRORED_REPEAT", WrapMode::kMirroredRepeat);
   py::class_<Texture>(m, "Texture")
       .def_readonly("uri", &Texture::uri)
+      .def_readonly("uv_set", &Texture::uv_set, "the UV set it reads: 0 = Mesh.uvs, 1 = the second set")
       .def_property_readonly("empty", &Texture::empty)
       .def_property_readonly(
           "image",
@@ -205,6 +206,11 @@ void bind_core(py::module_& m) {
       .def_readonly("double_sided", &SourceMaterial::double_sided)
       .def_readonly("base_color_texture", &SourceMaterial::base_color_texture)
       .def_readonly("metallic_roughness_texture", &SourceMaterial::metallic_roughness_texture)
+      .def_readonly("normal_texture", &SourceMaterial::normal_texture)
+      .def_readonly("normal_scale", &SourceMaterial::normal_scale)
+      .def_readonly("occlusion_texture", &SourceMaterial::occlusion_texture)
+      .def_readonly("occlusion_strength", &SourceMaterial::occlusion_strength)
+      .def_readonly("emissive_texture", &SourceMaterial::emissive_texture)
       .def_readonly("pbr_from_file", &SourceMaterial::pbr_from_file,
                     "False for formats without PBR materials (OBJ, PLY, STL, DAE): metallic and roughness derived")
       .def("__repr__", [](const SourceMaterial& s) { return "<g2p.SourceMaterial '" + s.name + "'>"; });

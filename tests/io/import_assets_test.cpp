@@ -3,7 +3,6 @@
 // file's own JSON rather than against assimp.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -15,13 +14,7 @@ namespace {
 
 using nlohmann::json;
 
-// The JSON chunk of a GLB file.
-json glb_json(const std::string& path) {
-  const std::string bytes = test::read_file(path);
-  std::uint32_t length = 0;
-  std::memcpy(&length, bytes.data() + 12, 4);
-  return json::parse(bytes.substr(20, length));
-}
+json glb_json(const std::string& path) { return json::parse(test::gltf_json_text(path)); }
 
 struct AssetCase {
   const char* name;

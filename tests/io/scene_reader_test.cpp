@@ -50,6 +50,8 @@ void expect_same_model(const Model& a, const Model& b) {
   EXPECT_TRUE(a.mesh.normals == b.mesh.normals) << "normals differ";
   EXPECT_TRUE(a.mesh.uvs == b.mesh.uvs) << "texture coordinates differ";
   EXPECT_TRUE(a.mesh.colors == b.mesh.colors) << "vertex colours differ";
+  EXPECT_TRUE(a.mesh.uvs1 == b.mesh.uvs1) << "second texture coordinates differ";
+  EXPECT_TRUE(a.mesh.tangents == b.mesh.tangents) << "tangents differ";
   EXPECT_TRUE(a.mesh.triangles == b.mesh.triangles) << "triangles differ";
   EXPECT_TRUE(a.mesh.face_source == b.mesh.face_source) << "face provenance differs";
   EXPECT_TRUE(a.mesh.face_flags == b.mesh.face_flags) << "face flags differ";
@@ -67,8 +69,10 @@ void expect_same_model(const Model& a, const Model& b) {
     EXPECT_TRUE(x.emissive == y.emissive) << where;
     EXPECT_EQ(x.double_sided, y.double_sided) << where;
     EXPECT_EQ(x.pbr_from_file, y.pbr_from_file) << where;
-    expect_same_texture(x.base_color_texture, y.base_color_texture, where + " base colour");
-    expect_same_texture(x.metallic_roughness_texture, y.metallic_roughness_texture, where + " metallic-roughness");
+    EXPECT_EQ(x.normal_scale, y.normal_scale) << where;
+    EXPECT_EQ(x.occlusion_strength, y.occlusion_strength) << where;
+    for (std::size_t t = 0; t < x.textures().size(); ++t)
+      expect_same_texture(*x.textures()[t], *y.textures()[t], where + " texture " + std::to_string(t));
   }
   ASSERT_EQ(a.primitives.size(), b.primitives.size());
   for (std::size_t p = 0; p < a.primitives.size(); ++p) {

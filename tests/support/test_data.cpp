@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -37,6 +39,14 @@ std::string read_file(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+std::string gltf_json_text(const std::string& path) {
+  const std::string bytes = read_file(path);
+  if (bytes.compare(0, 4, "glTF") != 0 || bytes.size() < 20) return bytes;
+  std::uint32_t length = 0;
+  std::memcpy(&length, bytes.data() + 12, 4);  // GLB: little-endian, as every platform libg2p builds on
+  return bytes.substr(20, length);
 }
 
 void write_file(const std::string& path, const std::string& bytes) {

@@ -18,6 +18,8 @@ std::string source_path(const std::string& relative);
 std::string scratch_dir(const std::string& test_name);
 
 std::string read_file(const std::string& path);
+// The JSON text of a glTF file: a .gltf whole, or a .glb's first (JSON) chunk.
+std::string gltf_json_text(const std::string& path);
 void write_file(const std::string& path, const std::string& bytes);
 
 }  // namespace g2p::test

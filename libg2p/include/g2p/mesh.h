@@ -40,12 +40,23 @@ struct Mesh {
   std::vector<Eigen::Vector3i> triangles;  // counter-clockwise seen from outside; indices into positions
   std::vector<FaceSource> face_source;     // per triangle; empty for meshes built without provenance
   std::vector<std::uint8_t> face_flags;    // per triangle, FaceFlag bits; empty = no flags
+  // Per vertex, second UV set (glTF TEXCOORD_1), image convention as `uvs`;
+  // empty or positions.size(). Only textures that name set 1 read it
+  // (Texture::uv_set), such as a baked occlusion map; the renderer reads `uvs`.
+  std::vector<Eigen::Vector2f> uvs1;
+  // Per vertex, a glTF file's tangents (TANGENT), kept for normal maps in the
+  // GLB export: xyz a unit vector along increasing u of `uvs`, w = +1 or -1,
+  // the bitangent being w * cross(normal, xyz). Empty or positions.size();
+  // zero on vertices of source meshes without tangents. Other formats: empty.
+  std::vector<Eigen::Vector4f> tangents;
 
   int num_vertices() const { return static_cast<int>(positions.size()); }
   int num_faces() const { return static_cast<int>(triangles.size()); }
   bool has_normals() const { return !normals.empty(); }
   bool has_uvs() const { return !uvs.empty(); }
   bool has_colors() const { return !colors.empty(); }
+  bool has_uvs1() const { return !uvs1.empty(); }
+  bool has_tangents() const { return !tangents.empty(); }
   bool is_degenerate(int face) const {
     return !face_flags.empty() && (face_flags[static_cast<std::size_t>(face)] & kFaceDegenerate);
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -22,7 +23,9 @@ enum class WrapMode { kRepeat, kClampToEdge, kMirroredRepeat };
 struct Texture {
   std::string uri;                       // file path, or "*N" for the N-th embedded image
   std::shared_ptr<const ImageU8> image;  // RGBA, 4 channels; null if absent or undecodable
-  int uv_set = 0;                        // which UV set it reads (libg2p keeps set 0)
+  // Which UV set it reads (glTF texCoord, or KHR_texture_transform's texCoord
+  // override): 0 = Mesh::uvs, 1 = Mesh::uvs1. The renderer samples set 0.
+  int uv_set = 0;
   WrapMode wrap_u = WrapMode::kRepeat;
   WrapMode wrap_v = WrapMode::kRepeat;
   // Affine map applied to Mesh::uvs before sampling (glTF KHR_texture_transform:
@@ -49,6 +52,23 @@ struct SourceMaterial {
   // and roughness were then derived by the importer (metallic 0, roughness
   // from the Phong exponent), not set by the author.
   bool pbr_from_file = true;
+  // The rest of the look, kept for the GLB export (the renderer and the
+  // segmenters do not read them). glTF's normalTexture, occlusionTexture and
+  // emissiveTexture; other formats' normal and emissive maps.
+  Texture normal_texture;          // tangent-space normals, RGB = XYZ (linear)
+  float normal_scale = 1.f;        // glTF normalTexture.scale: scales the normals' X and Y
+  Texture occlusion_texture;       // R = ambient occlusion (linear)
+  float occlusion_strength = 1.f;  // glTF occlusionTexture.strength, 0..1
+  Texture emissive_texture;        // sRGB colour (times emissive)
+
+  // Every texture, in glTF's order: base colour, metallic-roughness, normal,
+  // occlusion, emissive.
+  std::array<const Texture*, 5> textures() const {
+    return {&base_color_texture, &metallic_roughness_texture, &normal_texture, &occlusion_texture, &emissive_texture};
+  }
+  std::array<Texture*, 5> textures() {
+    return {&base_color_texture, &metallic_roughness_texture, &normal_texture, &occlusion_texture, &emissive_texture};
+  }
 };
 
 // One placement of a source mesh in the scene: a node instancing a mesh.
@@ -116,7 +136,8 @@ G2P_API void anonymize_names(Model& model);
 
 // Reduces every material to what image-to-3D generators emit: base colour
 // (factor and texture) only. Metallic and roughness go to glTF's defaults
-// (1, 1); the metallic-roughness texture and transmission are dropped. For
+// (1, 1); the metallic-roughness, normal, occlusion and emissive textures
+// and transmission are dropped. For
 // measuring the pipeline on curated assets as if they were generated.
 G2P_API void reduce_to_base_color(Model& model);
 

@@ -88,6 +88,9 @@ Status validate(const Mesh& mesh) {
     return size_error("normals", mesh.normals.size(), nv, "vertex");
   if (!mesh.uvs.empty() && mesh.uvs.size() != nv) return size_error("uvs", mesh.uvs.size(), nv, "vertex");
   if (!mesh.colors.empty() && mesh.colors.size() != nv) return size_error("colors", mesh.colors.size(), nv, "vertex");
+  if (!mesh.uvs1.empty() && mesh.uvs1.size() != nv) return size_error("uvs1", mesh.uvs1.size(), nv, "vertex");
+  if (!mesh.tangents.empty() && mesh.tangents.size() != nv)
+    return size_error("tangents", mesh.tangents.size(), nv, "vertex");
   if (!mesh.face_source.empty() && mesh.face_source.size() != nf)
     return size_error("face_source", mesh.face_source.size(), nf, "triangle");
   if (!mesh.face_flags.empty() && mesh.face_flags.size() != nf)

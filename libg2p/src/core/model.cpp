@@ -15,7 +15,7 @@ void anonymize_names(Model& model) {
   for (std::size_t i = 0; i < model.materials.size(); ++i) {
     SourceMaterial& m = model.materials[i];
     m.name = "material_" + std::to_string(i);
-    for (Texture* t : {&m.base_color_texture, &m.metallic_roughness_texture})
+    for (Texture* t : m.textures())
       if (!t->uri.empty() && t->uri[0] != '*') t->uri = "texture_" + std::to_string(i) + ".png";
   }
   for (SourcePrimitive& p : model.primitives) {
@@ -30,6 +30,7 @@ void reduce_to_base_color(Model& model) {
     m.roughness = 1.f;
     m.transmission = 0.f;
     m.metallic_roughness_texture = Texture{};
+    m.normal_texture = m.occlusion_texture = m.emissive_texture = Texture{};
   }
 }
 

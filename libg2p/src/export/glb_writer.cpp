@@ -1,7 +1,9 @@
 // write_glb: the object as a binary glTF 2.0 with its physical properties.
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "core/file_util.h"
 #include "core/json_text.h"
@@ -59,24 +61,55 @@ class GlbBuilder {
     doc["accessors"].push_back({{"bufferView", v}, {"componentType", 5125}, {"count", idx.size()}, {"type", "SCALAR"}});
     return static_cast<int>(doc["accessors"].size()) - 1;
   }
-  // A PNG image of a decoded texture, once per image.
+  // A decoded texture: its image as PNG once per image, a texture and sampler
+  // once per image and wrap modes.
   Result<int> texture(const Texture& t) {
-    auto found = textures_.find(t.image.get());
+    const auto key = std::make_tuple(t.image.get(), t.wrap_u, t.wrap_v);
+    auto found = textures_.find(key);
     if (found != textures_.end()) return found->second;
-    Result<std::string> png = detail::encode_png(*t.image);
-    if (!png.ok()) return png.status();
-    const int v = view(png->data(), png->size(), 0);
-    doc["images"].push_back({{"bufferView", v}, {"mimeType", "image/png"}});
+    auto image = images_.find(t.image.get());
+    if (image == images_.end()) {
+      Result<std::string> png = detail::encode_png(*t.image);
+      if (!png.ok()) return png.status();
+      const int v = view(png->data(), png->size(), 0);
+      doc["images"].push_back({{"bufferView", v}, {"mimeType", "image/png"}});
+      image = images_.emplace(t.image.get(), static_cast<int>(doc["images"].size()) - 1).first;
+    }
     auto wrap = [](WrapMode w) {
       return w == WrapMode::kClampToEdge ? 33071 : w == WrapMode::kMirroredRepeat ? 33648 : 10497;
     };
     doc["samplers"].push_back({{"wrapS", wrap(t.wrap_u)}, {"wrapT", wrap(t.wrap_v)}});
     const int index = static_cast<int>(doc["textures"].size());
-    doc["textures"].push_back({{"source", static_cast<int>(doc["images"].size()) - 1},
-                               {"sampler", static_cast<int>(doc["samplers"].size()) - 1}});
-    textures_[t.image.get()] = index;
+    doc["textures"].push_back({{"source", image->second}, {"sampler", static_cast<int>(doc["samplers"].size()) - 1}});
+    textures_[key] = index;
     return index;
   }
+  // A textureInfo object: the texture, the UV set it reads where the mesh
+  // keeps that set (set 0 otherwise, as the importer warned), and its
+  // Texture::uv_transform as KHR_texture_transform unless the identity.
+  Result<json> texture_info(const Texture& t, bool has_uvs1) {
+    Result<int> index = texture(t);
+    if (!index.ok()) return index.status();
+    json info = {{"index", *index}};
+    if (t.uv_set == 1 && has_uvs1) info["texCoord"] = 1;
+    const Eigen::Matrix<float, 2, 3>& m = t.uv_transform;
+    if (m != Texture().uv_transform) {
+      // m = [[c sx, s sy, ox], [-s sx, c sy, oy]] (gltf_layout.cpp): sx >= 0 and
+      // the rotation from the first column, sy from the second; any sign of
+      // the file's scales gives the same map back.
+      const float rotation = std::atan2(-m(1, 0), m(0, 0));
+      const float c = std::cos(rotation), s = std::sin(rotation);
+      const float sx = std::hypot(m(0, 0), m(1, 0)), sy = s * m(0, 1) + c * m(1, 1);
+      json& tt = info["extensions"]["KHR_texture_transform"];
+      tt = json::object();
+      if (m(0, 2) != 0.f || m(1, 2) != 0.f) tt["offset"] = {m(0, 2), m(1, 2)};
+      if (rotation != 0.f) tt["rotation"] = rotation;
+      if (sx != 1.f || sy != 1.f) tt["scale"] = {sx, sy};
+      uses_texture_transform = true;
+    }
+    return info;
+  }
+  bool uses_texture_transform = false;
   std::string glb() {
     while (bin.size() % 4) bin.push_back('\0');
     doc["buffers"] = json::array({{{"byteLength", bin.size()}}});
@@ -101,7 +134,8 @@ class GlbBuilder {
   }
 
  private:
-  std::map<const ImageU8*, int> textures_;
+  std::map<const ImageU8*, int> images_;
+  std::map<std::tuple<const ImageU8*, WrapMode, WrapMode>, int> textures_;
 };
 
 json mass_extras(const MassProperties& m) {
@@ -120,22 +154,32 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
   const Mesh& mesh = model.mesh;
   const Eigen::Matrix3d r = to_gltf();
   GlbBuilder g;
-  // Materials: the input's, in its order.
-  for (const SourceMaterial& m : model.materials) {
+  // Materials: the input's, in its order, with every texture it carries.
+  // Which of them read the second UV set (their primitives get TEXCOORD_1).
+  std::vector<char> reads_uvs1(model.materials.size(), 0);
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    const SourceMaterial& m = model.materials[i];
     json pbr = {{"baseColorFactor", {m.base_color.x(), m.base_color.y(), m.base_color.z(), m.base_color.w()}},
                 {"metallicFactor", m.metallic},
                 {"roughnessFactor", m.roughness}};
-    if (!m.base_color_texture.empty()) {
-      Result<int> t = g.texture(m.base_color_texture);
-      if (!t.ok()) return t.status();
-      pbr["baseColorTexture"] = {{"index", *t}};
+    json mat = {{"name", m.name}};
+    // Where each of m.textures() goes.
+    json* const parents[] = {&pbr, &pbr, &mat, &mat, &mat};
+    const char* const keys[] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture", "occlusionTexture",
+                                "emissiveTexture"};
+    for (std::size_t k = 0; k < m.textures().size(); ++k) {
+      if (m.textures()[k]->empty()) continue;
+      Result<json> info = g.texture_info(*m.textures()[k], mesh.has_uvs1());
+      if (!info.ok()) return info.status();
+      reads_uvs1[i] |= info->contains("texCoord");
+      (*parents[k])[keys[k]] = std::move(*info);
     }
-    if (!m.metallic_roughness_texture.empty()) {
-      Result<int> t = g.texture(m.metallic_roughness_texture);
-      if (!t.ok()) return t.status();
-      pbr["metallicRoughnessTexture"] = {{"index", *t}};
-    }
-    json mat = {{"name", m.name}, {"pbrMetallicRoughness", pbr}, {"doubleSided", m.double_sided}};
+    if (mat.contains("normalTexture") && m.normal_scale != 1.f) mat["normalTexture"]["scale"] = m.normal_scale;
+    if (mat.contains("occlusionTexture") && m.occlusion_strength != 1.f)
+      mat["occlusionTexture"]["strength"] = m.occlusion_strength;
+    if (!m.emissive.isZero()) mat["emissiveFactor"] = {m.emissive.x(), m.emissive.y(), m.emissive.z()};
+    mat["pbrMetallicRoughness"] = std::move(pbr);
+    mat["doubleSided"] = m.double_sided;
     if (m.alpha_mode == AlphaMode::kMask) mat["alphaMode"] = "MASK", mat["alphaCutoff"] = m.alpha_cutoff;
     if (m.alpha_mode == AlphaMode::kBlend) mat["alphaMode"] = "BLEND";
     g.doc["materials"].push_back(mat);
@@ -170,8 +214,14 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
       by_material[mesh.face_source.empty() ? -1 : mesh.face_source[static_cast<std::size_t>(f)].material].push_back(f);
     json primitives = json::array();
     for (const auto& [material, faces] : by_material) {
+      const SourceMaterial* source = material >= 0 && material < static_cast<int>(model.materials.size())
+                                         ? &model.materials[static_cast<std::size_t>(material)]
+                                         : nullptr;
+      const bool with_uvs1 = source != nullptr && reads_uvs1[static_cast<std::size_t>(material)];
+      // The file's tangents where its normal map reads them (all or none).
+      bool with_tangents = source != nullptr && !source->normal_texture.empty() && mesh.has_tangents();
       std::map<int, std::uint32_t> remap;
-      std::vector<float> pos, nrm, uv, rgba;
+      std::vector<float> pos, nrm, uv, uv1, rgba, tan;
       std::vector<std::uint32_t> idx;
       for (int f : faces)
         for (int c = 0; c < 3; ++c) {
@@ -187,6 +237,16 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
             if (mesh.has_uvs())
               uv.insert(uv.end(),
                         {mesh.uvs[static_cast<std::size_t>(v)].x(), mesh.uvs[static_cast<std::size_t>(v)].y()});
+            if (with_uvs1)
+              uv1.insert(uv1.end(),
+                         {mesh.uvs1[static_cast<std::size_t>(v)].x(), mesh.uvs1[static_cast<std::size_t>(v)].y()});
+            if (with_tangents) {
+              const Eigen::Vector4f& t = mesh.tangents[static_cast<std::size_t>(v)];
+              const Eigen::Vector3d x = r * t.head<3>().cast<double>();
+              with_tangents = t.w() != 0.f;
+              tan.insert(tan.end(),
+                         {static_cast<float>(x.x()), static_cast<float>(x.y()), static_cast<float>(x.z()), t.w()});
+            }
             if (mesh.has_colors()) {
               const Eigen::Vector4f& colour = mesh.colors[static_cast<std::size_t>(v)];
               rgba.insert(rgba.end(), {colour[0], colour[1], colour[2], colour[3]});
@@ -197,8 +257,10 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
       json prim = {{"attributes", {{"POSITION", g.accessor(pos, 3, true)}}}, {"indices", g.indices(idx)}};
       if (!nrm.empty()) prim["attributes"]["NORMAL"] = g.accessor(nrm, 3, false);
       if (!uv.empty()) prim["attributes"]["TEXCOORD_0"] = g.accessor(uv, 2, false);
+      if (!uv1.empty()) prim["attributes"]["TEXCOORD_1"] = g.accessor(uv1, 2, false);
+      if (with_tangents) prim["attributes"]["TANGENT"] = g.accessor(tan, 4, false);
       if (!rgba.empty()) prim["attributes"]["COLOR_0"] = g.accessor(rgba, 4, false);  // linear, as Mesh::colors
-      if (material >= 0 && material < static_cast<int>(model.materials.size())) prim["material"] = material;
+      if (source != nullptr) prim["material"] = material;
       primitives.push_back(prim);
     }
     g.doc["meshes"].push_back({{"name", p.name}, {"primitives", primitives}});
@@ -247,6 +309,7 @@ Status write_glb(const std::string& path, const Model& model, const std::vector<
   }
   if (!shapes.empty()) g.doc["extensions"]["OMI_physics_shape"]["shapes"] = shapes;
   g.doc["extensionsUsed"] = json::array({"OMI_physics_body", "OMI_physics_shape"});
+  if (g.uses_texture_transform) g.doc["extensionsUsed"].push_back("KHR_texture_transform");
   g.doc["scenes"] = json::array({{{"nodes", {0}}}});
   g.doc["scene"] = 0;
   return detail::write_file_atomically(path, g.glb());

@@ -18,4 +18,9 @@ namespace g2p::detail {
 std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::string& model_dir, bool load_textures,
                                               std::vector<std::string>& warnings);
 
+// A warning for each texture that reads a UV set other than 0 where that
+// changes what is seen: the renderer samples set 0 only, and a set the mesh
+// does not keep (Mesh::uvs1 holds set 1) is read as set 0 everywhere.
+void warn_about_uv_sets(const Model& model, std::vector<std::string>& warnings);
+
 }  // namespace g2p::detail

@@ -147,6 +147,9 @@ std::string vertex_key(const aiMesh& m, unsigned v) {
   add(&m.mVertices[v], sizeof(aiVector3D));
   if (m.mNormals != nullptr) add(&m.mNormals[v], sizeof(aiVector3D));
   if (m.mTextureCoords[0] != nullptr) add(&m.mTextureCoords[0][v], sizeof(aiVector3D));
+  if (m.mTextureCoords[1] != nullptr) add(&m.mTextureCoords[1][v], sizeof(aiVector3D));
+  if (m.mTangents != nullptr) add(&m.mTangents[v], sizeof(aiVector3D));
+  if (m.mBitangents != nullptr) add(&m.mBitangents[v], sizeof(aiVector3D));
   if (m.mColors[0] != nullptr) add(&m.mColors[0][v], sizeof(aiColor4D));
   return key;
 }
@@ -262,6 +265,8 @@ class SceneFlattener {
     // a scene with colours (scene_reader.cpp); equal ones are joined here.
     const bool has_normals = src.mNormals != nullptr;
     const bool has_uvs = src.mTextureCoords[0] != nullptr;
+    const bool has_uvs1 = src.mTextureCoords[1] != nullptr;
+    const bool has_tangents = has_normals && src.mTangents != nullptr && src.mBitangents != nullptr;
     const aiColor4D* colors = src.mColors[0];  // the first colour set, as glTF's COLOR_0
     bool bad_normals = false;
     std::vector<int> kept(static_cast<std::size_t>(nv));  // local index of each file vertex after joining
@@ -292,17 +297,11 @@ class SceneFlattener {
           bad_normals = true;
       }
       mesh.normals.push_back(n);
+      mesh.tangents.push_back(has_tangents ? tangent_of(src.mTangents[v], src.mBitangents[v], linear, n)
+                                           : Eigen::Vector4f::Zero());
       missing_normal_.push_back(!has_normals || n.isZero());
-      if (has_uvs) {
-        const aiVector3D& t = src.mTextureCoords[0][v];
-        const bool finite = std::isfinite(t.x) && std::isfinite(t.y);
-        // assimp hands out OpenGL-style v-up coordinates (it flips glTF's);
-        // libg2p keeps the image convention, glTF's own.
-        mesh.uvs.emplace_back(finite ? t.x : 0.f, finite ? 1.f - t.y : 0.f);
-        any_bad_uv_ |= !finite;
-      } else {
-        mesh.uvs.emplace_back(0.f, 0.f);
-      }
+      mesh.uvs.push_back(uv_of(has_uvs ? &src.mTextureCoords[0][v] : nullptr));
+      mesh.uvs1.push_back(uv_of(has_uvs1 ? &src.mTextureCoords[1][v] : nullptr));
       Eigen::Vector4f color = Eigen::Vector4f::Ones();  // white: a neutral factor where a mesh has none
       if (colors != nullptr) {
         const aiColor4D& c = colors[v];
@@ -316,6 +315,8 @@ class SceneFlattener {
     }
     if (bad_normals) model_.info.warnings.push_back(where + ": zero or non-finite normals recomputed");
     any_uvs_ |= has_uvs;
+    any_uvs1_ |= has_uvs1;
+    any_tangents_ |= has_tangents;
     any_colors_ |= colors != nullptr;
 
     const int base = prim.first_vertex;
@@ -333,8 +334,34 @@ class SceneFlattener {
     return Status::Ok();
   }
 
+  // A tangent (xyz along u, w the bitangent's sign, as glTF's TANGENT) from
+  // assimp's tangent and bitangent, in libg2p's frame: w from the transformed
+  // vectors, so a mirroring node flips it. Zero when it cannot be had.
+  static Eigen::Vector4f tangent_of(const aiVector3D& t, const aiVector3D& b, const Eigen::Matrix3d& linear,
+                                    const Eigen::Vector3f& normal) {
+    const Eigen::Vector3d x = linear * Eigen::Vector3d(t.x, t.y, t.z);
+    const Eigen::Vector3d y = linear * Eigen::Vector3d(b.x, b.y, b.z);
+    const double len = x.norm();
+    if (!std::isfinite(len) || len == 0.0 || !y.allFinite() || normal.isZero()) return Eigen::Vector4f::Zero();
+    const float w = normal.cast<double>().cross(x).dot(y) < 0.0 ? -1.f : 1.f;
+    const Eigen::Vector3f u = (x / len).cast<float>();
+    return {u.x(), u.y(), u.z(), w};
+  }
+
+  // A texture coordinate in the image convention; (0, 0) where there is none.
+  Eigen::Vector2f uv_of(const aiVector3D* t) {
+    if (t == nullptr) return Eigen::Vector2f::Zero();
+    const bool finite = std::isfinite(t->x) && std::isfinite(t->y);
+    any_bad_uv_ |= !finite;
+    // assimp hands out OpenGL-style v-up coordinates (it flips glTF's);
+    // libg2p keeps the image convention, glTF's own.
+    return finite ? Eigen::Vector2f(t->x, 1.f - t->y) : Eigen::Vector2f::Zero();
+  }
+
  public:
   bool any_uvs() const { return any_uvs_; }
+  bool any_uvs1() const { return any_uvs1_; }
+  bool any_tangents() const { return any_tangents_; }
   bool any_bad_uv() const { return any_bad_uv_; }
   bool any_colors() const { return any_colors_; }
   bool any_bad_color() const { return any_bad_color_; }
@@ -347,6 +374,8 @@ class SceneFlattener {
   std::vector<bool> missing_normal_;
   const bool join_vertices_ = detail::has_vertex_colors(scene_);  // see vertex_key
   bool any_uvs_ = false;
+  bool any_uvs1_ = false;
+  bool any_tangents_ = false;
   bool any_bad_uv_ = false;
   bool any_colors_ = false;
   bool any_bad_color_ = false;
@@ -453,15 +482,16 @@ Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bo
     const int file_index = layout->primitives[k].material;
     const unsigned assimp_index = scene.mMeshes[k]->mMaterialIndex;
     if (file_index < 0 || assimp_index >= model.materials.size()) continue;
-    // Factors and texture transforms come from the file's JSON; decoded
-    // textures and samplers from assimp.
+    // Factors, texture transforms and UV sets come from the file's JSON;
+    // decoded textures and samplers from assimp.
     SourceMaterial& m = materials[static_cast<std::size_t>(file_index)];
     const SourceMaterial& decoded = model.materials[assimp_index];
-    for (auto [to, from] : {std::pair{&m.base_color_texture, &decoded.base_color_texture},
-                            std::pair{&m.metallic_roughness_texture, &decoded.metallic_roughness_texture}}) {
-      const Eigen::Matrix<float, 2, 3> transform = to->uv_transform;
-      *to = *from;
-      to->uv_transform = transform;
+    for (std::size_t t = 0; t < m.textures().size(); ++t) {
+      Texture& to = *m.textures()[t];
+      const Texture from_json = to;
+      to = *decoded.textures()[t];
+      to.uv_transform = from_json.uv_transform;
+      to.uv_set = from_json.uv_set;
     }
   }
   for (FaceSource& s : model.mesh.face_source)
@@ -548,6 +578,10 @@ Result<Model> convert_scene(const aiScene& scene, const std::string& ext, const 
       if (missing[v]) mesh.normals[v] = computed.normals[v];
   }
   if (!flattener.any_uvs()) mesh.uvs.clear();
+  if (!flattener.any_uvs1()) mesh.uvs1 = {};  // its memory too: most models have no second set
+  // Tangents only from glTF, whose TANGENT relates to its own UV convention
+  // (which libg2p keeps); other formats' are relative to flipped UVs.
+  if (!flattener.any_tangents() || !is_gltf(ext)) mesh.tangents = {};
   if (flattener.any_bad_uv()) model.info.warnings.push_back("non-finite texture coordinates replaced by (0, 0)");
   if (!flattener.any_colors()) {
     mesh.colors.clear();
@@ -570,6 +604,7 @@ Result<Model> convert_scene(const aiScene& scene, const std::string& ext, const 
     G2P_RETURN_IF_ERROR(apply_gltf_layout(scene, gltf_bytes, options.strict, model));
   else
     drop_unused_default_material(model);
+  detail::warn_about_uv_sets(model, model.info.warnings);
   G2P_RETURN_IF_ERROR(validate(mesh).with_context("after import"));
   return model;
 }

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <thread>
@@ -118,11 +119,19 @@ Texture read_texture(const aiMaterial& mat, aiTextureType type, TextureCache* ca
   tex.image = cache->get(tex.uri, error);
   if (!tex.image)
     warnings.push_back(what + " texture '" + tex.uri + "' not loaded (" + error + "); using the factor alone");
-  if (tex.uv_set != 0)
-    warnings.push_back(what + " texture '" + tex.uri + "' reads UV set " + std::to_string(tex.uv_set) +
-                       "; libg2p keeps UV set 0 only");
   return tex;
 }
+
+// The texture types read, with the first of each list that the material has:
+// assimp's glTF reader files occlusion under LIGHTMAP.
+aiTextureType first_present(const aiMaterial& mat, std::initializer_list<aiTextureType> types) {
+  for (aiTextureType t : types)
+    if (mat.GetTextureCount(t) > 0) return t;
+  return *types.begin();
+}
+constexpr aiTextureType kTextureTypes[] = {
+    aiTextureType_BASE_COLOR,        aiTextureType_DIFFUSE,  aiTextureType_UNKNOWN, aiTextureType_NORMALS,
+    aiTextureType_AMBIENT_OCCLUSION, aiTextureType_LIGHTMAP, aiTextureType_EMISSIVE};
 
 }  // namespace
 
@@ -134,7 +143,7 @@ std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::s
     for (unsigned i = 0; i < scene.mNumMaterials; ++i) {
       const aiMaterial* mat = scene.mMaterials != nullptr ? scene.mMaterials[i] : nullptr;
       if (mat == nullptr) continue;
-      for (aiTextureType type : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, aiTextureType_UNKNOWN}) {
+      for (aiTextureType type : kTextureTypes) {
         aiString path;
         if (mat->GetTexture(type, 0, &path) == AI_SUCCESS) uris.emplace_back(path.C_Str());
       }
@@ -199,14 +208,36 @@ std::vector<SourceMaterial> convert_materials(const aiScene& scene, const std::s
     if (mat.Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) m.double_sided = two_sided != 0;
 
     TextureCache* textures = load_textures ? &cache : nullptr;
-    const aiTextureType colour_type =
-        mat.GetTextureCount(aiTextureType_BASE_COLOR) > 0 ? aiTextureType_BASE_COLOR : aiTextureType_DIFFUSE;
-    m.base_color_texture = read_texture(mat, colour_type, textures, what + ": base colour", warnings);
+    m.base_color_texture = read_texture(mat, first_present(mat, {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}),
+                                        textures, what + ": base colour", warnings);
     m.metallic_roughness_texture =
         read_texture(mat, aiTextureType_UNKNOWN, textures, what + ": metallic-roughness", warnings);
+    m.normal_texture = read_texture(mat, aiTextureType_NORMALS, textures, what + ": normal", warnings);
+    m.occlusion_texture =
+        read_texture(mat, first_present(mat, {aiTextureType_AMBIENT_OCCLUSION, aiTextureType_LIGHTMAP}), textures,
+                     what + ": occlusion", warnings);
+    m.emissive_texture = read_texture(mat, aiTextureType_EMISSIVE, textures, what + ": emissive", warnings);
     materials.push_back(std::move(m));
   }
   return materials;
+}
+
+void warn_about_uv_sets(const Model& model, std::vector<std::string>& warnings) {
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    const SourceMaterial& m = model.materials[i];
+    const char* const names[] = {"base colour", "metallic-roughness", "normal", "occlusion", "emissive"};
+    for (std::size_t k = 0; k < m.textures().size(); ++k) {
+      const Texture* t = m.textures()[k];
+      const char* what = names[k];
+      if (t->uri.empty() || t->uv_set == 0) continue;
+      const std::string where = "material " + std::to_string(i) + " '" + m.name + "': " + what + " texture '" + t->uri +
+                                "' reads UV set " + std::to_string(t->uv_set);
+      if (t->uv_set > 1 || !model.mesh.has_uvs1())
+        warnings.push_back(where + ", which libg2p does not keep; it reads UV set 0 instead");
+      else if (t == &m.base_color_texture || t == &m.metallic_roughness_texture)
+        warnings.push_back(where + "; the renderer reads UV set 0 (the GLB keeps set 1)");
+    }
+  }
 }
 
 }  // namespace g2p::detail

@@ -39,12 +39,14 @@ float number_or(const json& obj, const char* key, float fallback) {
   return it != obj.end() && it->is_number() ? it->get<float>() : fallback;
 }
 
-// KHR_texture_transform of a textureInfo object, as the affine map
-// translation * rotation * scale (the extension's specification).
-Eigen::Matrix<float, 2, 3> texture_transform(const json& info) {
-  Eigen::Matrix<float, 2, 3> t;
-  t << 1, 0, 0, 0, 1, 0;
+// What a textureInfo object says of how its texture is read: the
+// KHR_texture_transform as the affine map translation * rotation * scale (the
+// extension's specification), and the UV set (`texCoord`, which the
+// extension's own `texCoord` overrides). The image comes from assimp.
+Texture texture_info(const json& info) {
+  Texture t;
   if (!info.is_object()) return t;
+  if (auto set = info.find("texCoord"); set != info.end() && set->is_number_integer()) t.uv_set = set->get<int>();
   auto ext = info.find("extensions");
   if (ext == info.end() || !ext->is_object()) return t;
   auto tt = ext->find("KHR_texture_transform");
@@ -59,8 +61,19 @@ Eigen::Matrix<float, 2, 3> texture_transform(const json& info) {
   const float r = number_or(*tt, "rotation", 0.f);
   const float c = std::cos(r), s = std::sin(r);
   // [[c, s], [-s, c]] * diag(scale), then the offset.
-  t << c * scale[0], s * scale[1], offset[0], -s * scale[0], c * scale[1], offset[1];
+  t.uv_transform << c * scale[0], s * scale[1], offset[0], -s * scale[0], c * scale[1], offset[1];
+  if (auto set = tt->find("texCoord"); set != tt->end() && set->is_number_integer()) t.uv_set = set->get<int>();
   return t;
+}
+
+// The textureInfo `key` of `parent` (if any) into `out`; its `factor_key`
+// (normalTexture.scale, occlusionTexture.strength) into `factor`.
+void read_texture_info(const json& parent, const char* key, Texture& out, const char* factor_key = nullptr,
+                       float* factor = nullptr) {
+  auto t = parent.find(key);
+  if (t == parent.end() || !t->is_object()) return;
+  out = texture_info(*t);
+  if (factor_key != nullptr) *factor = number_or(*t, factor_key, 1.f);
 }
 
 SourceMaterial parse_material(const json& m) {
@@ -75,11 +88,12 @@ SourceMaterial parse_material(const json& m) {
     }
     out.metallic = number_or(*pbr, "metallicFactor", 1.f);
     out.roughness = number_or(*pbr, "roughnessFactor", 1.f);
-    if (auto t = pbr->find("baseColorTexture"); t != pbr->end())
-      out.base_color_texture.uv_transform = texture_transform(*t);
-    if (auto t = pbr->find("metallicRoughnessTexture"); t != pbr->end())
-      out.metallic_roughness_texture.uv_transform = texture_transform(*t);
+    read_texture_info(*pbr, "baseColorTexture", out.base_color_texture);
+    read_texture_info(*pbr, "metallicRoughnessTexture", out.metallic_roughness_texture);
   }
+  read_texture_info(m, "normalTexture", out.normal_texture, "scale", &out.normal_scale);
+  read_texture_info(m, "occlusionTexture", out.occlusion_texture, "strength", &out.occlusion_strength);
+  read_texture_info(m, "emissiveTexture", out.emissive_texture);
   if (auto a = m.find("alphaMode"); a != m.end() && a->is_string()) {
     const std::string mode = a->get<std::string>();
     out.alpha_mode = mode == "MASK" ? AlphaMode::kMask : mode == "BLEND" ? AlphaMode::kBlend : AlphaMode::kOpaque;

@@ -29,7 +29,7 @@ struct GltfPrimitive {
 };
 
 struct GltfLayout {
-  std::vector<SourceMaterial> materials;  // the file's `materials`, factors only (no textures)
+  std::vector<SourceMaterial> materials;  // the file's `materials`: factors, texture transforms and UV sets (no images)
   std::vector<GltfPrimitive> primitives;  // meshes then primitives, in file order (assimp's mesh order)
   std::vector<std::string> extensions_required;
 };

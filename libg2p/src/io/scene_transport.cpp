@@ -139,6 +139,8 @@ void write_mesh(Writer& w, const aiMesh* mesh) {
   w.pod(mesh->mNumVertices);
   w.array(mesh->mVertices, mesh->mNumVertices);
   w.array(mesh->mNormals, mesh->mNumVertices);
+  w.array(mesh->mTangents, mesh->mNumVertices);
+  w.array(mesh->mBitangents, mesh->mNumVertices);
   for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++k) {
     w.pod(mesh->mNumUVComponents[k]);
     w.array(mesh->mTextureCoords[k], mesh->mNumVertices);
@@ -244,6 +246,8 @@ aiMesh* read_mesh(Reader& r) {
   mesh->mNumVertices = vertices;
   mesh->mVertices = vectors();
   mesh->mNormals = vectors();
+  mesh->mTangents = vectors();
+  mesh->mBitangents = vectors();
   for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++k) {
     mesh->mNumUVComponents[k] = r.pod<unsigned>();
     mesh->mTextureCoords[k] = vectors();

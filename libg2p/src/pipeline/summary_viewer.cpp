@@ -37,21 +37,32 @@ nlohmann::json mesh_json(const Mesh& mesh) {
   return {{"positions", base64_of(positions)}, {"indices", base64_of(indices)}};
 }
 
-// The input's own colour of each drawn face: its material's base colour (factor
-// times texture at the face's UV centroid), sRGB bytes.
+// The input's own colour of each drawn face, as the renderer sees it at the
+// face's centre: its material's base colour (factor times texture at the
+// face's UV centroid) times the mean of its vertex colours (Mesh::colors, as
+// glTF's COLOR_0); a face without a material shows its vertex colours on
+// white, or light grey when the mesh has none. sRGB bytes.
 std::string look_colors(const Model& model, const std::vector<int>& source_faces) {
   std::vector<std::uint8_t> rgb;
   rgb.reserve(source_faces.size() * 3);
   const Mesh& mesh = model.mesh;
+  const SourceMaterial white;  // glTF's default material: a white base colour
   for (int f : source_faces) {
     Eigen::Vector3f color(0.7f, 0.7f, 0.7f);
     const std::size_t fi = static_cast<std::size_t>(f);
     const int m = fi < mesh.face_source.size() ? mesh.face_source[fi].material : -1;
-    if (m >= 0 && static_cast<std::size_t>(m) < model.materials.size()) {
+    const bool has_material = m >= 0 && static_cast<std::size_t>(m) < model.materials.size();
+    if (has_material || mesh.has_colors()) {
       Eigen::Vector2f uv = Eigen::Vector2f::Zero();
-      if (mesh.has_uvs())
-        for (int k = 0; k < 3; ++k) uv += mesh.uvs[static_cast<std::size_t>(mesh.triangles[fi][k])] / 3.f;
-      color = evaluate_material(model.materials[static_cast<std::size_t>(m)], uv).base_color;
+      Eigen::Vector4f vertex_color = Eigen::Vector4f::Zero();
+      for (int k = 0; k < 3; ++k) {
+        const std::size_t v = static_cast<std::size_t>(mesh.triangles[fi][k]);
+        if (mesh.has_uvs()) uv += mesh.uvs[v] / 3.f;
+        vertex_color +=
+            mesh.has_colors() ? Eigen::Vector4f(mesh.colors[v] / 3.f) : Eigen::Vector4f::Constant(1.f / 3.f);
+      }
+      color = evaluate_material(has_material ? model.materials[static_cast<std::size_t>(m)] : white, uv, vertex_color)
+                  .base_color;
     }
     for (int k = 0; k < 3; ++k) rgb.push_back(linear_to_srgb8(color[k]));
   }

@@ -16,6 +16,15 @@
 namespace g2p {
 namespace {
 
+// The backend's own behaviour: no part kept as given, no volume check (both
+// are complete()'s, tested in closed_parts_test.cpp).
+const CompletionOptions kBackendOnly = [] {
+  CompletionOptions o;
+  o.keep_closed_parts = false;
+  o.volume_tolerance = 0.0;
+  return o;
+}();
+
 constexpr int kWood = static_cast<int>(PaperClass::kWood);
 constexpr int kMetal = static_cast<int>(PaperClass::kMetal);
 
@@ -53,7 +62,7 @@ std::unique_ptr<Completer> completer(const std::string& name, const BackendSetti
 CompletedPart run_single(const Completer& c, const Mesh& mesh, double* seconds = nullptr) {
   const std::vector<Part> parts = test::single_part(mesh, kWood);
   const auto start = std::chrono::steady_clock::now();
-  Result<Completion> r = complete({&mesh, &parts, nullptr}, c);
+  Result<Completion> r = complete({&mesh, &parts, nullptr}, c, nullptr, kBackendOnly);
   if (seconds != nullptr) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_TRUE(r.ok()) << r.status().to_string();
   if (!r.ok() || r->parts.size() != 1) return {};
@@ -146,7 +155,7 @@ TEST(CgalCompleters, AlphaWrapsEveryPart) {
   for (int f = 0; f < mesh.num_faces(); ++f) parts[f < first_ball ? 0 : 1].faces.push_back(f);
   auto c = completer("alpha-wrap");
   ASSERT_NE(c, nullptr);
-  Result<Completion> r = complete({&mesh, &parts, nullptr}, *c);
+  Result<Completion> r = complete({&mesh, &parts, nullptr}, *c, nullptr, kBackendOnly);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   ASSERT_EQ(r->parts.size(), 2u);
   EXPECT_EQ(r->parts[1].label, kMetal);
@@ -243,7 +252,7 @@ TEST(CgalCompleters, FillFallsBackOnAHugeHole) {
   const std::vector<Part> parts = test::single_part(tube, kWood);
   auto fill = completer("fill");
   ASSERT_NE(fill, nullptr);
-  Result<Completion> alone = complete({&tube, &parts, nullptr}, *fill);
+  Result<Completion> alone = complete({&tube, &parts, nullptr}, *fill, nullptr, kBackendOnly);
   ASSERT_TRUE(alone.ok()) << alone.status().to_string();
   ASSERT_EQ(alone->parts.size(), 1u);
   EXPECT_FALSE(alone->parts[0].ok);
@@ -251,7 +260,7 @@ TEST(CgalCompleters, FillFallsBackOnAHugeHole) {
 
   Result<std::unique_ptr<Completer>> partition = make_completer("partition", {{"resolution", "64"}});
   ASSERT_TRUE(partition.ok()) << partition.status().to_string();
-  Result<Completion> r = complete({&tube, &parts, nullptr}, *fill, partition->get());
+  Result<Completion> r = complete({&tube, &parts, nullptr}, *fill, partition->get(), kBackendOnly);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   ASSERT_EQ(r->parts.size(), 1u);
   const CompletedPart& p = r->parts[0];
@@ -302,7 +311,7 @@ TEST(CgalCompleters, FillFailsGracefullyOnNonManifoldPatches) {
   for (const char* name : {"fill", "alpha-wrap"}) {
     auto b = completer(name);
     ASSERT_NE(b, nullptr);
-    Result<Completion> r = complete({&box, &empty, nullptr}, *b);
+    Result<Completion> r = complete({&box, &empty, nullptr}, *b, nullptr, kBackendOnly);
     ASSERT_TRUE(r.ok());
     ASSERT_EQ(r->parts.size(), 1u);
     EXPECT_FALSE(r->parts[0].ok);

@@ -49,7 +49,7 @@ Result<Completion> complete_with_partition(const Mesh& mesh, const std::vector<P
                                            const CompletionOptions& options = {}) {
   Result<std::unique_ptr<Completer>> partition = make_completer("partition");
   if (!partition.ok()) return partition.status();
-  return complete(CompletionInput{&mesh, &parts, nullptr, {}}, **partition, nullptr, options);
+  return complete(CompletionInput{&mesh, &parts, nullptr, nullptr, {}}, **partition, nullptr, options);
 }
 
 struct ClosedCase {

@@ -8,6 +8,15 @@
 namespace g2p {
 namespace {
 
+// The backend's own behaviour: no part kept as given, no volume check (both
+// are complete()'s, tested in closed_parts_test.cpp).
+const CompletionOptions kBackendOnly = [] {
+  CompletionOptions o;
+  o.keep_closed_parts = false;
+  o.volume_tolerance = 0.0;
+  return o;
+}();
+
 constexpr int kWood = static_cast<int>(PaperClass::kWood);
 
 std::unique_ptr<Completer> external(const std::string& command, const std::string& timeout = "60") {
@@ -22,7 +31,7 @@ TEST(ExternalCompleter, ReadsBackAClosedMesh) {
   const std::vector<Part> parts = test::single_part(box, kWood);
   auto c = external("cp {object} {output}");
   ASSERT_NE(c, nullptr);
-  Result<Completion> r = complete({&box, &parts, nullptr}, *c);
+  Result<Completion> r = complete({&box, &parts, nullptr}, *c, nullptr, kBackendOnly);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   ASSERT_EQ(r->parts.size(), 1u);
   EXPECT_TRUE(r->parts[0].ok);
@@ -58,7 +67,7 @@ TEST(ExternalCompleter, FailuresFallBackToPartition) {
     // (The sleeping command's note "killed" shows its timeout fired; a wall-clock
     // bound here failed under a loaded sanitizer build, where the partition
     // fallback alone took 53 s.)
-    Result<Completion> r = complete({&tube, &parts, nullptr}, *c, fallback.get());
+    Result<Completion> r = complete({&tube, &parts, nullptr}, *c, fallback.get(), kBackendOnly);
     ASSERT_TRUE(r.ok()) << r.status().to_string();
     ASSERT_EQ(r->parts.size(), 1u);
     const CompletedPart& p = r->parts[0];
@@ -69,7 +78,7 @@ TEST(ExternalCompleter, FailuresFallBackToPartition) {
     EXPECT_NE(notes.find(k.expect_in_notes), std::string::npos) << notes;
     EXPECT_NE(notes.find("fell back to 'partition'"), std::string::npos) << notes;
     // Without a fallback the failed part stays flagged.
-    Result<Completion> alone = complete({&tube, &parts, nullptr}, *c);
+    Result<Completion> alone = complete({&tube, &parts, nullptr}, *c, nullptr, kBackendOnly);
     ASSERT_TRUE(alone.ok());
     EXPECT_FALSE(alone->parts[0].ok);
   }

@@ -47,6 +47,7 @@ RunOptions unusual() {
   o.refiner = {"none", {}};
   o.completer = {"partition", {{"resolution", "48"}}};
   o.completion_fallback = "";
+  o.keep_closed_parts = false;
   o.estimator = {"table", {}};
   o.decomposer = {"hull", {}};
   o.decompose.max_hulls = 5;

@@ -92,6 +92,9 @@ Model one_atlas_material(const Model& source) {
   out.positions.clear();
   out.normals.clear();
   out.uvs.clear();
+  out.uvs1.clear();  // one atlas, one UV set: the second set and the tangents went with the materials
+  out.tangents.clear();
+  out.colors.clear();
   for (int f = 0; f < in.num_faces(); ++f) {
     const int material = in.face_source[static_cast<std::size_t>(f)].material;
     const Eigen::Vector2f uv((std::max(material, 0) + 0.5f) / static_cast<float>(tiles), 0.5f);

@@ -118,8 +118,8 @@ struct BatchRow {
   // What the run warns about (run.json's warnings): a part whose volume
   // disagrees with the input's, a mass outside the kind's range, ...
   std::vector<std::string> warnings;
-  std::string output;                           // OUT/NAME when ok, else ""
-  std::string finished_at;                      // UTC, ISO 8601
+  std::string output;       // OUT/NAME when ok, else ""
+  std::string finished_at;  // UTC, ISO 8601
 };
 
 struct BatchResult {

@@ -163,7 +163,7 @@ struct CompletionOptions {
   // (a thin board, a rod, a closed shell), not between faces of different
   // parts, where the estimate's split (halfway along each ray) and the
   // completer's (nearest surface) differ by design. <= 0: no check.
-  double volume_tolerance = 0.05;
+  double volume_tolerance = 0.10;
   double volume_check_own_fraction = 0.8;
   int volume_rays = 192;  // rays per side of each of the three ray grids (estimate_volumes)
 };

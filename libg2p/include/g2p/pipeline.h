@@ -152,6 +152,9 @@ struct PipelineOptions {
   //    the GPL component is registered (g2p::cgal::register_cgal_completers).
   BackendChoice completer{"partition", {}};
   std::string completion_fallback = "partition";  // for parts the completer fails; "" = none
+  // Parts whose faces already bound a solid are kept as given, and the
+  // completer closes only the others (CompletionOptions::keep_closed_parts).
+  bool keep_closed_parts = true;
 
   // 6. properties: "table" (default) or "vlm" (falls back to the table per part).
   BackendChoice estimator{"table", {}};

@@ -183,7 +183,8 @@ bool orient_components(Mesh& m, bool& turned) {
     sign[c] = signed_volume_of(m, faces[c]) >= 0.0 ? 1 : -1;
     for (int f : faces[c])
       for (int k = 0; k < 3; ++k)
-        box[c].extend(m.positions[static_cast<std::size_t>(m.triangles[static_cast<std::size_t>(f)][k])].cast<double>());
+        box[c].extend(
+            m.positions[static_cast<std::size_t>(m.triangles[static_cast<std::size_t>(f)][k])].cast<double>());
   }
   // The winding number just outside each component, from the others: it
   // does not depend on how the component itself is turned.
@@ -218,7 +219,8 @@ bool orient_components(Mesh& m, bool& turned) {
       // Inside another component, the wrong way round is ambiguous: a cavity
       // wound the wrong way, or a second solid overlapping the first.
       if (w != 0) return false;
-      for (int f : faces[c]) std::swap(m.triangles[static_cast<std::size_t>(f)][1], m.triangles[static_cast<std::size_t>(f)][2]);
+      for (int f : faces[c])
+        std::swap(m.triangles[static_cast<std::size_t>(f)][1], m.triangles[static_cast<std::size_t>(f)][2]);
       sign[c] = wanted;
       any_turned = turned = true;
     }

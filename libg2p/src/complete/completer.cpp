@@ -258,7 +258,8 @@ Status write_completion(const std::string& dir, const Completion& completion, co
     j["ok"] = p.ok;
     j["checks"] = checks_json(p.checks);
     j["input_volume_m3"] = p.input_volume_m3;
-    j["volume_difference"] = std::isfinite(p.volume_difference) ? nlohmann::json(p.volume_difference) : nlohmann::json();
+    j["volume_difference"] =
+        std::isfinite(p.volume_difference) ? nlohmann::json(p.volume_difference) : nlohmann::json();
     j["notes"] = p.notes;
     j["vertices"] = p.mesh.num_vertices();
     j["triangles"] = p.mesh.num_faces();

@@ -485,15 +485,19 @@ void give_kept_solids(const Grid& g, const CompletionInput& input, std::vector<i
       const Eigen::Vector3d c = solid.positions[static_cast<std::size_t>(t[2])].cast<double>();
       const double area = (b.y() - a.y()) * (c.z() - a.z()) - (b.z() - a.z()) * (c.y() - a.y());
       if (area == 0.0) continue;
-      const int tj0 = std::max(j0, static_cast<int>(std::ceil((std::min({a.y(), b.y(), c.y()}) - g.origin.y() - nudge) / g.h)));
-      const int tj1 = std::min(j1, static_cast<int>(std::floor((std::max({a.y(), b.y(), c.y()}) - g.origin.y() - nudge) / g.h)));
-      const int tk0 = std::max(k0, static_cast<int>(std::ceil((std::min({a.z(), b.z(), c.z()}) - g.origin.z() - nudge) / g.h)));
-      const int tk1 = std::min(k1, static_cast<int>(std::floor((std::max({a.z(), b.z(), c.z()}) - g.origin.z() - nudge) / g.h)));
+      const int tj0 =
+          std::max(j0, static_cast<int>(std::ceil((std::min({a.y(), b.y(), c.y()}) - g.origin.y() - nudge) / g.h)));
+      const int tj1 =
+          std::min(j1, static_cast<int>(std::floor((std::max({a.y(), b.y(), c.y()}) - g.origin.y() - nudge) / g.h)));
+      const int tk0 =
+          std::max(k0, static_cast<int>(std::ceil((std::min({a.z(), b.z(), c.z()}) - g.origin.z() - nudge) / g.h)));
+      const int tk1 =
+          std::min(k1, static_cast<int>(std::floor((std::max({a.z(), b.z(), c.z()}) - g.origin.z() - nudge) / g.h)));
       for (int k = tk0; k <= tk1; ++k)
         for (int j = tj0; j <= tj1; ++j) {
           const double y = g.origin.y() + j * g.h + nudge, z = g.origin.z() + k * g.h + nudge;
-          auto edge = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
-            return (q.y() - p.y()) * (z - p.z()) - (q.z() - p.z()) * (y - p.y());
+          auto edge = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+            return (v.y() - u.y()) * (z - u.z()) - (v.z() - u.z()) * (y - u.y());
           };
           const double w0 = edge(b, c), w1 = edge(c, a), w2 = edge(a, b);
           const bool inside = area > 0 ? (w0 >= 0 && w1 >= 0 && w2 >= 0) : (w0 <= 0 && w1 <= 0 && w2 <= 0);
@@ -720,9 +724,8 @@ Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::ve
   const double longest = ext.maxCoeff();
   if (!(longest > 0)) return Status::InvalidArgument("partition: the mesh has no extent");
   GridChoice choice;
-  double h =
-      std::max(thin_part_cell_size(mesh, parts, input, longest / resolution_, choice.thin_part),
-               longest / max_resolution_);
+  double h = std::max(thin_part_cell_size(mesh, parts, input, longest / resolution_, choice.thin_part),
+                      longest / max_resolution_);
   const int pad = gap_ + 2;
   Grid& g = choice.grid;
   for (int attempt = 0; attempt < 64; ++attempt) {
@@ -812,7 +815,7 @@ void PartitionCompleter::close_small_parts(const CompletionInput& input, const P
     if (boxes.hi[static_cast<std::size_t>(p)].x() >= 0 || input.is_kept(static_cast<std::size_t>(p))) continue;
     const Mesh patch = part_patch(*input.mesh, parts[static_cast<std::size_t>(p)]);
     const std::vector<Part> alone = {whole_patch_part(patch, parts[static_cast<std::size_t>(p)])};
-    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table, nullptr});
+    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table, nullptr, {}});
     if (!own.ok() || own->parts.empty() || own->parts[0].mesh.num_faces() == 0) {
       out.notes.push_back("partition: the part is smaller than a cell and could not be closed on its own" +
                           (own.ok() ? std::string() : ": " + own.status().message()));

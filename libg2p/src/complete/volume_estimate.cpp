@@ -35,9 +35,9 @@ namespace g2p {
 namespace {
 
 struct Crossing {
-  double t;   // along the axis, metres
-  int sign;   // +1 entering (normal against the ray), -1 leaving
-  int part;   // -1 for faces of no part
+  double t;  // along the axis, metres
+  int sign;  // +1 entering (normal against the ray), -1 leaving
+  int part;  // -1 for faces of no part
 };
 
 struct AxisTotals {
@@ -115,9 +115,7 @@ AxisTotals cast_axis(const Mesh& mesh, const std::vector<int>& face_part, std::s
   // Ray (i, j) passes through (lo_b + (i + ob) db, lo_c + (j + oc) dc).
   constexpr double ob = 0.5 + 0.0718281828, oc = 0.5 - 0.0414213562;
   const double lo_b = box.min()[b], lo_c = box.min()[c];
-  auto first_ray = [n](double lo, double offset) {
-    return std::clamp(static_cast<int>(std::ceil(lo - offset)), 0, n);
-  };
+  auto first_ray = [n](double lo, double offset) { return std::clamp(static_cast<int>(std::ceil(lo - offset)), 0, n); };
   auto last_ray = [n](double hi, double offset) {
     return std::clamp(static_cast<int>(std::floor(hi - offset)), -1, n - 1);
   };
@@ -144,7 +142,8 @@ AxisTotals cast_axis(const Mesh& mesh, const std::vector<int>& face_part, std::s
   std::vector<int> items(static_cast<std::size_t>(start.back()));
   {
     std::vector<int> fill(start.begin(), start.end() - 1);
-    for (int f = 0; f < nf; ++f) for_each_ray(f, [&](std::size_t r) { items[static_cast<std::size_t>(fill[r]++)] = f; });
+    for (int f = 0; f < nf; ++f)
+      for_each_ray(f, [&](std::size_t r) { items[static_cast<std::size_t>(fill[r]++)] = f; });
   }
   // Each row of rays on its own; rows summed afterwards, in order.
   std::vector<AxisTotals> rows(static_cast<std::size_t>(n), AxisTotals(np));

@@ -411,13 +411,14 @@ Status Pipeline::Impl::complete_parts(RunState& s) {
   PipelineResult& r = s.r;
   detail::StageClock clock(Stage::kComplete, completer.backend(options.completer), options.measure_stage_memory);
   G2P_RETURN_IF_ERROR(s.context.report(Stage::kComplete, 0.0, std::to_string(r.projection.parts.size()) + " parts"));
-  CompletionInput input{&r.model.mesh, &r.projection.parts, &r.table, {}};
+  CompletionInput input{&r.model.mesh, &r.projection.parts, &r.table, nullptr, {}};
   RunContext& context = s.context;
   input.progress = [&context](double fraction, const std::string& message) {
     return context.report(Stage::kComplete, fraction, message);
   };
   CompletionOptions completion_options;
   completion_options.weld_tolerance = options.project.weld_tolerance;
+  completion_options.keep_closed_parts = options.keep_closed_parts;
   Result<Completion> done = complete(input, *completer.get(), fallback.get(), completion_options);
   if (!done.ok()) return done.status().with_context("complete");
   r.completion = std::move(*done);

@@ -99,6 +99,13 @@ TEST(ToolBatch, AManifestRunsEachRowWithItsFlagsAndABadRowIsNamed) {
   EXPECT_EQ(row(index, "in_m")["kind_confidence"], 1.0);
   EXPECT_EQ(row(index, "in_m")["mass_in_kind_range"], "no");  // a 1.4 kg refrigerator
   EXPECT_NE(test::read_file(dir + "/out/index.csv").find(",refrigerator,1,no,"), std::string::npos);
+  // The run's warnings reach the index (run.json's, in its JSON and CSV).
+  const nlohmann::json warnings = row(index, "in_m")["warnings"];
+  ASSERT_TRUE(warnings.is_array()) << row(index, "in_m");
+  bool mass_warning = false;
+  for (const auto& w : warnings) mass_warning |= w.get<std::string>().rfind("mass: ", 0) == 0;
+  EXPECT_TRUE(mass_warning) << warnings;
+  EXPECT_NE(test::read_file(dir + "/out/index.csv").find("mass: the object weighs"), std::string::npos);
 
   test::write_file(dir + "/bad.jsonl",
                    "{\"path\": \"hammer.obj\"}\n{\"path\": \"hammer.obj\", \"height\": \"tall\"}\n");

@@ -232,5 +232,47 @@ TEST(VolumeEstimate, AThinPartTheCompleterCannotResolveIsFlagged) {
   EXPECT_FALSE(done->parts[0].ok);
 }
 
+TEST(VolumeEstimate, TheObjectIsJudgedWhereNoPartCanBeAlone) {
+  // The edge-less 2 mm board again, its two faces two parts (as the project
+  // stage makes them: they share no edge). Every interval runs from one part
+  // to the other, so neither is judged alone; the object is.
+  Mesh board = test::box_mesh({0, 0, 0}, {0.6f, 0.3f, 0.002f});
+  Mesh faces;
+  faces.positions = board.positions;
+  for (const auto& t : board.triangles) {
+    const float z0 = board.positions[static_cast<std::size_t>(t[0])].z();
+    if (z0 == board.positions[static_cast<std::size_t>(t[1])].z() &&
+        z0 == board.positions[static_cast<std::size_t>(t[2])].z())
+      faces.triangles.push_back(t);
+  }
+  std::vector<Part> parts(2);
+  for (int f = 0; f < faces.num_faces(); ++f) {
+    const bool top =
+        faces.positions[static_cast<std::size_t>(faces.triangles[static_cast<std::size_t>(f)][0])].z() > 0.001f;
+    parts[top ? 1 : 0].label = 1;
+    parts[top ? 1 : 0].faces.push_back(f);
+  }
+  CompletionOptions strict;  // below any difference a grid can leave on a board this thin
+  strict.volume_tolerance = 0.001;
+  Result<Completion> done = complete_with_partition(faces, parts, strict);
+  ASSERT_TRUE(done.ok()) << done.status().message();
+  EXPECT_NEAR(done->input_volume_m3, 0.6 * 0.3 * 0.002, 0.6 * 0.3 * 0.002 * 0.01);
+  bool object_noted = false;
+  for (const std::string& n : done->notes) object_noted |= n.rfind("volume check: the parts together hold", 0) == 0;
+  EXPECT_TRUE(object_noted);
+  for (const CompletedPart& p : done->parts) {
+    SCOPED_TRACE("part " + std::to_string(p.part));
+    EXPECT_FALSE(std::isfinite(p.volume_difference));  // not judged alone
+    EXPECT_FALSE(p.ok);
+  }
+  // At the default tolerance the verdict follows the measured difference.
+  done = complete_with_partition(faces, parts);
+  ASSERT_TRUE(done.ok());
+  const double off = (done->parts_volume_m3 - done->input_volume_m3) / done->input_volume_m3;
+  bool noted = false;
+  for (const std::string& n : done->notes) noted |= n.rfind("volume check: the parts together hold", 0) == 0;
+  EXPECT_EQ(noted, std::abs(off) > CompletionOptions().volume_tolerance) << off;
+}
+
 }  // namespace
 }  // namespace g2p

@@ -370,6 +370,52 @@ TEST_P(ToolRunSignal, CancelsAndWritesNothing) {
 // Ctrl-C, and TERM as `timeout`, CI runners and containers send it.
 INSTANTIATE_TEST_SUITE_P(IntAndTerm, ToolRunSignal, ::testing::Values(SIGINT, SIGTERM));
 
+// A closed 2 mm oak board is kept as given (exact mass), and the same board
+// without its four edge faces (open: two sheets) is closed on the grid and
+// checked against the volume its faces enclose: the warning reaches run.json,
+// report.json and summary.html (#50).
+TEST(ToolRun, AClosedBoardKeepsItsMassAndAnOpenOneIsCheckedAgainstItsFaces) {
+  const std::string dir = test::scratch_dir("ToolRunBoards");
+  const std::string corners =
+      "v -0.3 -0.15 -0.001\nv -0.3 -0.15 0.001\nv -0.3 0.15 -0.001\nv -0.3 0.15 0.001\n"
+      "v 0.3 -0.15 -0.001\nv 0.3 -0.15 0.001\nv 0.3 0.15 -0.001\nv 0.3 0.15 0.001\n";
+  const std::string faces_top_bottom = "f 1 3 7\nf 1 7 5\nf 2 6 8\nf 2 8 4\n";
+  const std::string faces_edges = "f 1 2 4\nf 1 4 3\nf 5 7 8\nf 5 8 6\nf 1 5 6\nf 1 6 2\nf 3 4 8\nf 3 8 7\n";
+  test::write_file(dir + "/oak.mtl", "newmtl oak\nKd 0.6 0.4 0.2\n");
+  test::write_file(dir + "/closed_board.obj",
+                   "mtllib oak.mtl\nusemtl oak\n" + corners + faces_top_bottom + faces_edges);
+  test::write_file(dir + "/open_board.obj", "mtllib oak.mtl\nusemtl oak\n" + corners + faces_top_bottom);
+
+  test::ToolRun r = test::run_tool("run " + test::quote(dir + "/closed_board.obj") + " --unit m -o " +
+                                   test::quote(dir + "/closed") + " --views 6 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  nlohmann::json report = nlohmann::json::parse(test::read_file(dir + "/closed/report.json"));
+  const double oak = report["parts"][0]["density_kg_m3"].get<double>();
+  EXPECT_NEAR(report["object"]["mass_kg"].get<double>(), oak * 0.6 * 0.3 * 0.002, 1e-6);
+  EXPECT_TRUE(report["parts"][0]["completion_ok"].get<bool>());
+  nlohmann::json run = nlohmann::json::parse(test::read_file(dir + "/closed/run.json"));
+  for (const auto& w : run["warnings"]) EXPECT_EQ(w.get<std::string>().find("volume"), std::string::npos) << w;
+
+  r = test::run_tool("run " + test::quote(dir + "/open_board.obj") + " --unit m -o " + test::quote(dir + "/open") +
+                     " --views 6");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  report = nlohmann::json::parse(test::read_file(dir + "/open/report.json"));
+  run = nlohmann::json::parse(test::read_file(dir + "/open/run.json"));
+  const double mass = report["object"]["mass_kg"].get<double>();
+  const double off = mass / (oak * 0.6 * 0.3 * 0.002) - 1.0;
+  // Whatever the grid makes of it, a mass more than 10 % off is never silent.
+  bool warned = false;
+  for (const auto& w : run["warnings"]) warned |= w.get<std::string>().rfind("complete: ", 0) == 0;
+  EXPECT_EQ(warned, std::abs(off) > 0.1) << off << " " << run["warnings"];
+  if (warned) {
+    bool any_failed = false;
+    for (const auto& p : report["parts"]) any_failed |= !p["completion_ok"].get<bool>();
+    EXPECT_TRUE(any_failed);
+    EXPECT_NE(test::read_file(dir + "/open/summary.html").find("the input's faces enclose"), std::string::npos);
+    EXPECT_NE(r.err.find("warning: complete: "), std::string::npos) << r.err;
+  }
+}
+
 // Issue #31's first item: with no segmenter option, a real image-to-3D mesh
 // (TRELLIS: one material, a baked atlas, no names, metallic 1) gets more
 // than one class; the old default read it as one class, Metal.

@@ -115,6 +115,24 @@ void check_volumes(const CompletionInput& input, const CompletionOptions& option
                          percent(part.volume_difference) + ", more than the " + percent(options.volume_tolerance) +
                          " allowed)");
   }
+  // The whole object: the parts together against everything the faces
+  // enclose. It catches what no part alone could be judged on (a thin board
+  // whose two faces became two parts, each half of every interval); the
+  // parts it could not judge alone fail with it.
+  double sum = 0.0;
+  for (const CompletedPart& part : out.parts) sum += part.checks.volume_m3;
+  if (!(estimate.object_m3 > 0)) return;
+  const double difference = (sum - estimate.object_m3) / estimate.object_m3;
+  if (std::abs(difference) <= options.volume_tolerance) return;
+  const std::string what = std::string("the parts together hold ") + cm3(sum) + ", the input's faces enclose " +
+                           cm3(estimate.object_m3) + " (" + (difference > 0 ? "+" : "") + percent(difference) +
+                           ", more than the " + percent(options.volume_tolerance) + " allowed)";
+  out.notes.push_back("volume check: " + what);
+  for (CompletedPart& part : out.parts) {
+    if (part.backend == "input" || std::isfinite(part.volume_difference) || part.mesh.num_faces() == 0) continue;
+    part.ok = false;
+    part.notes.push_back("volume check: not judged alone, and " + what);
+  }
 }
 
 }  // namespace

@@ -427,11 +427,14 @@ Status Pipeline::Impl::complete_parts(RunState& s) {
     closed += p.ok ? 1 : 0;
     // A volume the input disagrees with is a mass the user must not trust.
     for (const std::string& n : p.notes)
-      if (n.rfind("volume check: ", 0) == 0)
+      if (n.rfind("volume check: ", 0) == 0 && n.rfind("volume check: not judged alone", 0) != 0)
         r.warnings.push_back("complete: part " + std::to_string(p.part) + " (" +
                              (r.table.valid_label(p.label) ? r.table[p.label].name : std::string("Unknown")) +
                              "): " + n.substr(14) + "; its mass follows its closed volume");
   }
+  for (const std::string& n : r.completion.notes)  // the object's volume against the input's
+    if (n.rfind("volume check: ", 0) == 0)
+      r.warnings.push_back("complete: " + n.substr(14) + "; the mass follows the closed parts");
   clock.report().notes = r.completion.notes;
   clock.report().notes.push_back(std::to_string(closed) + " of " + std::to_string(r.completion.parts.size()) +
                                  " parts closed and checked");

@@ -45,6 +45,21 @@ double exact_volume(const Mesh& m) {
   return six_v / 6.0;
 }
 
+// A 600 x 300 x 2 mm board (z from 0 to 2 mm) given as its two large faces
+// only: open along its edges.
+Mesh edgeless_board() {
+  const Mesh board = test::box_mesh({0, 0, 0}, {0.6f, 0.3f, 0.002f});
+  Mesh faces;
+  faces.positions = board.positions;
+  for (const auto& t : board.triangles) {
+    const float z0 = board.positions[static_cast<std::size_t>(t[0])].z();
+    if (z0 == board.positions[static_cast<std::size_t>(t[1])].z() &&
+        z0 == board.positions[static_cast<std::size_t>(t[2])].z())
+      faces.triangles.push_back(t);
+  }
+  return faces;
+}
+
 Result<Completion> complete_with_partition(const Mesh& mesh, const std::vector<Part>& parts,
                                            const CompletionOptions& options = {}) {
   Result<std::unique_ptr<Completer>> partition = make_completer("partition");
@@ -198,15 +213,7 @@ TEST(VolumeEstimate, AThinPartTheCompleterCannotResolveIsFlagged) {
   // so the completer must close it, but the rays through both faces measure
   // its volume. Whatever the completer makes of it, a volume off by more
   // than the tolerance fails the part with a note saying by how much.
-  Mesh board = test::box_mesh({0, 0, 0}, {0.6f, 0.3f, 0.002f});
-  Mesh faces;
-  faces.positions = board.positions;
-  for (const auto& t : board.triangles) {
-    const float z0 = board.positions[static_cast<std::size_t>(t[0])].z();
-    const bool flat = z0 == board.positions[static_cast<std::size_t>(t[1])].z() &&
-                      z0 == board.positions[static_cast<std::size_t>(t[2])].z();
-    if (flat) faces.triangles.push_back(t);
-  }
+  const Mesh faces = edgeless_board();
   ASSERT_EQ(faces.num_faces(), 4);
   Result<Completion> done = complete_with_partition(faces, test::single_part(faces, 1));
   ASSERT_TRUE(done.ok()) << done.status().message();
@@ -236,15 +243,7 @@ TEST(VolumeEstimate, TheObjectIsJudgedWhereNoPartCanBeAlone) {
   // The edge-less 2 mm board again, its two faces two parts (as the project
   // stage makes them: they share no edge). Every interval runs from one part
   // to the other, so neither is judged alone; the object is.
-  Mesh board = test::box_mesh({0, 0, 0}, {0.6f, 0.3f, 0.002f});
-  Mesh faces;
-  faces.positions = board.positions;
-  for (const auto& t : board.triangles) {
-    const float z0 = board.positions[static_cast<std::size_t>(t[0])].z();
-    if (z0 == board.positions[static_cast<std::size_t>(t[1])].z() &&
-        z0 == board.positions[static_cast<std::size_t>(t[2])].z())
-      faces.triangles.push_back(t);
-  }
+  const Mesh faces = edgeless_board();
   std::vector<Part> parts(2);
   for (int f = 0; f < faces.num_faces(); ++f) {
     const bool top =

@@ -5,6 +5,8 @@
 // the colours.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -27,12 +29,13 @@ std::vector<std::string> look_bytes(const PipelineResult& r) {
   for (const auto& p : data["parts"]) {
     const std::string b64 = p["visual"]["look"];
     std::string bytes;  // base64 decoded
-    int bits = 0, value = 0;
+    int bits = 0;
+    std::uint32_t value = 0;  // the last 24 bits read; older ones are already decoded
     for (char c : b64) {
       const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
       const std::size_t k = alphabet.find(c);
       if (k == std::string::npos) continue;
-      value = (value << 6) | static_cast<int>(k), bits += 6;
+      value = ((value << 6) | static_cast<std::uint32_t>(k)) & 0xffffffu, bits += 6;
       if (bits >= 8) bits -= 8, bytes.push_back(static_cast<char>((value >> bits) & 0xff));
     }
     out.push_back(bytes);

@@ -96,7 +96,10 @@ Vector3d TriangleBins::tri(int t, int corner) const {
 Eigen::Vector3i TriangleBins::cell_of(const Vector3d& p) const {
   const Vector3d r = (p - box_.min()) / cell_;
   Eigen::Vector3i c;
-  for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>(std::floor(r[a])), 0, dims_[a] - 1);
+  // Clamped before the cast: a point far outside the box (a query against a
+  // tiny patch) lies beyond int's range in cells.
+  for (int a = 0; a < 3; ++a)
+    c[a] = static_cast<int>(std::clamp(std::floor(r[a]), 0.0, static_cast<double>(dims_[a] - 1)));
   return c;
 }
 

@@ -314,6 +314,8 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("completion_fallback", &PipelineOptions::completion_fallback, "'' = none")
       .def_readwrite("keep_closed_parts", &PipelineOptions::keep_closed_parts,
                      "parts whose faces already bound a solid are kept as given")
+      .def_readwrite("resolve_thin_parts", &PipelineOptions::resolve_thin_parts,
+                     "parts whose volume disagrees with the input's faces are tried again (closing, shell)")
       .def_readwrite("estimator", &PipelineOptions::estimator)
       .def_readwrite("memory_limit_bytes", &PipelineOptions::memory_limit_bytes,
                      "refuse runs needing more; 0 = the machine's memory")

@@ -60,11 +60,23 @@ Mesh edgeless_board() {
   return faces;
 }
 
+// The two faces of the edge-less board as two parts, bottom (0) and top (1).
+std::vector<Part> board_faces_as_parts(const Mesh& faces) {
+  std::vector<Part> parts(2);
+  for (int f = 0; f < faces.num_faces(); ++f) {
+    const bool top =
+        faces.positions[static_cast<std::size_t>(faces.triangles[static_cast<std::size_t>(f)][0])].z() > 0.001f;
+    parts[top ? 1 : 0].label = 1;
+    parts[top ? 1 : 0].faces.push_back(f);
+  }
+  return parts;
+}
+
 Result<Completion> complete_with_partition(const Mesh& mesh, const std::vector<Part>& parts,
                                            const CompletionOptions& options = {}) {
   Result<std::unique_ptr<Completer>> partition = make_completer("partition");
   if (!partition.ok()) return partition.status();
-  return complete(CompletionInput{&mesh, &parts, nullptr, nullptr, {}}, **partition, nullptr, options);
+  return complete(CompletionInput{&mesh, &parts, nullptr, nullptr, 0.0, {}}, **partition, nullptr, options);
 }
 
 struct ClosedCase {
@@ -215,7 +227,9 @@ TEST(VolumeEstimate, AThinPartTheCompleterCannotResolveIsFlagged) {
   // than the tolerance fails the part with a note saying by how much.
   const Mesh faces = edgeless_board();
   ASSERT_EQ(faces.num_faces(), 4);
-  Result<Completion> done = complete_with_partition(faces, test::single_part(faces, 1));
+  CompletionOptions first_pass_only;  // the grid's result as it is (ThinParts below resolves it)
+  first_pass_only.resolve_thin_parts = false;
+  Result<Completion> done = complete_with_partition(faces, test::single_part(faces, 1), first_pass_only);
   ASSERT_TRUE(done.ok()) << done.status().message();
   const CompletedPart& p = done->parts[0];
   EXPECT_EQ(p.backend, "partition");
@@ -232,7 +246,7 @@ TEST(VolumeEstimate, AThinPartTheCompleterCannotResolveIsFlagged) {
     EXPECT_FALSE(noted);
   }
   // A tolerance below the difference always fails it.
-  CompletionOptions strict;
+  CompletionOptions strict = first_pass_only;
   strict.volume_tolerance = 0.5 * std::abs(p.volume_difference);
   done = complete_with_partition(faces, test::single_part(faces, 1), strict);
   ASSERT_TRUE(done.ok());
@@ -244,15 +258,10 @@ TEST(VolumeEstimate, TheObjectIsJudgedWhereNoPartCanBeAlone) {
   // stage makes them: they share no edge). Every interval runs from one part
   // to the other, so neither is judged alone; the object is.
   const Mesh faces = edgeless_board();
-  std::vector<Part> parts(2);
-  for (int f = 0; f < faces.num_faces(); ++f) {
-    const bool top =
-        faces.positions[static_cast<std::size_t>(faces.triangles[static_cast<std::size_t>(f)][0])].z() > 0.001f;
-    parts[top ? 1 : 0].label = 1;
-    parts[top ? 1 : 0].faces.push_back(f);
-  }
+  const std::vector<Part> parts = board_faces_as_parts(faces);
   CompletionOptions strict;  // below any difference a grid can leave on a board this thin
   strict.volume_tolerance = 0.001;
+  strict.resolve_thin_parts = false;
   Result<Completion> done = complete_with_partition(faces, parts, strict);
   ASSERT_TRUE(done.ok()) << done.status().message();
   EXPECT_NEAR(done->input_volume_m3, 0.6 * 0.3 * 0.002, 0.6 * 0.3 * 0.002 * 0.01);
@@ -271,6 +280,120 @@ TEST(VolumeEstimate, TheObjectIsJudgedWhereNoPartCanBeAlone) {
   bool noted = false;
   for (const std::string& n : done->notes) noted |= n.rfind("volume check: the parts together hold", 0) == 0;
   EXPECT_EQ(noted, std::abs(off) > CompletionOptions().volume_tolerance) << off;
+}
+
+TEST(ThinParts, ABoardGivenAsItsFacesIsClosedAsAShellOfItsThickness) {
+  const double board = 0.6 * 0.3 * 0.002;
+  const Mesh faces = edgeless_board();
+  // One part: its two faces are two pieces, each takes half the thickness.
+  Result<Completion> done = complete_with_partition(faces, test::single_part(faces, 1));
+  ASSERT_TRUE(done.ok()) << done.status().message();
+  const CompletedPart& one = done->parts[0];
+  EXPECT_EQ(one.backend, "shell");
+  EXPECT_TRUE(one.ok);
+  EXPECT_TRUE(one.checks.watertight());
+  EXPECT_NEAR(one.checks.volume_m3, board, 0.01 * board);
+  EXPECT_NEAR(exact_volume(one.mesh), board, 0.01 * board);
+  EXPECT_LE(one.mesh.num_faces(), 64);  // the faces twice and walls, not a grid's surface
+  const Eigen::AlignedBox3d box = bounds(one.mesh);
+  EXPECT_NEAR(box.min().z(), 0.0, 1e-6);
+  EXPECT_NEAR(box.max().z(), 0.002, 1e-6);
+
+  // Two parts (the project stage makes two: no edge between them): each half
+  // of the board, meeting in its middle; the parts together hold the board.
+  done = complete_with_partition(faces, board_faces_as_parts(faces));
+  ASSERT_TRUE(done.ok()) << done.status().message();
+  for (const CompletedPart& p : done->parts) {
+    SCOPED_TRACE("part " + std::to_string(p.part));
+    EXPECT_EQ(p.backend, "shell");
+    EXPECT_TRUE(p.ok);
+    EXPECT_NEAR(p.checks.volume_m3, 0.5 * board, 0.01 * board);
+    const Eigen::AlignedBox3d b = bounds(p.mesh);
+    EXPECT_NEAR(p.part == 1 ? b.min().z() : b.max().z(), 0.001, 1e-6);  // the middle
+  }
+  EXPECT_NEAR(done->parts_volume_m3, board, 0.01 * board);
+  for (const std::string& n : done->notes) EXPECT_EQ(n.rfind("volume check:", 0), std::string::npos) << n;
+  bool said = false;
+  for (const std::string& n : done->notes) said |= n.find("closed as shells of their measured thickness") != n.npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(ThinParts, AShellIsOnlyMadeWhereTheFacesBoundAThinSolid) {
+  // A single sheet: nothing behind it.
+  const Mesh sheet = test::mesh_from_geometry({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 3}});
+  EXPECT_EQ(thin_part_shell(sheet, test::single_part(sheet, 1), 0).num_faces(), 0);
+  // A closed cube: every ray meets the cube's own (single) piece.
+  const Mesh cube = test::box_mesh({0, 0, 0}, {0.1f, 0.1f, 0.1f});
+  EXPECT_EQ(thin_part_shell(cube, test::single_part(cube, 1), 0).num_faces(), 0);
+  // A box split into its top face and the rest: the top is not thin (its
+  // offset would reach halfway down a box as deep as it is wide).
+  std::vector<Part> split(2);
+  for (int f = 0; f < cube.num_faces(); ++f) {
+    const Eigen::Vector3i& t = cube.triangles[static_cast<std::size_t>(f)];
+    const bool top = cube.positions[static_cast<std::size_t>(t[0])].z() > 0.099f &&
+                     cube.positions[static_cast<std::size_t>(t[1])].z() > 0.099f &&
+                     cube.positions[static_cast<std::size_t>(t[2])].z() > 0.099f;
+    split[top ? 1 : 0].label = 1;
+    split[top ? 1 : 0].faces.push_back(f);
+  }
+  EXPECT_EQ(thin_part_shell(cube, split, 1).num_faces(), 0);
+  // The edge-less board's top face: a shell, from its face to the middle.
+  const Mesh faces = edgeless_board();
+  const Mesh shell = thin_part_shell(faces, board_faces_as_parts(faces), 1);
+  ASSERT_GT(shell.num_faces(), 0);
+  EXPECT_NEAR(exact_volume(shell), 0.6 * 0.3 * 0.001, 1e-9);
+  // Out of range: nothing.
+  EXPECT_EQ(thin_part_shell(faces, board_faces_as_parts(faces), 7).num_faces(), 0);
+}
+
+// A pot 100 mm wide and tall with a 5 mm wall, its bottom ring missing: the
+// wall is open along its lower edge, one part whose faces bound it on both
+// sides.
+Mesh pot_without_bottom_ring() {
+  const int n = 48;
+  std::vector<Eigen::Vector3f> p;
+  std::vector<std::array<unsigned, 3>> t;
+  for (float radius : {0.05f, 0.045f})
+    for (float z : {0.0f, 0.1f})
+      for (int i = 0; i < n; ++i) {
+        const double a = 2 * M_PI * i / n;
+        p.emplace_back(static_cast<float>(radius * std::cos(a)), static_cast<float>(radius * std::sin(a)), z);
+      }
+  // Rings: outer bottom 0, outer top n, inner bottom 2n, inner top 3n.
+  for (unsigned i = 0; i < static_cast<unsigned>(n); ++i) {
+    const unsigned j = (i + 1) % n, N = static_cast<unsigned>(n);
+    t.push_back({i, j, j + N}), t.push_back({i, j + N, i + N});                                      // outer wall
+    t.push_back({2 * N + i, 3 * N + j, 2 * N + j}), t.push_back({2 * N + i, 3 * N + i, 3 * N + j});  // inner wall
+    t.push_back({N + i, N + j, 3 * N + j}), t.push_back({N + i, 3 * N + j, 3 * N + i});              // rim
+  }
+  return test::mesh_from_geometry(p, t);
+}
+
+TEST(ThinParts, AWallOpenAtItsEdgeIsClosedOnASecondTry) {
+  const Mesh pot = pot_without_bottom_ring();
+  const std::vector<Part> parts = test::single_part(pot, 1);
+  const double wall = 0.5 * 48 * std::sin(2 * M_PI / 48) * (0.05 * 0.05 - 0.045 * 0.045) * 0.1;
+  // First pass only: the outside floods into the wall through its open edge.
+  CompletionOptions first_pass_only;
+  first_pass_only.resolve_thin_parts = false;
+  Result<Completion> done = complete_with_partition(pot, parts, first_pass_only);
+  ASSERT_TRUE(done.ok()) << done.status().message();
+  EXPECT_NEAR(done->input_volume_m3, wall, 0.01 * wall);
+  EXPECT_LT(done->parts[0].checks.volume_m3, 0.5 * wall);
+  EXPECT_FALSE(done->parts[0].ok);
+  // The second try closes openings as wide as the wall is thick.
+  done = complete_with_partition(pot, parts);
+  ASSERT_TRUE(done.ok()) << done.status().message();
+  const CompletedPart& p = done->parts[0];
+  EXPECT_EQ(p.backend, "partition");
+  EXPECT_TRUE(p.ok);
+  EXPECT_NEAR(p.checks.volume_m3, wall, CompletionOptions().volume_tolerance * wall);
+  bool tried = false;
+  for (const std::string& n : done->notes) tried |= n.find("tried again closing openings") != n.npos;
+  EXPECT_TRUE(tried);
+  bool widened = false;
+  for (const std::string& n : done->notes) widened |= n.find("closing radius") != n.npos;
+  EXPECT_TRUE(widened);
 }
 
 }  // namespace

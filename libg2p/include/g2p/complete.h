@@ -40,6 +40,13 @@ struct CompletionInput {
   // need not close those parts (complete() replaces whatever it returns for
   // them); `partition` gives their solids to them and splits only the rest.
   const std::vector<Mesh>* kept = nullptr;
+  // Optional, metres: the thinnest solid part the input's faces measure
+  // where an earlier pass lost volume (complete() sets it when it tries
+  // again). A grid backend closes openings up to this wide, so that a wall
+  // of this thickness left open at its edge (a pot without its bottom
+  // face) stays solid; `partition` widens its closing radius to 0.6 of it.
+  // 0: no hint. Other backends may ignore it.
+  double thin_thickness_m = 0.0;
   // Optional: checked between the steps of a backend and between parts; a
   // status other than OK (cancellation) ends complete() with it.
   StageProgress progress;
@@ -166,6 +173,13 @@ struct CompletionOptions {
   double volume_tolerance = 0.10;
   double volume_check_own_fraction = 0.8;
   int volume_rays = 192;  // rays per side of each of the three ray grids (estimate_volumes)
+  // Parts the volume check fails are tried again: the completer once more
+  // with the failing parts' thickness as a hint (CompletionInput::
+  // thin_thickness_m), and a failing part whose volume lies between its own
+  // faces and another part's as a shell of its measured thickness
+  // (thin_part_shell). Each is kept only where the parts then agree better
+  // with the input's volume. false: the first result stands, flagged.
+  bool resolve_thin_parts = true;
 };
 
 // Runs `completer`; parts it failed (not ok) are redone by `fallback` (if
@@ -185,6 +199,19 @@ G2P_API Result<Completion> complete(const CompletionInput& input, const Complete
 // a solid, or not clearly one: open, non-manifold, self-intersecting,
 // overlapping components, a nested component wound like the one around it.
 G2P_API Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance = 1e-6);
+
+// A thin part closed as a shell of its measured thickness, for a part whose
+// volume lies between its own faces and the faces of other parts (a board
+// given as its top and bottom faces, two parts with no edge between them):
+// its welded faces, a copy of them moved inward along the vertex normals by
+// half the distance to the surface behind (where a ray from each vertex
+// first meets another part's face or another edge-connected piece of its
+// own, as estimate_volumes splits every inside interval halfway), and walls
+// along its open edges. Empty where that is not a thin shell: a ray that
+// meets nothing, its own piece or a face from outside, an offset deeper than
+// a tenth of the part's second-largest extent, or a result not watertight.
+G2P_API Mesh thin_part_shell(const Mesh& mesh, const std::vector<Part>& parts, std::size_t part,
+                             double weld_tolerance = 1e-6);
 
 // The volume inside the input's faces, estimated without closing them: rays
 // cast along each axis through a grid of `rays_per_side` x `rays_per_side`

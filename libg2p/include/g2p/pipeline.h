@@ -155,6 +155,10 @@ struct PipelineOptions {
   // Parts whose faces already bound a solid are kept as given, and the
   // completer closes only the others (CompletionOptions::keep_closed_parts).
   bool keep_closed_parts = true;
+  // Parts whose volume disagrees with the input's faces are tried again
+  // (a closing fitted to their thickness, a shell of it), kept where they
+  // agree better (CompletionOptions::resolve_thin_parts).
+  bool resolve_thin_parts = true;
 
   // 6. properties: "table" (default) or "vlm" (falls back to the table per part).
   BackendChoice estimator{"table", {}};

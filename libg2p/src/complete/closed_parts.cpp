@@ -18,6 +18,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "complete/welded_part.h"
 #include "g2p/complete.h"
 
 namespace g2p {
@@ -33,7 +34,7 @@ int find_root(std::vector<int>& parent, int x) {
 
 // The welded, compacted faces of `part`, without triangles that welding
 // collapsed.
-Mesh welded_part(const Mesh& mesh, const Part& part, const std::vector<int>& rep) {
+Mesh welded_part(const Mesh& mesh, const Part& part, const std::vector<int>& rep, std::vector<int>* source) {
   Mesh out;
   std::unordered_map<int, int> index;
   index.reserve(part.faces.size() * 2);
@@ -49,6 +50,7 @@ Mesh welded_part(const Mesh& mesh, const Part& part, const std::vector<int>& rep
     const Eigen::Vector3i w(vertex(t[0]), vertex(t[1]), vertex(t[2]));
     if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
     out.triangles.push_back(w);
+    if (source != nullptr) source->push_back(f);
   }
   return out;
 }
@@ -230,10 +232,15 @@ bool orient_components(Mesh& m, bool& turned) {
 
 }  // namespace
 
-Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance) {
+Mesh detail::welded_part_faces(const Mesh& mesh, const Part& part, double weld_tolerance, std::vector<int>* source) {
+  if (source != nullptr) source->clear();
   if (part.faces.empty() || mesh.num_faces() == 0) return {};
   const double eps = std::max(0.0, weld_tolerance) * bounds(mesh).diagonal().norm();
-  Mesh closed = welded_part(mesh, part, weld(mesh, part, eps));
+  return welded_part(mesh, part, weld(mesh, part, eps), source);
+}
+
+Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance) {
+  Mesh closed = detail::welded_part_faces(mesh, part, weld_tolerance);
   if (closed.num_faces() < 4 || !edges_pair_up(closed)) return {};
   MeshChecks checks = check_closed_mesh(closed);
   // Closed and oriented within each component; orientation between

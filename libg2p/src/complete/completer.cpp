@@ -2,6 +2,7 @@
 // the stage writes.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "complete/backends.h"
@@ -88,69 +89,95 @@ Result<Completion> complete_with_fallback(const CompletionInput& input, const Co
   return out;
 }
 
-// Holds every part to the input's own volume (estimate_volumes).
-void check_volumes(const CompletionInput& input, const CompletionOptions& options, Completion& out) {
-  if (!(options.volume_tolerance > 0)) return;
-  const VolumeEstimate estimate = estimate_volumes(*input.mesh, *input.parts, options.volume_rays);
-  if (!estimate.usable()) {
-    out.notes.push_back("volume check: the input's faces are too open to estimate their volume (" +
-                        std::to_string(estimate.rays_paired) + " of " + std::to_string(estimate.rays_hit) +
-                        " rays paired their crossings); no part was checked");
-    return;
-  }
-  out.input_volume_m3 = estimate.object_m3;
-  for (std::size_t p = 0; p < out.parts.size() && p < estimate.part_m3.size(); ++p) {
-    CompletedPart& part = out.parts[p];
-    part.input_volume_m3 = estimate.part_m3[p];
+// How far a completion's volumes lie from the input's (estimate_volumes):
+// per part where the estimate judges it alone, and for the parts together.
+struct VolumeJudgement {
+  std::vector<double> part;  // (ours - input) / input; NaN where not judged
+  double object = std::numeric_limits<double>::quiet_NaN();
+  double object_sum_m3 = 0.0;
+  std::vector<char> failing;  // beyond the tolerance, alone or with the object
+  int num_failing = 0;
+  // Summed relative errors, judged parts and the object: the lower, the
+  // closer the completion is to the input.
+  double score = 0.0;
+};
+
+VolumeJudgement judge_volumes(const VolumeEstimate& estimate, const CompletionOptions& options, const Completion& c) {
+  VolumeJudgement j;
+  const std::size_t np = c.parts.size();
+  j.part.assign(np, std::numeric_limits<double>::quiet_NaN());
+  j.failing.assign(np, 0);
+  for (std::size_t p = 0; p < np && p < estimate.part_m3.size(); ++p) {
+    const CompletedPart& part = c.parts[p];
     // Enough rays through the part for a sampled estimate (sampling error
     // well under the tolerance), and a volume bounded by its own faces.
     if (estimate.part_intervals[p] < 100 || estimate.part_own_fraction[p] < options.volume_check_own_fraction ||
         !(estimate.part_m3[p] > 0) || part.mesh.num_faces() == 0)
       continue;
-    part.volume_difference = (part.checks.volume_m3 - estimate.part_m3[p]) / estimate.part_m3[p];
-    if (std::abs(part.volume_difference) <= options.volume_tolerance) continue;
+    j.part[p] = (part.checks.volume_m3 - estimate.part_m3[p]) / estimate.part_m3[p];
+    j.score += std::abs(j.part[p]);
+    if (std::abs(j.part[p]) > options.volume_tolerance) j.failing[p] = 1;
+  }
+  for (const CompletedPart& part : c.parts) j.object_sum_m3 += part.checks.volume_m3;
+  if (estimate.object_m3 > 0) {
+    j.object = (j.object_sum_m3 - estimate.object_m3) / estimate.object_m3;
+    j.score += std::abs(j.object);
+    // The parts the estimate could not judge alone fail with the object.
+    if (std::abs(j.object) > options.volume_tolerance)
+      for (std::size_t p = 0; p < np; ++p)
+        if (c.parts[p].backend != "input" && !std::isfinite(j.part[p]) && c.parts[p].mesh.num_faces() > 0)
+          j.failing[p] = 1;
+  }
+  for (char f : j.failing) j.num_failing += f;
+  return j;
+}
+
+// Holds every part to the input's own volume: fields, notes, ok = false.
+void apply_judgement(const VolumeEstimate& estimate, const CompletionOptions& options, const VolumeJudgement& j,
+                     Completion& out) {
+  out.input_volume_m3 = estimate.object_m3;
+  for (std::size_t p = 0; p < out.parts.size() && p < estimate.part_m3.size(); ++p) {
+    CompletedPart& part = out.parts[p];
+    part.input_volume_m3 = estimate.part_m3[p];
+    part.volume_difference = j.part[p];
+    if (!std::isfinite(j.part[p]) || std::abs(j.part[p]) <= options.volume_tolerance) continue;
     part.ok = false;
     part.notes.push_back("volume check: the closed part holds " + cm3(part.checks.volume_m3) + ", its input faces " +
-                         cm3(estimate.part_m3[p]) + " (" + (part.volume_difference > 0 ? "+" : "") +
-                         percent(part.volume_difference) + ", more than the " + percent(options.volume_tolerance) +
-                         " allowed)");
+                         cm3(estimate.part_m3[p]) + " (" + (j.part[p] > 0 ? "+" : "") + percent(j.part[p]) +
+                         ", more than the " + percent(options.volume_tolerance) + " allowed)");
   }
-  // The whole object: the parts together against everything the faces
-  // enclose. It catches what no part alone could be judged on (a thin board
-  // whose two faces became two parts, each half of every interval); the
-  // parts it could not judge alone fail with it.
-  double sum = 0.0;
-  for (const CompletedPart& part : out.parts) sum += part.checks.volume_m3;
-  if (!(estimate.object_m3 > 0)) return;
-  const double difference = (sum - estimate.object_m3) / estimate.object_m3;
-  if (std::abs(difference) <= options.volume_tolerance) return;
-  const std::string what = std::string("the parts together hold ") + cm3(sum) + ", the input's faces enclose " +
-                           cm3(estimate.object_m3) + " (" + (difference > 0 ? "+" : "") + percent(difference) +
-                           ", more than the " + percent(options.volume_tolerance) + " allowed)";
+  // The whole object catches what no part alone could be judged on (a thin
+  // board whose two faces became two parts, each half of every interval).
+  if (!std::isfinite(j.object) || std::abs(j.object) <= options.volume_tolerance) return;
+  const std::string what = std::string("the parts together hold ") + cm3(j.object_sum_m3) +
+                           ", the input's faces enclose " + cm3(estimate.object_m3) + " (" + (j.object > 0 ? "+" : "") +
+                           percent(j.object) + ", more than the " + percent(options.volume_tolerance) + " allowed)";
   out.notes.push_back("volume check: " + what);
-  for (CompletedPart& part : out.parts) {
-    if (part.backend == "input" || std::isfinite(part.volume_difference) || part.mesh.num_faces() == 0) continue;
+  for (std::size_t p = 0; p < out.parts.size(); ++p) {
+    CompletedPart& part = out.parts[p];
+    if (!j.failing[p] || std::isfinite(j.part[p])) continue;
     part.ok = false;
     part.notes.push_back("volume check: not judged alone, and " + what);
   }
 }
 
-}  // namespace
-
-Result<Completion> complete(const CompletionInput& input, const Completer& completer, const Completer* fallback,
-                            const CompletionOptions& options) {
-  if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
-  if (input.mesh == nullptr) return Status::InvalidArgument("complete: no mesh");
-  const std::size_t np = input.parts->size();
-  // Parts already closed are kept as they are.
-  std::vector<Mesh> kept(np);
-  std::size_t num_kept = 0;
-  if (options.keep_closed_parts) {
-    for (std::size_t p = 0; p < np; ++p) {
-      kept[p] = closed_part_surface(*input.mesh, (*input.parts)[p], options.weld_tolerance);
-      num_kept += kept[p].num_faces() > 0;
-    }
+// The thinnest of the failing parts, metres: twice its estimated volume over
+// its area (a slab's thickness); 0 where none can say.
+double thinnest_failing(const VolumeEstimate& estimate, const std::vector<Part>& parts, const VolumeJudgement& j) {
+  double thinnest = 0.0;
+  for (std::size_t p = 0; p < parts.size() && p < estimate.part_m3.size(); ++p) {
+    if (!j.failing[p] || estimate.part_intervals[p] < 100 || !(estimate.part_m3[p] > 0) || !(parts[p].area_m2 > 0))
+      continue;
+    const double t = 2.0 * estimate.part_m3[p] / parts[p].area_m2;
+    if (thinnest == 0.0 || t < thinnest) thinnest = t;
   }
+  return thinnest;
+}
+
+// The completer's result with the kept parts in place.
+Result<Completion> run_completer(const CompletionInput& input, const Completer& completer, const Completer* fallback,
+                                 std::vector<Mesh> kept, std::size_t num_kept) {
+  const std::size_t np = input.parts->size();
   Completion out;
   if (num_kept < np || np == 0) {
     CompletionInput with_kept = input;
@@ -179,7 +206,98 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
   if (num_kept > 0 && num_kept < np)
     out.notes.push_back(std::to_string(num_kept) + " of " + std::to_string(np) +
                         " parts kept as given (their faces already bound a solid)");
-  check_volumes(input, options, out);
+  return out;
+}
+
+// The failing parts that close as shells of their measured thickness
+// (thin_part_shell), all at once: true if the completion now agrees better
+// with the input and `out` holds it.
+bool try_thin_shells(const CompletionInput& input, const VolumeEstimate& estimate, const CompletionOptions& options,
+                     VolumeJudgement& judged, Completion& out) {
+  Completion trial = out;
+  std::vector<int> shelled;
+  for (std::size_t p = 0; p < trial.parts.size(); ++p) {
+    if (!judged.failing[p] || trial.parts[p].backend == "input") continue;
+    Mesh shell = thin_part_shell(*input.mesh, *input.parts, p, options.weld_tolerance);
+    if (shell.num_faces() == 0) continue;
+    CompletedPart& part = trial.parts[p];
+    const Mesh patch = part_patch(*input.mesh, (*input.parts)[p]);
+    part.mesh = std::move(shell);
+    part.checks = check_closed_mesh(part.mesh, &patch);
+    part.backend = "shell";
+    part.ok = part.checks.watertight();
+    part.notes.push_back("closed as a shell of its measured thickness: the completer's surface held " +
+                         cm3(out.parts[p].checks.volume_m3) + ", its input faces " + cm3(estimate.part_m3[p]));
+    shelled.push_back(static_cast<int>(p));
+  }
+  if (shelled.empty()) return false;
+  VolumeJudgement again = judge_volumes(estimate, options, trial);
+  if (!(again.score < judged.score) || again.num_failing > judged.num_failing) return false;
+  trial.notes.push_back(std::to_string(shelled.size()) +
+                        " part(s) too thin for the completer closed as shells of their measured thickness");
+  out = std::move(trial);
+  judged = std::move(again);
+  return true;
+}
+
+}  // namespace
+
+Result<Completion> complete(const CompletionInput& input, const Completer& completer, const Completer* fallback,
+                            const CompletionOptions& options) {
+  if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
+  if (input.mesh == nullptr) return Status::InvalidArgument("complete: no mesh");
+  const std::size_t np = input.parts->size();
+  // Parts already closed are kept as they are.
+  std::vector<Mesh> kept(np);
+  std::size_t num_kept = 0;
+  if (options.keep_closed_parts) {
+    for (std::size_t p = 0; p < np; ++p) {
+      kept[p] = closed_part_surface(*input.mesh, (*input.parts)[p], options.weld_tolerance);
+      num_kept += kept[p].num_faces() > 0;
+    }
+  }
+  Result<Completion> first = run_completer(input, completer, fallback, kept, num_kept);
+  if (!first.ok()) return first.status();
+  Completion out = std::move(*first);
+
+  // The independent volume check (estimate_volumes), and where it fails, the
+  // second tries of resolve_thin_parts.
+  if (options.volume_tolerance > 0) {
+    const VolumeEstimate estimate = estimate_volumes(*input.mesh, *input.parts, options.volume_rays);
+    if (!estimate.usable()) {
+      out.notes.push_back("volume check: the input's faces are too open to estimate their volume (" +
+                          std::to_string(estimate.rays_paired) + " of " + std::to_string(estimate.rays_hit) +
+                          " rays paired their crossings); no part was checked");
+    } else {
+      VolumeJudgement judged = judge_volumes(estimate, options, out);
+      const double thinnest = thinnest_failing(estimate, *input.parts, judged);
+      // A grid that could resolve the wall (4 cells across) but let the
+      // outside in through an opening: close again, openings up to the wall's
+      // thickness closed.
+      if (options.resolve_thin_parts && judged.num_failing > 0 && out.grid_spacing_m > 0 &&
+          thinnest >= 4 * out.grid_spacing_m) {
+        CompletionInput hinted = input;
+        hinted.thin_thickness_m = thinnest;
+        Result<Completion> second = run_completer(hinted, completer, fallback, kept, num_kept);
+        if (!second.ok() && second.status().code() == StatusCode::kCancelled) return second.status();
+        if (second.ok()) {
+          VolumeJudgement again = judge_volumes(estimate, options, *second);
+          char text[200];
+          std::snprintf(text, sizeof text,
+                        "tried again closing openings up to the %.3g mm thin wall the input measures: "
+                        "volume error %.3g -> %.3g (%s)",
+                        thinnest * 1000, judged.score, again.score, again.score < judged.score ? "kept" : "not kept");
+          if (again.score < judged.score) {
+            out = std::move(*second);
+            judged = std::move(again);
+          }
+          out.notes.push_back(text);
+        }
+      }
+      if (options.resolve_thin_parts && judged.num_failing > 0) try_thin_shells(input, estimate, options, judged, out);
+      apply_judgement(estimate, options, judged, out);
+    }
+  }
   out.parts_volume_m3 = 0.0;
   for (const CompletedPart& p : out.parts) out.parts_volume_m3 += p.checks.volume_m3;
   if (num_kept == np) out.object_volume_m3 = out.parts_volume_m3;

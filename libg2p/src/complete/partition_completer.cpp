@@ -258,6 +258,8 @@ struct GridChoice {
   // counts) are the last attempt's and this the next, larger one.
   double h = 1.0;
   int thin_part = -1;  // the part that refined the grid, -1 if none did
+  int gap = 2;         // closing radius, cells: the setting, or wider for CompletionInput::thin_thickness_m
+  bool widened = false;
 };
 
 std::string grid_note(const GridChoice& choice) {
@@ -266,6 +268,7 @@ std::string grid_note(const GridChoice& choice) {
   note.precision(3);
   note << "grid " << g.nx << "x" << g.ny << "x" << g.nz << " points, cell " << choice.h * 1000 << " mm";
   if (choice.thin_part >= 0) note << " (refined for thin part " << choice.thin_part << ")";
+  if (choice.widened) note << ", closing radius " << choice.gap << " cells for a wall this thin";
   return note.str();
 }
 
@@ -659,7 +662,7 @@ Result<Completion> PartitionCompleter::complete(const CompletionInput& input) co
   G2P_RETURN_IF_ERROR(input.report(0.3, "distance transform"));
 
   // ---- 2. Inside and outside ---------------------------------------------------
-  std::vector<std::uint8_t> state = inside_outside_by_closing(g, dist2, gap_);
+  std::vector<std::uint8_t> state = inside_outside_by_closing(g, dist2, choice->gap);
   timing << ", closing " << lap() << " ms";
   G2P_RETURN_IF_ERROR(input.report(0.45, "inside and outside"));
   Result<std::unique_ptr<detail::SegmentTester>> tester = detail::SegmentTester::create(mesh);
@@ -726,7 +729,15 @@ Result<GridChoice> PartitionCompleter::size_grid(const Mesh& mesh, const std::ve
   GridChoice choice;
   double h = std::max(thin_part_cell_size(mesh, parts, input, longest / resolution_, choice.thin_part),
                       longest / max_resolution_);
-  const int pad = gap_ + 2;
+  // Openings as wide as the thin wall the caller measured are closed: the
+  // outside floods through points farther than `gap` cells from the surface,
+  // and a wall's middle lies half its thickness from it.
+  choice.gap = gap_;
+  if (input.thin_thickness_m > 0) {
+    const int wide = static_cast<int>(std::ceil(0.6 * input.thin_thickness_m / h));
+    if (wide > gap_) choice.gap = std::min(wide, 16), choice.widened = true;
+  }
+  const int pad = choice.gap + 2;
   Grid& g = choice.grid;
   for (int attempt = 0; attempt < 64; ++attempt) {
     g.h = h;
@@ -815,7 +826,7 @@ void PartitionCompleter::close_small_parts(const CompletionInput& input, const P
     if (boxes.hi[static_cast<std::size_t>(p)].x() >= 0 || input.is_kept(static_cast<std::size_t>(p))) continue;
     const Mesh patch = part_patch(*input.mesh, parts[static_cast<std::size_t>(p)]);
     const std::vector<Part> alone = {whole_patch_part(patch, parts[static_cast<std::size_t>(p)])};
-    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table, nullptr, {}});
+    Result<Completion> own = single.complete(CompletionInput{&patch, &alone, input.table, nullptr, 0.0, {}});
     if (!own.ok() || own->parts.empty() || own->parts[0].mesh.num_faces() == 0) {
       out.notes.push_back("partition: the part is smaller than a cell and could not be closed on its own" +
                           (own.ok() ? std::string() : ": " + own.status().message()));

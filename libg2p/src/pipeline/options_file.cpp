@@ -74,6 +74,7 @@ json full_json(const RunOptions& r) {
             {"completer", backend_json(o.completer)},
             {"completion_fallback", o.completion_fallback},
             {"keep_closed_parts", o.keep_closed_parts},
+            {"resolve_thin_parts", o.resolve_thin_parts},
             {"estimator", backend_json(o.estimator)},
             {"decomposer", backend_json(o.decomposer)},
             {"decompose",
@@ -183,6 +184,7 @@ Result<RunOptions> options_of(const json& j, RunOptions r) {
   o.completer = backend_of(j.at("completer"));
   o.completion_fallback = j.at("completion_fallback").get<std::string>();
   o.keep_closed_parts = j.at("keep_closed_parts").get<bool>();
+  o.resolve_thin_parts = j.at("resolve_thin_parts").get<bool>();
   o.estimator = backend_of(j.at("estimator"));
   o.decomposer = backend_of(j.at("decomposer"));
   const json& d = j.at("decompose");

@@ -419,6 +419,7 @@ Status Pipeline::Impl::complete_parts(RunState& s) {
   CompletionOptions completion_options;
   completion_options.weld_tolerance = options.project.weld_tolerance;
   completion_options.keep_closed_parts = options.keep_closed_parts;
+  completion_options.resolve_thin_parts = options.resolve_thin_parts;
   Result<Completion> done = complete(input, *completer.get(), fallback.get(), completion_options);
   if (!done.ok()) return done.status().with_context("complete");
   r.completion = std::move(*done);

@@ -25,13 +25,16 @@ core=(
 )
 # Tests, validation with real consumers, benchmarks, bindings; WordNet for the
 # object table's check (scripts/objects/build_objects.py --check); Chromium for
-# the summary.html browser tests (headless).
+# the summary.html browser tests (headless); DART 6.12 with its URDF and SDF
+# readers and ODE's collision detector, the second engine the URDF and SDF are
+# dropped in (tests/export/dart_test.cpp; about 200 MB, most of it Boost).
 extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
   wordnet-base
   libmujoco-dev libgl-dev libopengl-dev libbullet-extras-dev
   liburdfdom-tools libsdformat-dev libcpp-httplib-dev
+  libdart-dev libdart-utils-dev libdart-utils-urdf-dev libdart-collision-ode-dev
   pybind11-dev python3-dev python3-numpy python3-onnx
   python3-pandas python3-dask python3-distributed
   clang libclang-rt-14-dev

@@ -17,6 +17,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "export/export_fixtures.h"
 #include "g2p/complete.h"
 #include "g2p/export.h"
 #include "g2p/io.h"
@@ -641,24 +642,12 @@ class ExportAssets : public testing::TestWithParam<const char*> {};
 
 TEST_P(ExportAssets, MujocoAgreesAndTheDropSettles) {
   const std::string name = GetParam();
-  const Model model = *load_model(test::asset_path(name));
-  const MaterialTable& table = MaterialTable::paper_default();
-  const std::vector<int> by_material = *material_labels_from_json(test::read_file(test::labels_json_path()), name,
-                                                                  table, static_cast<int>(model.materials.size()));
-  std::vector<int> labels(static_cast<std::size_t>(model.mesh.num_faces()));
-  for (int f = 0; f < model.mesh.num_faces(); ++f) {
-    const int l = by_material[static_cast<std::size_t>(model.mesh.face_source[static_cast<std::size_t>(f)].material)];
-    labels[static_cast<std::size_t>(f)] = l == kUnknownLabel ? static_cast<int>(PaperClass::kOther) : l;
-  }
-  std::vector<int> face_part;
-  const std::vector<Part> parts = partition(model.mesh, *build_face_graph(model.mesh), labels, face_part);
-  const Completion completion = *(*make_completer("partition"))->complete({&model.mesh, &parts, &table});
-  const PropertiesReport report = *estimate_properties(model.mesh, parts, completion, table, **make_estimator("table"));
+  const test::TruthExport e = test::export_shared_asset(name);
   // A part whose closed volume passed its checks has a mass (the checks and
   // the mass properties agree on what encloses a volume).
-  for (std::size_t i = 0; i < parts.size(); ++i)
-    if (completion.parts[i].ok) EXPECT_GT(report.parts[i].mass.mass_kg, 0.0) << name << " part " << i;
-  const SimulationAsset asset = *make_asset(name, model.mesh, parts, completion, report, table);
+  for (std::size_t i = 0; i < e.parts.size(); ++i)
+    if (e.completion.parts[i].ok) EXPECT_GT(e.report.parts[i].mass.mass_kg, 0.0) << name << " part " << i;
+  const SimulationAsset& asset = e.asset;
   const std::string dir = test::scratch_dir("ExportAsset" + name);
   ASSERT_TRUE(write_asset(dir, asset, {"mjcf", "urdf", "sdf"}).ok());
   Result<EngineCheck> c = check_in_mujoco(dir + "/" + asset.name + ".xml");

@@ -73,8 +73,9 @@ std::vector<Part> board_faces_as_parts(const Mesh& faces) {
 }
 
 Result<Completion> complete_with_partition(const Mesh& mesh, const std::vector<Part>& parts,
-                                           const CompletionOptions& options = {}) {
-  Result<std::unique_ptr<Completer>> partition = make_completer("partition");
+                                           const CompletionOptions& options = {},
+                                           const BackendSettings& settings = {}) {
+  Result<std::unique_ptr<Completer>> partition = make_completer("partition", settings);
   if (!partition.ok()) return partition.status();
   return complete(CompletionInput{&mesh, &parts, nullptr, nullptr, 0.0, {}}, **partition, nullptr, options);
 }
@@ -376,13 +377,16 @@ TEST(ThinParts, AWallOpenAtItsEdgeIsClosedOnASecondTry) {
   // First pass only: the outside floods into the wall through its open edge.
   CompletionOptions first_pass_only;
   first_pass_only.resolve_thin_parts = false;
-  Result<Completion> done = complete_with_partition(pot, parts, first_pass_only);
+  // 100 cells across (1 mm): the wall spans 5 cells, its middle 2.5 from
+  // the surface, beyond the default closing radius of 2.
+  const BackendSettings coarse = {{"resolution", "100"}};
+  Result<Completion> done = complete_with_partition(pot, parts, first_pass_only, coarse);
   ASSERT_TRUE(done.ok()) << done.status().message();
   EXPECT_NEAR(done->input_volume_m3, wall, 0.01 * wall);
   EXPECT_LT(done->parts[0].checks.volume_m3, 0.5 * wall);
   EXPECT_FALSE(done->parts[0].ok);
   // The second try closes openings as wide as the wall is thick.
-  done = complete_with_partition(pot, parts);
+  done = complete_with_partition(pot, parts, {}, coarse);
   ASSERT_TRUE(done.ok()) << done.status().message();
   const CompletedPart& p = done->parts[0];
   EXPECT_EQ(p.backend, "partition");

@@ -18,7 +18,7 @@
 #include <numeric>
 #include <unordered_map>
 
-#include "complete/welded_part.h"
+#include "complete/closed_parts.h"
 #include "g2p/complete.h"
 
 namespace g2p {
@@ -239,10 +239,12 @@ Mesh detail::welded_part_faces(const Mesh& mesh, const Part& part, double weld_t
   return welded_part(mesh, part, weld(mesh, part, eps), source);
 }
 
-Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance) {
+Mesh detail::closed_part_surface_checked(const Mesh& mesh, const Part& part, double weld_tolerance,
+                                         MeshChecks& checks) {
+  checks = MeshChecks();
   Mesh closed = detail::welded_part_faces(mesh, part, weld_tolerance);
   if (closed.num_faces() < 4 || !edges_pair_up(closed)) return {};
-  MeshChecks checks = check_closed_mesh(closed);
+  checks = check_closed_mesh(closed);
   // Closed and oriented within each component; orientation between
   // components is decided below.
   if (!checks.closed || !checks.manifold || (checks.self_intersections_checked && !checks.self_intersection_free))
@@ -252,6 +254,11 @@ Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_toleran
   if (turned) checks = check_closed_mesh(closed);
   if (!checks.watertight()) return {};
   return closed;
+}
+
+Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance) {
+  MeshChecks checks;
+  return detail::closed_part_surface_checked(mesh, part, weld_tolerance, checks);
 }
 
 }  // namespace g2p

@@ -5,7 +5,10 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include "complete/backends.h"
+#include "complete/closed_parts.h"
 #include "core/file_util.h"
 #include "core/json_text.h"
 #include "g2p/io.h"
@@ -174,14 +177,51 @@ double thinnest_failing(const VolumeEstimate& estimate, const std::vector<Part>&
   return thinnest;
 }
 
+// The parts whose faces already bound a solid (closed_part_surface), found
+// in parallel, with their checks: the kept meshes (empty for the others) and
+// the CompletedPart each becomes.
+struct KeptParts {
+  std::vector<Mesh> meshes;
+  std::vector<CompletedPart> parts;
+  std::size_t count = 0;
+};
+
+KeptParts find_kept_parts(const CompletionInput& input, const CompletionOptions& options) {
+  const std::size_t np = input.parts->size();
+  KeptParts kept;
+  kept.meshes.resize(np);
+  kept.parts.resize(np);
+  if (!options.keep_closed_parts) return kept;
+  tbb::parallel_for(std::size_t{0}, np, [&](std::size_t p) {
+    MeshChecks checks;  // closed_part_surface's, self-intersections included
+    Mesh closed = detail::closed_part_surface_checked(*input.mesh, (*input.parts)[p], options.weld_tolerance, checks);
+    if (closed.num_faces() == 0) return;
+    CompletedPart& part = kept.parts[p];
+    part.part = static_cast<int>(p);
+    part.label = (*input.parts)[p].label;
+    part.backend = "input";
+    // Its surface is its patch's own faces: nothing lies away from them.
+    part.checks = checks;
+    part.checks.max_distance_m = 0.0;
+    part.checks.relative_distance = 0.0;
+    part.ok = part.checks.watertight();
+    part.notes.push_back("kept as given: its faces already bound a solid");
+    part.mesh = closed;
+    kept.meshes[p] = std::move(closed);
+  });
+  for (const Mesh& m : kept.meshes) kept.count += m.num_faces() > 0;
+  return kept;
+}
+
 // The completer's result with the kept parts in place.
 Result<Completion> run_completer(const CompletionInput& input, const Completer& completer, const Completer* fallback,
-                                 std::vector<Mesh> kept, std::size_t num_kept) {
+                                 const KeptParts& kept) {
   const std::size_t np = input.parts->size();
+  const std::size_t num_kept = kept.count;
   Completion out;
   if (num_kept < np || np == 0) {
     CompletionInput with_kept = input;
-    with_kept.kept = &kept;
+    with_kept.kept = &kept.meshes;
     Result<Completion> done = complete_with_fallback(with_kept, completer, fallback);
     if (!done.ok()) return done.status();
     out = std::move(*done);
@@ -189,19 +229,8 @@ Result<Completion> run_completer(const CompletionInput& input, const Completer& 
     out.parts.resize(np);
     out.notes.push_back("every part's faces already bound a solid: nothing to complete");
   }
-  for (std::size_t p = 0; p < np; ++p) {
-    if (kept[p].num_faces() == 0) continue;
-    CompletedPart& part = out.parts[p];
-    part = CompletedPart();
-    part.part = static_cast<int>(p);
-    part.label = (*input.parts)[p].label;
-    part.backend = "input";
-    part.mesh = std::move(kept[p]);
-    const Mesh patch = part_patch(*input.mesh, (*input.parts)[p]);
-    part.checks = check_closed_mesh(part.mesh, &patch);
-    part.ok = part.checks.watertight();
-    part.notes.push_back("kept as given: its faces already bound a solid");
-  }
+  for (std::size_t p = 0; p < np; ++p)
+    if (kept.meshes[p].num_faces() > 0) out.parts[p] = kept.parts[p];
   out.kept_parts = static_cast<int>(num_kept);
   if (num_kept > 0 && num_kept < np)
     out.notes.push_back(std::to_string(num_kept) + " of " + std::to_string(np) +
@@ -247,16 +276,8 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
   if (input.parts == nullptr) return Status::InvalidArgument("complete: no parts");
   if (input.mesh == nullptr) return Status::InvalidArgument("complete: no mesh");
   const std::size_t np = input.parts->size();
-  // Parts already closed are kept as they are.
-  std::vector<Mesh> kept(np);
-  std::size_t num_kept = 0;
-  if (options.keep_closed_parts) {
-    for (std::size_t p = 0; p < np; ++p) {
-      kept[p] = closed_part_surface(*input.mesh, (*input.parts)[p], options.weld_tolerance);
-      num_kept += kept[p].num_faces() > 0;
-    }
-  }
-  Result<Completion> first = run_completer(input, completer, fallback, kept, num_kept);
+  const KeptParts kept = find_kept_parts(input, options);  // parts already closed are kept as they are
+  Result<Completion> first = run_completer(input, completer, fallback, kept);
   if (!first.ok()) return first.status();
   Completion out = std::move(*first);
 
@@ -278,7 +299,7 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
           thinnest >= 4 * out.grid_spacing_m) {
         CompletionInput hinted = input;
         hinted.thin_thickness_m = thinnest;
-        Result<Completion> second = run_completer(hinted, completer, fallback, kept, num_kept);
+        Result<Completion> second = run_completer(hinted, completer, fallback, kept);
         if (!second.ok() && second.status().code() == StatusCode::kCancelled) return second.status();
         if (second.ok()) {
           VolumeJudgement again = judge_volumes(estimate, options, *second);
@@ -300,7 +321,7 @@ Result<Completion> complete(const CompletionInput& input, const Completer& compl
   }
   out.parts_volume_m3 = 0.0;
   for (const CompletedPart& p : out.parts) out.parts_volume_m3 += p.checks.volume_m3;
-  if (num_kept == np) out.object_volume_m3 = out.parts_volume_m3;
+  if (kept.count == np) out.object_volume_m3 = out.parts_volume_m3;
   return out;
 }
 

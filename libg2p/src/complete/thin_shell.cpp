@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include "complete/welded_part.h"
+#include "complete/closed_parts.h"
 #include "core/segment_tester.h"
 #include "g2p/complete.h"
 

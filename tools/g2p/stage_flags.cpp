@@ -104,6 +104,15 @@ void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
                   "Leave concavities shallower than this alone, in metres (0: 1 % of the object's bounding-box "
                   "diagonal)")
       ->capture_default_str();
+  cmd->add_option("--coverage-tolerance", args.options.coverage_tolerance,
+                  "Hulls should stand no farther outside a part, nor leave its surface uncovered by more, than this "
+                  "share of the object's bounding-box diagonal (0-1); a part that spends its hull budget and misses "
+                  "it gets twice the budget")
+      ->capture_default_str();
+  cmd->add_option("--max-hulls-per-object", args.options.max_hulls_per_object,
+                  "Convex hulls per object at most when raising part budgets for --coverage-tolerance (0: never "
+                  "raise)")
+      ->capture_default_str();
 }
 
 void add_export_flags(CLI::App* cmd, ExportArgs& args) {

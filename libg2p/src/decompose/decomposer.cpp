@@ -320,9 +320,14 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
       const std::size_t i = round[r].first;
       ConvexDecomposition& d = again[r];
       // The largest distance need not fall with every doubling (one gap of
-      // several still bridged keeps it), so an equal one is kept and raised
-      // again; a worse one ends the raise with the result before it.
-      if (d.hulls.empty() || d.fell_back || worst_distance(d) > worst_distance(out[i])) {
+      // several still bridged keeps it), so an equal one that spent its
+      // whole budget is kept and raised again; a worse one, or an equal one
+      // the backend finished within budget (more hulls for nothing), ends
+      // the raise with the result before it.
+      const bool better = worst_distance(d) < worst_distance(out[i]);
+      const bool progressing =
+          worst_distance(d) == worst_distance(out[i]) && static_cast<int>(d.hulls.size()) >= d.hull_budget;
+      if (d.hulls.empty() || d.fell_back || !(better || progressing)) {
         settled[i] = true;
         continue;
       }

@@ -95,7 +95,8 @@ void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
       ->capture_default_str();
   cmd->add_option("--decompose-set", args.settings,
                   "Decomposer setting KEY=VALUE, repeatable (`g2p run --settings decompose:NAME` lists them)");
-  cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256), unless --coverage-tolerance raises it")
+  cmd->add_option("--max-hulls", args.options.max_hulls,
+                  "Convex hulls per part at most (1-256), unless --coverage-tolerance raises it")
       ->capture_default_str();
   cmd->add_option("--hull-vertices", args.options.max_vertices_per_hull,
                   "Vertices per convex hull at most (4-255; engines cap hulls at 255)")

@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
-#include <numeric>
 #include <set>
 #include <sstream>
 
@@ -310,6 +309,13 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
       round.emplace_back(i, budget);
     }
     if (round.empty()) break;
+    if (progress) {  // a cancelled run stops raising; the hulls so far stand
+      std::lock_guard<std::mutex> lock(reporting);
+      if (!progress(1.0,
+                    "raising the hull budget of " + std::to_string(round.size()) + " parts for --coverage-tolerance")
+               .ok())
+        break;
+    }
     std::vector<ConvexDecomposition> again(round.size());
     tbb::parallel_for(std::size_t{0}, round.size(), [&](std::size_t r) {
       DecomposeOptions raised = options;
@@ -329,6 +335,7 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
           worst_distance(d) == worst_distance(out[i]) && static_cast<int>(d.hulls.size()) >= d.hull_budget;
       if (d.hulls.empty() || d.fell_back || !(better || progressing)) {
         settled[i] = true;
+        out[i].seconds += d.seconds;  // the attempt counts in the part's time
         continue;
       }
       d.seconds += out[i].seconds;

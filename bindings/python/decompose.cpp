@@ -58,7 +58,9 @@ void bind_decompose(py::module_& m) {
       .def_readwrite("max_hulls", &DecomposeOptions::max_hulls)
       .def_readwrite("max_vertices_per_hull", &DecomposeOptions::max_vertices_per_hull)
       .def_readwrite("min_depth_m", &DecomposeOptions::min_depth_m)
-      .def_readwrite("measure_resolution", &DecomposeOptions::measure_resolution);
+      .def_readwrite("measure_resolution", &DecomposeOptions::measure_resolution)
+      .def_readwrite("coverage_tolerance", &DecomposeOptions::coverage_tolerance)
+      .def_readwrite("max_hulls_per_object", &DecomposeOptions::max_hulls_per_object);
 
   py::class_<ConvexDecomposition>(m, "ConvexDecomposition", "One part's collision geometry: convex hulls.")
       .def(py::init<>())
@@ -70,6 +72,10 @@ void bind_decompose(py::module_& m) {
       .def_readwrite("hulls_volume_m3", &ConvexDecomposition::hulls_volume_m3)
       .def_readwrite("mean_distance_m", &ConvexDecomposition::mean_distance_m)
       .def_readwrite("max_distance_m", &ConvexDecomposition::max_distance_m)
+      .def_readwrite("uncovered_mean_m", &ConvexDecomposition::uncovered_mean_m)
+      .def_readwrite("uncovered_max_m", &ConvexDecomposition::uncovered_max_m)
+      .def_readwrite("hull_budget", &ConvexDecomposition::hull_budget)
+      .def_readwrite("coverage_tolerance_m", &ConvexDecomposition::coverage_tolerance_m)
       .def_readwrite("seconds", &ConvexDecomposition::seconds)
       .def_readwrite("notes", &ConvexDecomposition::notes)
       .def("__repr__", [](const ConvexDecomposition& d) {

@@ -131,4 +131,80 @@ Mesh chair_mesh(float cell_m) {
   return cells_mesh(cells, cell_m);
 }
 
+Mesh torus_mesh(double major_m, double minor_m, int segments, int sides) {
+  Mesh m;
+  const double pi = std::acos(-1.0);
+  for (int s = 0; s < segments; ++s)
+    for (int t = 0; t < sides; ++t) {
+      const double a = 2 * pi * s / segments, b = 2 * pi * t / sides;
+      const double r = major_m + minor_m * std::cos(b);
+      m.positions.emplace_back(static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)),
+                               static_cast<float>(minor_m * std::sin(b)));
+    }
+  for (int s = 0; s < segments; ++s)
+    for (int t = 0; t < sides; ++t) {
+      const int s1 = (s + 1) % segments, t1 = (t + 1) % sides;
+      const int a = s * sides + t, b = s1 * sides + t, c = s1 * sides + t1, d = s * sides + t1;
+      m.triangles.emplace_back(a, b, c);
+      m.triangles.emplace_back(a, c, d);
+    }
+  if (enclosed_volume(m) < 0)
+    for (Eigen::Vector3i& t : m.triangles) std::swap(t[1], t[2]);
+  return m;
+}
+
+Mesh mug_mesh() {
+  Mesh mug = cup_mesh(0.04, 0.1, 0.005, 0.008);
+  // The handle: the half of a torus about y at (0.0375, 0, 0.05) with
+  // x >= 0.0375, closed by flat caps at x = 0.0375, inside the wall.
+  const double pi = std::acos(-1.0), minor = 0.008, major = 0.03;
+  const Eigen::Vector3d centre(0.0375, 0.0, 0.05);
+  const int segments = 24, sides = 12;
+  Mesh h;
+  for (int s = 0; s <= segments; ++s)
+    for (int t = 0; t < sides; ++t) {
+      // From the bottom (-z) around the +x side to the top; the ends are
+      // pulled back into the wall (x = 0.0375).
+      const double a = -0.5 * pi + pi * s / segments, b = 2 * pi * t / sides;
+      const double r = major + minor * std::cos(b);
+      const Eigen::Vector3d p = centre + Eigen::Vector3d(r * std::cos(a), minor * std::sin(b), r * std::sin(a));
+      h.positions.push_back(p.cast<float>());
+    }
+  for (int s = 0; s < segments; ++s)
+    for (int t = 0; t < sides; ++t) {
+      const int t1 = (t + 1) % sides;
+      const int a = s * sides + t, b = (s + 1) * sides + t, c = (s + 1) * sides + t1, d = s * sides + t1;
+      h.triangles.emplace_back(a, b, c);
+      h.triangles.emplace_back(a, c, d);
+    }
+  for (int end : {0, segments}) {  // a fan over each end ring
+    const int middle = h.num_vertices();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int t = 0; t < sides; ++t) sum += h.positions[static_cast<std::size_t>(end * sides + t)].cast<double>();
+    h.positions.push_back((sum / sides).cast<float>());
+    for (int t = 0; t < sides; ++t) {
+      const int a = end * sides + t, b = end * sides + (t + 1) % sides;
+      if (end == 0)  // the tube runs the first ring's edges t + 1 -> t, the last ring's t -> t + 1
+        h.triangles.emplace_back(middle, a, b);
+      else
+        h.triangles.emplace_back(middle, b, a);
+    }
+  }
+  if (enclosed_volume(h) < 0)
+    for (Eigen::Vector3i& t : h.triangles) std::swap(t[1], t[2]);
+  const int offset = mug.num_vertices();
+  mug.positions.insert(mug.positions.end(), h.positions.begin(), h.positions.end());
+  for (const Eigen::Vector3i& t : h.triangles) mug.triangles.emplace_back(t + Eigen::Vector3i::Constant(offset));
+  return mug;
+}
+
+Mesh slatted_back_mesh(int slats, float cell_m) {
+  const int width = 3 * slats - 2;
+  std::vector<std::vector<std::vector<int>>> cells(10, std::vector<std::vector<int>>(1, std::vector<int>(width, 0)));
+  for (int x = 0; x < width; ++x) cells[0][0][x] = cells[9][0][x] = 1;  // the rails
+  for (int z = 1; z < 9; ++z)
+    for (int s = 0; s < slats; ++s) cells[z][0][3 * s] = 1;
+  return cells_mesh(cells, cell_m);
+}
+
 }  // namespace g2p::test

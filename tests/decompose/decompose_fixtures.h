@@ -35,4 +35,21 @@ Mesh cup_mesh(double radius_m, double height_m, double wall_m, double bottom_m, 
 // tall along the back edge (y = 7). One closed surface.
 Mesh chair_mesh(float cell_m);
 
+// A torus about +z through the origin: the tube's centre circle has radius
+// `major_m`, the tube radius `minor_m`. Its hole is an opening, no cavity.
+Mesh torus_mesh(double major_m, double minor_m, int segments = 48, int sides = 16);
+
+// A mug: cup_mesh(0.04, 0.1, 0.005, 0.008) with a handle, the +x half of
+// a torus in the xz plane about (0.0375, 0, 0.05) (the wall's middle;
+// radius 0.03 m, tube 0.008 m) whose capped ends sit inside the wall: two
+// overlapping closed surfaces, one part. The opening between handle and
+// wall is about 20 mm across, centred at (0.05, 0, 0.05).
+Mesh mug_mesh();
+
+// A chair's back of `slats` vertical slats, one cell wide with two-cell gaps,
+// between a bottom and a top rail one cell tall, 8 cells of slat between
+// them, one cell deep (y); the gaps are openings. The middle of gap g
+// (0-based) lies at x = (3 g + 2) cells, z = 5 cells, y = 0.5 cells.
+Mesh slatted_back_mesh(int slats, float cell_m);
+
 }  // namespace g2p::test

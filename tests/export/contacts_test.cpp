@@ -1,5 +1,5 @@
 // Contacts in MuJoCo: concave fixtures (a bowl, a cup, a chair-like frame, a
-// U channel) exported with their convex decomposition, probe balls dropped
+// U channel, a torus) exported with their convex decomposition, probe balls dropped
 // onto them with check_contacts_in_mujoco, and the free object dropped onto a
 // plane. The same fixtures exported as one convex hull show the failure the
 // decomposition removes: balls resting on the bowl's rim or the hull's slope.
@@ -134,6 +134,24 @@ TEST(Contacts, BallRestsInTheChannel) {
   EXPECT_TRUE(c.balls[0].on_object);
   EXPECT_NEAR(c.balls[0].rest.z() - c.balls[0].radius_m, 0.02, 0.004);
   expect_settled(c);
+}
+
+TEST(Contacts, BallFallsThroughTheTorusHole) {
+  // The hole is 15 cm across (tube centre radius 10 cm, tube 2.5 cm); the
+  // floor lies at the torus's lowest point.
+  const Mesh torus = test::torus_mesh(0.1, 0.025);
+  const ContactCheck c = check(export_fixture(torus, "torus", "voxel-cut"), {{0, 0}}, 0, 0.01);
+  ASSERT_EQ(c.balls.size(), 1u);
+  EXPECT_TRUE(c.balls[0].on_floor);
+  EXPECT_FALSE(c.balls[0].on_object);
+  EXPECT_LT(c.balls[0].rest.head<2>().norm(), 0.075 - 0.01) << "still under the hole";
+  expect_settled(c);
+
+  // One convex hull closes the hole: the ball stays on top of it.
+  const ContactCheck one = check(export_fixture(torus, "torus", "hull"), {{0, 0}}, 0, 0.01);
+  ASSERT_EQ(one.balls.size(), 1u);
+  EXPECT_TRUE(one.balls[0].on_object);
+  EXPECT_FALSE(one.balls[0].on_floor);
 }
 
 TEST(Contacts, GridOfBallsOverTheBowlAllSettle) {

@@ -54,6 +54,8 @@ RunOptions unusual() {
   o.decompose.max_vertices_per_hull = 32;
   o.decompose.min_depth_m = 0.002;
   o.decompose.measure_resolution = 40;
+  o.decompose.coverage_tolerance = 0.05;
+  o.decompose.max_hulls_per_object = 12;
   o.name = "thing";
   o.formats = {"urdf", "glb"};
   o.export_options.free_joint = false;

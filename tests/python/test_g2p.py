@@ -653,8 +653,14 @@ class DecomposeTest(unittest.TestCase):
             self.assertGreaterEqual(len(d.hulls), 1)
             for h in d.hulls:
                 self.assertLessEqual(h.num_vertices, 64)
+            self.assertGreaterEqual(d.hull_budget, 16)
+            self.assertGreater(d.coverage_tolerance_m, 0)
+            self.assertGreaterEqual(d.uncovered_max_m, d.uncovered_mean_m)
+            self.assertGreaterEqual(d.uncovered_mean_m, 0)
         one = quick_options()
         one.decompose.max_hulls = 1
+        one.decompose.max_hulls_per_object = 0  # no budget raised for --coverage-tolerance
+        self.assertAlmostEqual(one.decompose.coverage_tolerance, 0.03)
         for d in g2p.Pipeline(one).run_file(HAMMER).collision:
             self.assertEqual(len(d.hulls), 1)
 

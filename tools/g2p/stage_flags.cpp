@@ -95,7 +95,8 @@ void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
       ->capture_default_str();
   cmd->add_option("--decompose-set", args.settings,
                   "Decomposer setting KEY=VALUE, repeatable (`g2p run --settings decompose:NAME` lists them)");
-  cmd->add_option("--max-hulls", args.options.max_hulls, "Convex hulls per part at most (1-256)")
+  cmd->add_option("--max-hulls", args.options.max_hulls,
+                  "Convex hulls per part at most (1-256), unless --coverage-tolerance raises it")
       ->capture_default_str();
   cmd->add_option("--hull-vertices", args.options.max_vertices_per_hull,
                   "Vertices per convex hull at most (4-255; engines cap hulls at 255)")
@@ -103,6 +104,15 @@ void add_decomposer_flags(CLI::App* cmd, DecomposerArgs& args) {
   cmd->add_option("--min-concavity", args.options.min_depth_m,
                   "Leave concavities shallower than this alone, in metres (0: 1 % of the object's bounding-box "
                   "diagonal)")
+      ->capture_default_str();
+  cmd->add_option("--coverage-tolerance", args.options.coverage_tolerance,
+                  "Hulls should stand no farther outside a part, nor leave its surface uncovered by more, than this "
+                  "share of the object's bounding-box diagonal (0-1); a part that spends its hull budget and misses "
+                  "it gets twice the budget")
+      ->capture_default_str();
+  cmd->add_option("--max-hulls-per-object", args.options.max_hulls_per_object,
+                  "Convex hulls per object at most when raising part budgets for --coverage-tolerance (0: never "
+                  "raise)")
       ->capture_default_str();
 }
 

@@ -48,7 +48,8 @@ struct EstimatorArgs {
 };
 void add_estimator_flags(CLI::App* cmd, EstimatorArgs& args);
 
-// --decomposer, --decompose-set, --max-hulls, --hull-vertices, --min-concavity.
+// --decomposer, --decompose-set, --max-hulls, --hull-vertices, --min-concavity,
+// --coverage-tolerance, --max-hulls-per-object.
 struct DecomposerArgs {
   std::string name = PipelineOptions{}.decomposer.name;
   std::vector<std::string> settings;

@@ -40,6 +40,20 @@ struct DecomposeOptions {
   // Fidelity is measured on a voxel grid with this many cells along the part's
   // longest side: the distance below is exact to half a cell.
   int measure_resolution = 64;  // 16..512
+  // Coverage: a part's hulls should stand no farther outside its closed
+  // volume (max_distance_m below), and leave no point of its surface
+  // farther outside them (uncovered_max_m), than this share of the object's
+  // bounding-box diagonal (the part's when decompose_part() runs alone).
+  // decompose_parts() decomposes a part that spent its whole max_hulls
+  // budget and still misses it again with twice the budget, while the
+  // object's hulls stay within max_hulls_per_object; a part that still
+  // misses gets a note. docs/decompose.md gives the measurements behind the
+  // default.
+  double coverage_tolerance = 0.03;  // 0..1
+  // The most hulls decompose_parts() gives a whole object by raising part
+  // budgets (the first pass's max_hulls per part is never cut back); 0: no
+  // budget is raised.
+  int max_hulls_per_object = 256;  // 0..65536
 };
 
 // The collision geometry of one part.
@@ -57,6 +71,18 @@ struct ConvexDecomposition {
   // lies inside the volume). Contacts happen up to this far from the part.
   double mean_distance_m = 0.0;
   double max_distance_m = 0.0;
+  // The other way: how far the part's closed surface lies outside the union
+  // of its hulls (surface the hulls leave uncovered), the mean and the
+  // largest over about 20,000 area samples of the surface (and every vertex
+  // of a closed mesh of at most 20,000), in metres: the exact distance to
+  // the nearest hull at each sample, 0 where a hull holds it. Objects pass
+  // into the part this deep before they touch a hull.
+  double uncovered_mean_m = 0.0;
+  double uncovered_max_m = 0.0;
+  int hull_budget = 0;  // the max_hulls the hulls were made with (decompose_parts() may raise it)
+  // The distance both largest distances above should stay within
+  // (coverage_tolerance, in metres for this part); 0 where not checked.
+  double coverage_tolerance_m = 0.0;
   double seconds = 0.0;            // wall time of the decomposition and its measurement
   std::vector<std::string> notes;  // fallbacks, degenerate input, budgets that bound the result
 };
@@ -99,6 +125,11 @@ G2P_API Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Dec
 // Every part of a completion, in parallel; `backend` names the decomposer
 // in the results. A part that cannot be decomposed at all (no closed volume,
 // flat) gets no hulls and a note saying why; the call itself never fails.
+// A part whose hulls miss options.coverage_tolerance after spending its
+// whole budget is decomposed again with twice the budget (up to 256), the
+// worst part first, while the object's hulls stay within
+// options.max_hulls_per_object; the better result is kept, and a part that
+// still misses gets a note.
 // With the object and its parts (the completion's input), no hull gets more
 // vertices than the part's own faces have (at least 4), so that no
 // collision mesh is denser than the input it stands for, and min_depth_m

@@ -10,8 +10,10 @@
 #include <cmath>
 #include <mutex>
 #include <set>
+#include <sstream>
 
 #include "decompose/backends.h"
+#include "decompose/coverage.h"
 #include "decompose/voxel_grid.h"
 
 namespace g2p {
@@ -46,6 +48,11 @@ Status validate(const DecomposeOptions& o) {
   if (o.measure_resolution < 16 || o.measure_resolution > 512)
     return Status::InvalidArgument("the measuring grid's resolution must be 16..512 cells (got " +
                                    std::to_string(o.measure_resolution) + ")");
+  if (!(o.coverage_tolerance >= 0 && o.coverage_tolerance <= 1))
+    return Status::InvalidArgument("--coverage-tolerance must be a share of the object's diagonal, 0..1");
+  if (o.max_hulls_per_object < 0 || o.max_hulls_per_object > 65536)
+    return Status::InvalidArgument("--max-hulls-per-object must be 0..65536 (got " +
+                                   std::to_string(o.max_hulls_per_object) + ")");
   return Status::Ok();
 }
 
@@ -184,6 +191,11 @@ Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer&
   out.part_volume_m3 = enclosed_volume(closed);
   for (const Mesh& h : out.hulls) out.hulls_volume_m3 += enclosed_volume(h);
   measure(closed, options, out);
+  const detail::Uncovered uncovered = detail::uncovered_distance(closed, out.hulls);
+  out.uncovered_mean_m = uncovered.mean_m;
+  out.uncovered_max_m = uncovered.max_m;
+  out.hull_budget = options.max_hulls;
+  out.coverage_tolerance_m = options.coverage_tolerance * bounds(closed).diagonal().norm();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -219,7 +231,25 @@ ConvexDecomposition decompose_one(const Completion& completion, const Decomposer
   }
   out = std::move(*d);
   if (out.backend.empty()) out.backend = backend;
+  if (object != nullptr) out.coverage_tolerance_m = options.coverage_tolerance * bounds(*object).diagonal().norm();
   return out;
+}
+
+// The larger of the two distances decompose_parts() holds to the tolerance.
+double worst_distance(const ConvexDecomposition& d) { return std::max(d.max_distance_m, d.uncovered_max_m); }
+
+bool misses(const ConvexDecomposition& d) { return !d.hulls.empty() && worst_distance(d) > d.coverage_tolerance_m; }
+
+std::string millimetres(double m) {
+  std::ostringstream s;
+  s.precision(3);
+  s << 1000.0 * m << " mm";
+  return s.str();
+}
+
+std::string distances(const ConvexDecomposition& d) {
+  return "hulls stand up to " + millimetres(d.max_distance_m) + " outside the part and leave up to " +
+         millimetres(d.uncovered_max_m) + " of its surface uncovered";
 }
 
 }  // namespace
@@ -249,6 +279,92 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
                     "part " + std::to_string(i) + ": " + std::to_string(out[i].hulls.size()) + " hulls");
     if (!stop.ok()) stopped = true;
   });
+  if (stopped) return out;
+
+  // Coverage: parts that spent their whole budget and still miss the
+  // tolerance are decomposed again with twice the budget, the worst first,
+  // while the object's hulls stay within max_hulls_per_object.
+  constexpr int kMostHullsPerPart = 256;  // validate()'s bound on max_hulls
+  long total = 0;
+  for (const ConvexDecomposition& d : out) total += static_cast<long>(d.hulls.size());
+  std::vector<int> first_budget(out.size());
+  for (std::size_t i = 0; i < out.size(); ++i) first_budget[i] = out[i].hull_budget;
+  std::vector<bool> settled(out.size(), false);  // raising did not help, or cannot
+  for (;;) {
+    std::vector<std::size_t> candidates;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (!settled[i] && !out[i].fell_back && misses(out[i]) &&
+          static_cast<int>(out[i].hulls.size()) >= out[i].hull_budget && out[i].hull_budget < kMostHullsPerPart)
+        candidates.push_back(i);
+    std::sort(candidates.begin(), candidates.end(),
+              [&](std::size_t a, std::size_t b) { return worst_distance(out[a]) > worst_distance(out[b]); });
+    std::vector<std::pair<std::size_t, int>> round;  // part, its raised budget
+    long room = options.max_hulls_per_object - total;
+    for (std::size_t i : candidates) {
+      const int used = static_cast<int>(out[i].hulls.size());
+      const int budget = static_cast<int>(
+          std::min<long>({2L * out[i].hull_budget, kMostHullsPerPart, static_cast<long>(used) + room}));
+      if (budget <= used) continue;
+      room -= budget - used;
+      round.emplace_back(i, budget);
+    }
+    if (round.empty()) break;
+    if (progress) {  // a cancelled run stops raising; the hulls so far stand
+      std::lock_guard<std::mutex> lock(reporting);
+      if (!progress(1.0,
+                    "raising the hull budget of " + std::to_string(round.size()) + " parts for --coverage-tolerance")
+               .ok())
+        break;
+    }
+    std::vector<ConvexDecomposition> again(round.size());
+    tbb::parallel_for(std::size_t{0}, round.size(), [&](std::size_t r) {
+      DecomposeOptions raised = options;
+      raised.max_hulls = round[r].second;
+      again[r] = decompose_one(completion, decomposer, raised, backend, object, parts, round[r].first);
+    });
+    for (std::size_t r = 0; r < round.size(); ++r) {
+      const std::size_t i = round[r].first;
+      ConvexDecomposition& d = again[r];
+      // The largest distance need not fall with every doubling (one gap of
+      // several still bridged keeps it), so an equal one that spent its
+      // whole budget is kept and raised again; a worse one, or an equal one
+      // the backend finished within budget (more hulls for nothing), ends
+      // the raise with the result before it.
+      const bool better = worst_distance(d) < worst_distance(out[i]);
+      const bool progressing =
+          worst_distance(d) == worst_distance(out[i]) && static_cast<int>(d.hulls.size()) >= d.hull_budget;
+      if (d.hulls.empty() || d.fell_back || !(better || progressing)) {
+        settled[i] = true;
+        out[i].seconds += d.seconds;  // the attempt counts in the part's time
+        continue;
+      }
+      d.seconds += out[i].seconds;
+      total += static_cast<long>(d.hulls.size()) - static_cast<long>(out[i].hulls.size());
+      out[i] = std::move(d);
+    }
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    ConvexDecomposition& d = out[i];
+    if (d.hull_budget > first_budget[i])
+      d.notes.push_back("hull budget raised from " + std::to_string(first_budget[i]) + " to " +
+                        std::to_string(d.hull_budget) + " to bring the hulls within " +
+                        millimetres(d.coverage_tolerance_m) + " of the part (--coverage-tolerance)");
+    if (!misses(d)) continue;
+    std::string why;
+    if (static_cast<int>(d.hulls.size()) < d.hull_budget)
+      why = "the backend needed no more hulls (its own tolerance, or the part's fine detail)";
+    else if (d.fell_back)
+      why = "the part fell back to its single hull";
+    else if (settled[i])
+      why = "more hulls brought them no closer";
+    else if (d.hull_budget >= kMostHullsPerPart)
+      why = "the part's budget reached " + std::to_string(kMostHullsPerPart) + " hulls";
+    else
+      why = "the object's limit of " + std::to_string(options.max_hulls_per_object) +
+            " hulls is reached (--max-hulls-per-object)";
+    d.notes.push_back("coverage: " + distances(d) + ", beyond the tolerance of " + millimetres(d.coverage_tolerance_m) +
+                      " with " + std::to_string(d.hulls.size()) + " hulls: " + why);
+  }
   return out;
 }
 

@@ -153,6 +153,10 @@ std::string asset_report_json(const PropertiesReport& report, const SimulationAs
         {"volume_ratio", c.part_volume_m3 > 0 ? json(c.hulls_volume_m3 / c.part_volume_m3) : json(nullptr)},
         {"mean_distance_m", c.mean_distance_m},
         {"max_distance_m", c.max_distance_m},
+        {"uncovered_mean_m", c.uncovered_mean_m},
+        {"uncovered_max_m", c.uncovered_max_m},
+        {"hull_budget", c.hull_budget},
+        {"coverage_tolerance_m", c.coverage_tolerance_m},
         {"seconds", c.seconds},
         {"fell_back", c.fell_back},
         {"notes", c.notes}};

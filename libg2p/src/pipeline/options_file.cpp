@@ -81,7 +81,9 @@ json full_json(const RunOptions& r) {
              {{"max_hulls", d.max_hulls},
               {"max_vertices_per_hull", d.max_vertices_per_hull},
               {"min_depth_m", d.min_depth_m},
-              {"measure_resolution", d.measure_resolution}}},
+              {"measure_resolution", d.measure_resolution},
+              {"coverage_tolerance", d.coverage_tolerance},
+              {"max_hulls_per_object", d.max_hulls_per_object}}},
             {"name", o.name},
             {"formats", o.formats},
             {"free_joint", o.export_options.free_joint},
@@ -192,6 +194,8 @@ Result<RunOptions> options_of(const json& j, RunOptions r) {
   o.decompose.max_vertices_per_hull = d.at("max_vertices_per_hull").get<int>();
   o.decompose.min_depth_m = d.at("min_depth_m").get<double>();
   o.decompose.measure_resolution = d.at("measure_resolution").get<int>();
+  o.decompose.coverage_tolerance = d.at("coverage_tolerance").get<double>();
+  o.decompose.max_hulls_per_object = d.at("max_hulls_per_object").get<int>();
   o.name = j.at("name").get<std::string>();
   o.formats = j.at("formats").get<std::vector<std::string>>();
   o.export_options.free_joint = j.at("free_joint").get<bool>();

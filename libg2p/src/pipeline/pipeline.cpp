@@ -525,13 +525,18 @@ Status Pipeline::Impl::decompose_collision(RunState& s) {
                         return answer;
                       });
   if (!stopped.ok()) return stopped;
-  int hulls = 0, fell_back = 0, none = 0;
+  int hulls = 0, fell_back = 0, none = 0, uncovering = 0;
   for (std::size_t i = 0; i < r.collision.size(); ++i) {
     const ConvexDecomposition& d = r.collision[i];
     hulls += static_cast<int>(d.hulls.size());
     fell_back += d.fell_back ? 1 : 0;
     const bool weighed = i < r.properties.parts.size() && r.properties.parts[i].mass.mass_kg > 0;
     if (d.hulls.empty() && weighed) ++none;
+    // Beyond the tolerance with the whole budget spent: a part the backend
+    // finished early (the `hull` backend's every part) has its note only.
+    if (!d.hulls.empty() && static_cast<int>(d.hulls.size()) >= d.hull_budget &&
+        std::max(d.max_distance_m, d.uncovered_max_m) > d.coverage_tolerance_m)
+      ++uncovering;
     for (const std::string& n : d.notes) clock.report().notes.push_back("part " + std::to_string(i) + ": " + n);
   }
   clock.report().notes.push_back(std::to_string(hulls) + " convex hulls for " + std::to_string(r.collision.size()) +
@@ -540,6 +545,10 @@ Status Pipeline::Impl::decompose_collision(RunState& s) {
     r.warnings.push_back("decompose (" + clock.report().backend + "): " + std::to_string(fell_back) +
                          " parts fell back to their single convex hull and " + std::to_string(none) +
                          " have no collision shape (see report.json)");
+  if (uncovering > 0)
+    r.warnings.push_back("decompose (" + clock.report().backend + "): the hulls of " + std::to_string(uncovering) +
+                         " parts stay farther from their surfaces than --coverage-tolerance with their whole hull "
+                         "budget spent (see report.json's collision notes)");
   G2P_RETURN_IF_ERROR(s.context.report(Stage::kDecompose, 1.0, std::to_string(hulls) + " hulls"));
   s.finish(clock);
   return Status::Ok();

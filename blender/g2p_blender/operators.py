@@ -93,8 +93,9 @@ def build_scene(context, name, result, sources, corrections):
         if context.scene.rigidbody_world is None:
             with context.temp_override(scene=context.scene):
                 bpy.ops.rigidbody.world_add()
-        body = mesh_object(name, [], [], collection)
+        body = mesh_object(name + " (g2p)", [], [], collection)
         created.append(body)
+        body["g2p_collection"] = collection.name
         body.location = com
         body["g2p_mass_kg"] = result.mass_kg
         body["g2p_kind"] = result.kind
@@ -150,7 +151,8 @@ def build_scene(context, name, result, sources, corrections):
 
 def remove_result(body):
     """Removes a body object's collection and everything in it."""
-    for collection in list(body.users_collection):
+    collection = bpy.data.collections.get(body.get("g2p_collection", ""))
+    if collection is not None:
         for ob in list(collection.objects):
             data = ob.data
             bpy.data.objects.remove(ob)

@@ -19,7 +19,9 @@ import time
 try:
     import bpy
 except ImportError:
-    print("SKIPPED: run inside Blender (blender -b --python tests/blender/test_addon.py -- ...)")
+    reason = sys.argv[sys.argv.index("--skip-reason") + 1] if "--skip-reason" in sys.argv else \
+        "run inside Blender (blender -b --python tests/blender/test_addon.py -- ...)"
+    print("SKIPPED: " + reason)
     sys.exit(77)
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -163,6 +165,21 @@ def main():
     expected = reference(g2p, args.hammer, "")
     check_parts(args.hammer, hammer, expected)
     check_rigid_body(args.hammer, hammer, expected)
+
+    # A correction: the handle's density; the stages after it run again and the body is replaced.
+    wood = next(ob for ob in hammer.children if ob.get("g2p_class") == "Wood")
+    wood_mass, wood_density = wood["g2p_mass_kg"], wood["g2p_density_kg_m3"]
+    bpy.context.view_layer.objects.active = wood
+    wood.g2p_correction.density_kg_m3 = 1000.0
+    check(bpy.ops.g2p.correct(synchronous=True) == {"FINISHED"}, "the correction failed")
+    bodies = [ob for ob in bpy.data.objects if "g2p_sources" in ob]
+    check(len(bodies) == 1 and bodies[0].name == "hammer (g2p)", "the corrected run did not replace the body")
+    hammer = bodies[0]
+    wood = next(ob for ob in hammer.children if ob.get("g2p_class") == "Wood")
+    check(math.isclose(wood["g2p_mass_kg"], wood_mass * 1000.0 / wood_density, rel_tol=1e-6),
+          f"corrected handle: {wood['g2p_mass_kg']} kg, expected {wood_mass * 1000.0 / wood_density} kg")
+    check(math.isclose(hammer.rigid_body.mass, hammer["g2p_mass_kg"], rel_tol=1e-6), "the rigid body's mass was not updated")
+    print(f"corrected handle: {wood_mass:.4f} kg at {wood_density} kg/m^3 -> {wood['g2p_mass_kg']:.4f} kg at 1000")
 
     # A failed run changes nothing: an unknown segmenter is refused with an error.
     objects_before = len(bpy.data.objects)

@@ -25,27 +25,79 @@ def gather(context, objects, name):
             mesh.loop_triangles.foreach_get("vertices", triangles)
             slots = np.empty(len(mesh.loop_triangles), dtype=np.int32)
             mesh.loop_triangles.foreach_get("material_index", slots)
+            corner_uvs = None
+            if mesh.uv_layers.active is not None and any(textured(s.material) for s in ob.material_slots):
+                loops = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+                mesh.loop_triangles.foreach_get("loops", loops)
+                loop_uvs = np.empty(len(mesh.loops) * 2, dtype=np.float64)
+                mesh.uv_layers.active.data.foreach_get("uv", loop_uvs)
+                corner_uvs = loop_uvs.reshape(-1, 2)[loops]
         finally:
             ob_eval.to_mesh_clear()
         matrix = np.array(ob.matrix_world, dtype=np.float64)
         positions = positions.reshape(-1, 3) @ matrix[:3, :3].T + matrix[:3, 3]
         triangles = triangles.reshape(-1, 3)
+        uvs = None
+        if corner_uvs is not None:
+            source, triangles, uvs = core.split_by_uv(triangles, corner_uvs)
+            positions = positions[source]
         if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform turns the faces inside out
             triangles = triangles[:, ::-1]
         materials = [(s.material.name_full, material_record(s.material)) if s.material else None
                      for s in ob.material_slots]
-        data.add(positions, triangles, materials, slots)
+        data.add(positions, triangles, materials, slots, uvs)
     return data
+
+
+def principled(material):
+    if material is None or not material.use_nodes or material.node_tree is None:
+        return None
+    return next((n for n in material.node_tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
+
+
+def base_color_image(material):
+    """The image node feeding the Principled base colour directly, if any."""
+    bsdf = principled(material)
+    if bsdf is None or not bsdf.inputs["Base Color"].is_linked:
+        return None
+    node = bsdf.inputs["Base Color"].links[0].from_node
+    return node.image if node.type == "TEX_IMAGE" else None
+
+
+def image_bytes(image):
+    """(bytes, MIME type) of a PNG or JPEG image as packed or on disk, or None:
+    other images are not re-encoded (cheap only)."""
+    mime = {"PNG": "image/png", "JPEG": "image/jpeg"}.get(image.file_format)
+    if mime is None:
+        return None
+    if image.packed_file is not None:
+        return bytes(image.packed_file.data), mime
+    path = bpy.path.abspath(image.filepath)
+    try:
+        with open(path, "rb") as f:
+            return f.read(), mime
+    except OSError:
+        return None
+
+
+def textured(material):
+    image = base_color_image(material)
+    return image is not None and image_bytes(image) is not None
 
 
 def material_record(material):
     """A material's name and look, as glTF would carry them (linear base colour)."""
     record = {"name": material.name, "base_color": tuple(material.diffuse_color)}
-    bsdf = material.node_tree.nodes.get("Principled BSDF") if material.use_nodes and material.node_tree else None
+    bsdf = principled(material)
     if bsdf is not None:
         record["base_color"] = tuple(bsdf.inputs["Base Color"].default_value)
-        record["metallic"] = bsdf.inputs["Metallic"].default_value
-        record["roughness"] = bsdf.inputs["Roughness"].default_value
+        for key, socket in (("metallic", "Metallic"), ("roughness", "Roughness")):
+            if not bsdf.inputs[socket].is_linked:  # a texture drives it otherwise: glTF's default factor, 1
+                record[key] = bsdf.inputs[socket].default_value
+        image = base_color_image(material)
+        if image is not None and image_bytes(image) is not None:
+            record["base_color_image"] = image_bytes(image)
+            record["base_color"] = (1.0, 1.0, 1.0, 1.0)  # the input's factor is not recovered; glTF's default
     return record
 
 

@@ -38,6 +38,26 @@ class CoreTest(unittest.TestCase):
         self.assertAlmostEqual(model.materials[0].metallic, 1.0)
         np.testing.assert_allclose(model.materials[1].base_color[:3], [0.4, 0.2, 0.1], atol=1e-6)
 
+    def test_texture_and_uv_seams(self):
+        # A 1x1 PNG (red) on a square whose two triangles meet at a UV seam.
+        png = bytes.fromhex("89504e470d0a1a0a0000000d4948445200000001000000010802000000907753de"
+                            "0000000c4944415408d763f8cfc000000301010018dd8db00000000049454e44ae426082")
+        positions = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)
+        triangles = np.array([[0, 1, 2], [0, 2, 3]])
+        corner_uvs = np.array([[0, 0], [1, 0], [1, 1], [0.5, 0], [1, 1], [0, 1]], dtype=np.float64)
+        source, split, uvs = core.split_by_uv(triangles, corner_uvs)
+        self.assertEqual(len(source), 5)  # vertex 0 has two UVs
+        np.testing.assert_allclose(uvs[split.reshape(-1)], corner_uvs)
+        np.testing.assert_array_equal(source[split], triangles)
+        data = core.MeshInput("square")
+        data.add(positions[source], split, [("red", {"name": "red", "base_color_image": (png, "image/png")})],
+                 np.zeros(2), uvs)
+        model = data.model(g2p)
+        texture = model.materials[0].base_color_texture
+        self.assertFalse(texture.empty)
+        self.assertEqual(texture.image.shape, (1, 1, 4))
+        np.testing.assert_allclose(model.mesh.uvs.min(axis=0), [0, 0], atol=1e-6)
+
     def test_real_size(self):
         model = two_boxes().model(g2p, longest_side_m=0.5)
         np.testing.assert_allclose(model.mesh.bounds()[1], [0.5, 0.25, 0.25], atol=1e-6)

@@ -74,7 +74,7 @@ class G2P_SceneSettings(bpy.types.PropertyGroup):
         name="Longest side", unit="LENGTH", min=0.0,
         description="The object's real longest side (--longest-side); 0 = its size in the scene")
     max_hulls: bpy.props.IntProperty(
-        name="Hull budget", min=0, soft_max=64,
+        name="Hulls", min=0, soft_max=64,
         description="Most convex hulls per part; 0 = the library's default")
 
 
@@ -83,7 +83,8 @@ class G2P_Correction(bpy.types.PropertyGroup):
     klass: bpy.props.EnumProperty(name="Class", items=class_items)
     structure: bpy.props.EnumProperty(name="Structure", items=[(KEEP, "Keep", "as estimated"), ("solid", "Solid", ""),
                                                                 ("hollow", "Hollow", "")])
-    density_kg_m3: bpy.props.FloatProperty(name="Density (kg/m³)", min=0.0, description="0 = keep the estimate")
+    density_kg_m3: bpy.props.FloatProperty(name="Density", min=0.0,
+                                             description="kg/m³; 0 = keep the estimate")
 
 
 class G2P_PT_panel(bpy.types.Panel):
@@ -94,6 +95,8 @@ class G2P_PT_panel(bpy.types.Panel):
 
     def draw(self, context):
         layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
         settings = context.scene.g2p
         g2p, error = load_g2p(context)
         if g2p is None:
@@ -103,31 +106,35 @@ class G2P_PT_panel(bpy.types.Panel):
             defaults = core.library_defaults(g2p)
             layout.prop(settings, "segmenter")
             layout.prop(settings, "object_words")
-            row = layout.row()
-            row.prop(settings, "height_m")
-            row.prop(settings, "longest_side_m")
-            layout.prop(settings, "max_hulls",
-                        text=f"Hull budget (0 = {defaults['max_hulls']})")
+            layout.prop(settings, "height_m")
+            layout.prop(settings, "longest_side_m")
+            layout.prop(settings, "max_hulls")
+            if settings.max_hulls == 0:
+                layout.label(text=f"hull budget: the library's, {defaults['max_hulls']}")
         layout.operator("g2p.make_parts", icon="PHYSICS")
 
         part = context.active_object
+        body = part.parent if part is not None and "g2p_class" in part else part
+        if body is not None and "g2p_mass_kg" in body and "g2p_sources" in body:
+            layout.label(text=f"{body['g2p_mass_kg']:.4g} kg, {body['g2p_kind']}", icon="OBJECT_DATA")
         if part is None or "g2p_class" not in part:
             return
         box = layout.box()
-        box.label(text=f"{part.name}: part {part['g2p_part']}")
-        for key, label, fmt in (("g2p_class", "class", "{}"), ("g2p_structure", "structure", "{}"),
-                                ("g2p_wall_thickness_m", "wall", "{:.4g} m"),
-                                ("g2p_density_kg_m3", "density", "{:.4g} kg/m³"), ("g2p_mass_kg", "mass", "{:.4g} kg")):
-            if key in part:
-                row = box.row()
-                row.label(text=label)
-                row.label(text=fmt.format(part[key]))
+        box.label(text=f"part {part['g2p_part']}: {part['g2p_class']}")
+        rows = [("structure", part["g2p_structure"])]
+        if part["g2p_structure"] == "hollow":
+            rows.append(("wall", f"{part['g2p_wall_thickness_m'] * 1000:.3g} mm"))
+        rows += [("density", f"{part['g2p_density_kg_m3']:.4g} kg/m³"), ("mass", f"{part['g2p_mass_kg']:.4g} kg")]
+        for label, value in rows:
+            row = box.row()
+            row.label(text=label)
+            row.label(text=value)
         if g2p is not None:
             box.label(text="Correction")
             correction = part.g2p_correction
             box.prop(correction, "klass")
             box.prop(correction, "structure")
-            box.prop(correction, "density_kg_m3")
+            box.prop(correction, "density_kg_m3", text="Density")
             box.operator("g2p.correct", icon="FILE_REFRESH")
 
 

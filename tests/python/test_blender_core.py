@@ -13,6 +13,9 @@ import g2p
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "blender", "g2p_blender"))
 import core  # noqa: E402  (the add-on's package imports bpy; core does not)
 
+HAMMER = os.environ.get("G2P_HAMMER_OBJ",
+                        os.path.join(os.path.dirname(__file__), "..", "..", "examples", "data", "hammer.obj"))
+
 
 def two_boxes():
     """Two unit cubes side by side (2 x 1 x 1 m), one material each."""
@@ -83,6 +86,31 @@ class CoreTest(unittest.TestCase):
         self.assertTrue(overrides.changes_classes)
         with self.assertRaises(g2p.Error):
             core.correction_overrides(g2p, [{"faces": [0], "class": "Nothing"}], g2p.MaterialTable(), 24)
+
+    def test_run_on_a_thread_and_its_records(self):
+        run = core.Run(g2p, g2p.load_model(HAMMER), core.pipeline_options(g2p))
+        run.start()
+        run._thread.join(120)
+        self.assertIsNone(run.error)
+        self.assertEqual(run.progress, 1.0)
+        records = core.part_records(run.result)
+        self.assertEqual([r["class"] for r in records], [p["class"] for p in run.result.properties])
+        self.assertAlmostEqual(sum(r["mass_kg"] for r in records), run.result.mass_kg)
+        for r in records:
+            self.assertGreater(len(r["triangles"]), 0)
+            self.assertGreater(len(r["hulls"]), 0)
+        friction, restitution = core.contact_settings(records)
+        self.assertTrue(0 < friction < 2 and 0 <= restitution <= 1)
+
+    def test_run_on_a_thread_and_cancel(self):
+        model = g2p.load_model(HAMMER)
+        run = core.Run(g2p, model, core.pipeline_options(g2p))
+        run.cancel()  # before it starts: it stops at its first check
+        run.start()
+        run._thread.join(60)
+        self.assertTrue(run.done)
+        self.assertTrue(run.cancelled, run.error)
+        self.assertIsNone(run.result)
 
     def test_missing_module_says_where(self):
         saved = sys.modules.pop("g2p")

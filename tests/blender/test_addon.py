@@ -1,9 +1,11 @@
 """The Blender add-on (blender/g2p_blender) in Debian's Blender, headless:
 
+  BLENDER_USER_SCRIPTS=$(mktemp -d) BLENDER_USER_CONFIG=$(mktemp -d) \
   blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
       --module build/python --hammer examples/data/hammer.obj --asset ../shared/assets/X/X.glb [--segmenter S]
 
-Imports each model, runs the add-on's operator on it, checks the parts and
+Installs the add-on from its zip into BLENDER_USER_SCRIPTS (without it, registers it from the
+source tree), checks the error when the g2p module is not found, then imports each model, runs the add-on's operator on it, checks the parts and
 masses against the Python pipeline's run of the same file with the same
 options (what `g2p run` reports), checks the rigid body settings, and drops
 the asset onto a plane in Blender's rigid body world: it must come to rest,
@@ -14,7 +16,9 @@ import json
 import math
 import os
 import sys
+import tempfile
 import time
+import zipfile
 
 try:
     import bpy
@@ -43,7 +47,16 @@ def check(condition, message):
 
 
 def clear_scene():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    """An empty scene, the add-on still enabled (read_factory_settings would reset the preferences)."""
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob)
+    for data in (bpy.data.meshes, bpy.data.materials, bpy.data.collections, bpy.data.images):
+        for item in list(data):
+            data.remove(item)
+    scene = bpy.context.scene
+    if scene.rigidbody_world is not None:
+        bpy.ops.rigidbody.world_remove()
+    scene.frame_set(1)
 
 
 def import_model(path):
@@ -148,17 +161,69 @@ def drop(path, body, seconds=2.0, height_m=0.05):
                                           "off vertical)")
 
 
+def install_addon(work):
+    """Installs the add-on as a user does: its zip through Preferences' Install, then enabled.
+    The user folders are the test's own (BLENDER_USER_SCRIPTS, BLENDER_USER_CONFIG from ctest)."""
+    import addon_utils
+    zip_path = os.path.join(work, "g2p_blender.zip")
+    with zipfile.ZipFile(zip_path, "w") as z:
+        package = os.path.join(REPO, "blender", "g2p_blender")
+        for name in sorted(os.listdir(package)):
+            if name.endswith(".py"):
+                z.write(os.path.join(package, name), os.path.join("g2p_blender", name))
+    bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+    addon_utils.enable("g2p_blender", default_set=True, handle_error=None)
+    check("g2p_blender" in bpy.context.preferences.addons, "the add-on did not enable from its zip")
+    return bpy.context.preferences.addons["g2p_blender"].preferences
+
+
+def expect_error(what, words, **operator_args):
+    """The operator must fail with an ERROR report holding `words` and leave the scene as it was."""
+    objects, meshes = len(bpy.data.objects), len(bpy.data.meshes)
+    collections = len(bpy.data.collections)
+    try:
+        bpy.ops.g2p.make_parts(synchronous=True, **operator_args)
+        raise AssertionError(f"{what}: the operator did not fail")
+    except RuntimeError as e:  # bpy.ops raises the operator's ERROR report
+        check(words in str(e), f"{what}: the error says {str(e)!r}, not {words!r}")
+        print(f"{what}: {str(e).splitlines()[0][:160]}")
+    check((len(bpy.data.objects), len(bpy.data.meshes), len(bpy.data.collections)) == (objects, meshes, collections),
+          f"{what}: the failed run changed the scene")
+
+
+def select_sources(body):
+    bpy.ops.object.select_all(action="DESELECT")
+    for name in json.loads(body["g2p_sources"]):
+        bpy.data.objects[name].hide_set(False)
+        bpy.data.objects[name].select_set(True)
+
+
 def main():
     args = parse_args()
     start = time.time()
-    for path in filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep)):
-        sys.path.insert(0, path)  # Blender ignores PYTHONPATH unless --python-use-system-env
-    if args.module:
-        sys.path.insert(0, args.module)
-    sys.path.insert(0, os.path.join(REPO, "blender"))
-    import g2p
-    import g2p_blender
-    g2p_blender.register()
+    if os.environ.get("BLENDER_USER_SCRIPTS"):
+        with tempfile.TemporaryDirectory() as work:
+            prefs = install_addon(work)
+    else:  # not into the user's own add-ons: registered from the source tree
+        print("BLENDER_USER_SCRIPTS is not set: the add-on is registered from blender/, not installed from its zip")
+        sys.path.insert(0, os.path.join(REPO, "blender"))
+        import g2p_blender
+        g2p_blender.register()
+        prefs = argparse.Namespace(module_path="")
+        if args.module:
+            sys.path.insert(0, args.module)
+
+    # Without the module: a clear error, nothing changed (unless g2p is installed system-wide).
+    clear_scene()
+    import_model(args.hammer)
+    try:
+        import g2p  # noqa: F401
+        print("g2p imports without the add-on's module folder: the missing-module check is skipped")
+    except ImportError:
+        expect_error("no module", "cannot import the g2p Python module")
+    prefs.module_path = args.module or next(iter(os.environ.get("PYTHONPATH", "").split(os.pathsep)), "")
+    from g2p_blender import core
+    g2p = core.import_g2p(prefs.module_path)  # as the add-on finds it
 
     # The hammer: parts and masses as the library's, rigid body settings.
     hammer = run_addon(args.hammer, "")
@@ -178,23 +243,16 @@ def main():
     wood = next(ob for ob in hammer.children if ob.get("g2p_class") == "Wood")
     check(math.isclose(wood["g2p_mass_kg"], wood_mass * 1000.0 / wood_density, rel_tol=1e-6),
           f"corrected handle: {wood['g2p_mass_kg']} kg, expected {wood_mass * 1000.0 / wood_density} kg")
-    check(math.isclose(hammer.rigid_body.mass, hammer["g2p_mass_kg"], rel_tol=1e-6), "the rigid body's mass was not updated")
+    check(math.isclose(hammer.rigid_body.mass, hammer["g2p_mass_kg"], rel_tol=1e-6),
+          "the rigid body's mass was not updated")
     print(f"corrected handle: {wood_mass:.4f} kg at {wood_density} kg/m^3 -> {wood['g2p_mass_kg']:.4f} kg at 1000")
 
-    # A failed run changes nothing: an unknown segmenter is refused with an error.
-    objects_before = len(bpy.data.objects)
-    bpy.context.scene.g2p.max_hulls = 0
-    sources = [bpy.data.objects[n].name for n in json.loads(hammer["g2p_sources"])]
-    bpy.ops.object.select_all(action="DESELECT")
-    for n in sources:
-        bpy.data.objects[n].hide_set(False)
-        bpy.data.objects[n].select_set(True)
-    try:
-        bpy.ops.g2p.make_parts(synchronous=True, corrections='[{"faces": [0], "class": "NoSuchClass"}]')
-        raise AssertionError("a bad correction did not fail")
-    except RuntimeError as e:  # bpy.ops raises the operator's ERROR report
-        print(f"the expected error: {e}")
-    check(len(bpy.data.objects) == objects_before, "a failed run changed the scene")
+    # Failures change nothing: a correction the library refuses, a run that fails.
+    select_sources(hammer)
+    expect_error("bad correction", "unknown class 'NoSuchClass'", corrections='[{"faces": [0], "class": "NoSuchClass"}]')
+    bpy.context.scene.g2p.segmenter = "oracle"  # needs a labels file: the run fails
+    expect_error("failed run", "g2p run failed")
+    bpy.context.scene.g2p.segmenter = "DEFAULT"
 
     # The shared asset: the same checks, and the drop.
     asset = run_addon(args.asset, args.segmenter)

@@ -228,7 +228,7 @@ class G2P_OT_make_parts(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return any(ob.type == "MESH" for ob in context.selected_objects) or context.active_object is not None
+        return context.mode == "OBJECT"  # what is missing beyond that is reported, not greyed out
 
     def prepare(self, context):
         """The run, or None after reporting why not."""
@@ -250,8 +250,8 @@ class G2P_OT_make_parts(bpy.types.Operator):
             return None
         self._sources = [ob.name for ob in objects]
         self._corrections = json.loads(self.corrections) if self.corrections else []
-        name = objects[0].name if len(objects) == 1 else context.view_layer.objects.active.name \
-            if context.view_layer.objects.active in objects else objects[0].name
+        active = context.view_layer.objects.active
+        name = active.name if active in objects else objects[0].name
         settings = context.scene.g2p
         try:
             data = gather(context, objects, name)
@@ -285,6 +285,10 @@ class G2P_OT_make_parts(bpy.types.Operator):
             body.name = self.replace  # keep the name the user knew
         for name in self._sources:
             bpy.data.objects[name].hide_set(True)
+        for ob in context.view_layer.objects:
+            ob.select_set(False)
+        body.select_set(True)
+        context.view_layer.objects.active = body
         for w in run.result.warnings:
             self.report({"WARNING"}, f"g2p: {w}")
         self.report({"INFO"}, f"g2p: {len(run.result.properties)} parts, {run.result.mass_kg:.4g} kg")
@@ -311,7 +315,7 @@ class G2P_OT_make_parts(bpy.types.Operator):
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
-        if event.type == "ESC":
+        if event.type == "ESC" and event.value == "PRESS":
             self._run.cancel()
             context.workspace.status_text_set("g2p: cancelling...")
             return {"RUNNING_MODAL"}

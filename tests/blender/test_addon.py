@@ -246,6 +246,16 @@ def main():
     check(math.isclose(hammer.rigid_body.mass, hammer["g2p_mass_kg"], rel_tol=1e-6),
           "the rigid body's mass was not updated")
     print(f"corrected handle: {wood_mass:.4f} kg at {wood_density} kg/m^3 -> {wood['g2p_mass_kg']:.4f} kg at 1000")
+    # A second correction, the class: it accumulates on the first (whose density still stands).
+    bpy.context.view_layer.objects.active = wood
+    wood.g2p_correction.klass = "Plastic"
+    check(bpy.ops.g2p.correct(synchronous=True) == {"FINISHED"}, "the class correction failed")
+    hammer = next(ob for ob in bpy.data.objects if "g2p_sources" in ob)
+    classes = sorted(ob["g2p_class"] for ob in hammer.children if "g2p_class" in ob)
+    check(classes == ["Metal", "Plastic"], f"after the class correction the parts are {classes}")
+    handle = next(ob for ob in hammer.children if ob.get("g2p_class") == "Plastic")
+    check(math.isclose(handle["g2p_density_kg_m3"], 1000.0), f"the handle's density is {handle['g2p_density_kg_m3']}")
+    check(len(json.loads(hammer["g2p_corrections"])) == 2, "the corrections did not accumulate")
 
     # Failures change nothing: a correction the library refuses, a run that fails.
     select_sources(hammer)

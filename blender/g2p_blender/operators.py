@@ -284,7 +284,9 @@ class G2P_OT_make_parts(bpy.types.Operator):
             remove_result(bpy.data.objects[self.replace])
             body.name = self.replace  # keep the name the user knew
         for name in self._sources:
-            bpy.data.objects[name].hide_set(True)
+            source = bpy.data.objects.get(name)
+            if source is not None and source.name in context.view_layer.objects:
+                source.hide_set(True)
         for ob in context.view_layer.objects:
             ob.select_set(False)
         body.select_set(True)

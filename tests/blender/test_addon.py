@@ -201,6 +201,9 @@ def select_sources(body):
 def main():
     args = parse_args()
     start = time.time()
+    if not os.path.exists(args.asset):
+        print(f"SKIPPED: the shared asset {args.asset} is missing (G2P_SHARED_ASSETS)")
+        sys.exit(77)
     if os.environ.get("BLENDER_USER_SCRIPTS"):
         with tempfile.TemporaryDirectory() as work:
             prefs = install_addon(work)

@@ -27,7 +27,8 @@ core=(
 # object table's check (scripts/objects/build_objects.py --check); Chromium for
 # the summary.html browser tests (headless); DART 6.12 with its URDF and SDF
 # readers and ODE's collision detector, the second engine the URDF and SDF are
-# dropped in (tests/export/dart_test.cpp; about 200 MB, most of it Boost).
+# dropped in (tests/export/dart_test.cpp; about 200 MB, most of it Boost);
+# Blender 3.4 for the add-on's headless test (tests/blender; 363 MB installed).
 extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
@@ -39,6 +40,7 @@ extra=(
   python3-pandas python3-dask python3-distributed
   clang libclang-rt-14-dev
   chromium
+  blender
 )
 
 pkgs=("${core[@]}")

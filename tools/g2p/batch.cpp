@@ -91,6 +91,13 @@ int usage(const std::string& message) {
   return kExitUsage;
 }
 
+#ifndef G2P_CLI_PYTHON_DIR
+#define G2P_CLI_PYTHON_DIR ""
+#endif
+#ifndef G2P_CLI_INSTALLED_PYTHON_DIR
+#define G2P_CLI_INSTALLED_PYTHON_DIR ""
+#endif
+
 // `g2p batch --scheduler ADDRESS`: the same batch through the Python module's
 // Dask executor (g2p.batch(..., client=Client(ADDRESS))): this process
 // becomes bindings/python/g2p_dask_batch.py, which reports as this one does.
@@ -108,8 +115,17 @@ int run_on_dask(const BatchArgs& args, const RunOptions& options) {
                             {"fail_on_error", args.fail_on_error},
                             {"quiet", args.quiet}};
   const std::string j = a.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  // The module of this build first (the installed one, or PYTHONPATH's, otherwise).
-  const std::string dir = G2P_CLI_PYTHON_DIR, driver = dir + "/g2p_dask_batch.py";
+  // The module of this build first, then the installed one.
+  std::string dir;
+  for (const char* candidate : {G2P_CLI_PYTHON_DIR, G2P_CLI_INSTALLED_PYTHON_DIR}) {
+    if (*candidate != '\0' && ::access((std::string(candidate) + "/g2p_dask_batch.py").c_str(), R_OK) == 0) {
+      dir = candidate;
+      break;
+    }
+  }
+  if (dir.empty())
+    return usage("--scheduler needs libg2p's Python module (build it with pybind11-dev, or install python3-g2p)");
+  const std::string driver = dir + "/g2p_dask_batch.py";
   std::string path = dir;
   if (const char* old = std::getenv("PYTHONPATH"); old != nullptr && *old != '\0') path += std::string(":") + old;
   ::setenv("PYTHONPATH", path.c_str(), 1);

@@ -41,9 +41,8 @@ struct NameScores {
 };
 NameScores pbr_name_scores(const Model& model, const MaterialTable& table);
 
-// The card of the network libg2p ships (g2p-materials.json in $G2P_MODEL_DIR,
-// the source tree's libg2p/data/models or the installed share/g2p/models), or
-// "" when none is found.
+// The card of the network libg2p ships (g2p-materials.json where
+// shipped_model_file looks), or "" when none is found.
 std::string shipped_model_card();
 // shipped_model_file (core/model_files.h): a file beside the network.
 

@@ -126,8 +126,9 @@ class HybridSegmenter final : public Segmenter {
       const std::string card = detail::shipped_model_card();
       if (card.empty()) {
         unavailable_ =
-            "hybrid: the shipped network's card g2p-materials.json was not found ($G2P_MODEL_DIR, the source tree, "
-            "share/g2p/models); every material is labelled as 'pbr' labels it";
+            "hybrid: the shipped network's card g2p-materials.json was not found ($G2P_MODEL_DIR, share/g2p/models "
+            "beside libg2p, "
+            "the source tree, the install prefix); every material is labelled as 'pbr' labels it";
         return Status::Ok();
       }
       network["model_card"] = card;

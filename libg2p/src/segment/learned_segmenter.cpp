@@ -24,10 +24,10 @@
 // labels alone.
 //
 // Settings: model_card = FILE (default: the network libg2p ships, found in
-// $G2P_MODEL_DIR, the source tree's libg2p/data/models or the installed
-// share/g2p/models); flip = on|off (the network's test-time mirroring, see
-// onnx_segmenter.cpp; default off); names = threshold in (0, 1] (default 0.9) or "off" (the
-// network alone); pbr = on (default) or off (authored PBR values do not count).
+// $G2P_MODEL_DIR, share/g2p/models beside libg2p, the source tree's
+// libg2p/data/models or the install prefix's share/g2p/models); flip = on|off
+// (the network's test-time mirroring, see onnx_segmenter.cpp; default off); names = threshold in (0, 1] (default 0.9)
+// or "off" (the network alone); pbr = on (default) or off (authored PBR values do not count).
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>

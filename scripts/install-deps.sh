@@ -28,7 +28,9 @@ core=(
 # the summary.html browser tests (headless); DART 6.12 with its URDF and SDF
 # readers and ODE's collision detector, the second engine the URDF and SDF are
 # dropped in (tests/export/dart_test.cpp; about 200 MB, most of it Boost);
-# Blender 3.4 for the add-on's headless test (tests/blender; 363 MB installed).
+# Blender 3.4 for the add-on's headless test (tests/blender; 363 MB installed);
+# debhelper, dh-python, help2man and lintian build and check the Debian packages
+# (debian/, scripts/check-packages.sh).
 extra=(
   libgtest-dev libgmock-dev libbenchmark-dev
   assimp-testmodels
@@ -41,6 +43,7 @@ extra=(
   clang libclang-rt-14-dev
   chromium
   blender
+  debhelper dh-python help2man lintian
 )
 
 pkgs=("${core[@]}")

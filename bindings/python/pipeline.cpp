@@ -554,7 +554,21 @@ void bind_pipeline(py::module_& m) {
           py::arg("folder"), py::arg("first"), py::arg("last") = Stage::kExport, py::arg("progress") = py::none(),
           py::arg("context") = py::none(),
           "Reads an output folder (write_output's) and runs the stages from first to last on it, as g2p refine, "
-          "complete, properties and export do; the result holds the folder's earlier stages.");
+          "complete, properties and export do; the result holds the folder's earlier stages.")
+      .def(
+          "resume",
+          [](PyPipeline& p, const PyPipelineResult& result, Stage first, Stage last, const py::object& progress,
+             const py::object& context) {
+            PipelineResult state = result;  // the earlier result stays as it was
+            return run_pipeline(
+                p, [&](RunContext* ctx) { return p.pipeline.resume(std::move(state), first, last, ctx); }, progress,
+                context);
+          },
+          py::arg("result"), py::arg("first"), py::arg("last") = Stage::kExport, py::arg("progress") = py::none(),
+          py::arg("context") = py::none(),
+          "Runs the stages from first to last on a copy of an earlier run's result, without files: corrections in "
+          "options.overrides go back as far as what they change (classes: complete; properties or the object: "
+          "properties), after the result's own.");
 
   m.def(
       "write_output",

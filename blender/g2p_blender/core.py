@@ -4,9 +4,9 @@ Python (and used by the operators inside Blender)."""
 
 import importlib
 import json
-import struct
 import sys
 import threading
+import uuid
 
 import numpy as np
 
@@ -56,125 +56,6 @@ def pipeline_options(g2p, segmenter="", object_words="", max_hulls=0, overrides=
     if overrides is not None:
         options.overrides = overrides
     return options
-
-
-class MeshInput:
-    """The selected objects' geometry as one model: world-space positions in
-    metres (+Z up, as Blender and g2p), triangles, a material per face.
-
-    The model reaches g2p as a GLB built in memory (g2p.load_model_from_memory),
-    not Model.from_arrays: the segmenter reads the materials' names, base
-    colours and metallic/roughness, which from_arrays cannot carry, and the
-    import applies the real size (height_m, longest_side_m) as `g2p run` does."""
-
-    def __init__(self, name="object"):
-        self.name = name
-        self._positions = []
-        self._triangles = []
-        self._face_materials = []
-        self._uvs = []  # per object: (N, 2) in Blender's convention (v up), or None
-        self.materials = []  # dicts: name, base_color (linear RGBA), metallic, roughness
-        self._material_index = {}  # material key -> index into materials
-        self._vertices = 0
-
-    def add(self, positions, triangles, slot_materials, triangle_slots, uvs=None):
-        """One object's mesh: positions (N, 3), triangles (M, 3), its slots'
-        materials as (key, dict) or None per slot, each triangle's slot, and
-        optionally per-vertex texture coordinates (N, 2), v up as in Blender.
-        A material dict holds name, base_color (linear RGBA), metallic,
-        roughness and base_color_image: (bytes, 'image/png' or 'image/jpeg')."""
-        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-        triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-        triangle_slots = np.asarray(triangle_slots, dtype=np.int64).reshape(-1)
-        slot_to_material = []
-        for slot in slot_materials or [None]:
-            key, material = slot if slot is not None else (None, {})
-            if key not in self._material_index:
-                self._material_index[key] = len(self.materials)
-                material = dict(material)
-                material.setdefault("name", "material_" + str(len(self.materials)))
-                self.materials.append(material)
-            slot_to_material.append(self._material_index[key])
-        slots = np.clip(triangle_slots, 0, len(slot_to_material) - 1)
-        self._positions.append(positions)
-        self._uvs.append(None if uvs is None else np.asarray(uvs, dtype=np.float64).reshape(-1, 2))
-        self._triangles.append(triangles + self._vertices)
-        self._face_materials.append(np.asarray(slot_to_material, dtype=np.int32)[slots])
-        self._vertices += len(positions)
-
-    def arrays(self):
-        if not self._triangles or not sum(len(t) for t in self._triangles):
-            raise ValueError("no triangles in the selected objects")
-        return (np.concatenate(self._positions), np.concatenate(self._triangles).astype(np.uint32),
-                np.concatenate(self._face_materials))
-
-    def glb(self):
-        """The model as GLB bytes: one mesh, a primitive per material sharing
-        one vertex buffer, +Y up as glTF says (g2p turns it back to +Z)."""
-        positions, triangles, face_materials = self.arrays()
-        gltf_positions = np.ascontiguousarray(positions[:, [0, 2, 1]] * [1, 1, -1], dtype=np.float32)
-        blob = bytearray()
-        views, accessors = [], []
-
-        def add_view(data, **extra):
-            views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), **extra})
-            blob.extend(data)
-            blob.extend(b"\0" * (-len(blob) % 4))
-            return len(views) - 1
-
-        accessors.append({"bufferView": add_view(gltf_positions.tobytes(), target=34962), "componentType": 5126,
-                          "count": len(gltf_positions), "type": "VEC3",
-                          "min": gltf_positions.min(axis=0).tolist(), "max": gltf_positions.max(axis=0).tolist()})
-        attributes = {"POSITION": 0}
-        if any(uv is not None for uv in self._uvs):
-            uvs = np.concatenate([uv if uv is not None else np.zeros((len(p), 2))
-                                  for uv, p in zip(self._uvs, self._positions)])
-            gltf_uvs = np.ascontiguousarray(np.stack([uvs[:, 0], 1.0 - uvs[:, 1]], axis=1), dtype=np.float32)
-            accessors.append({"bufferView": add_view(gltf_uvs.tobytes(), target=34962), "componentType": 5126,
-                              "count": len(gltf_uvs), "type": "VEC2"})
-            attributes["TEXCOORD_0"] = len(accessors) - 1
-        primitives = []
-        for m in range(len(self.materials)):
-            indices = np.ascontiguousarray(triangles[face_materials == m], dtype=np.uint32).tobytes()
-            if not indices:
-                continue
-            accessors.append({"bufferView": add_view(indices, target=34963), "componentType": 5125,
-                              "count": len(indices) // 4, "type": "SCALAR"})
-            primitives.append({"attributes": attributes, "indices": len(accessors) - 1, "material": m})
-        materials, images = [], []
-        for m in self.materials:
-            pbr = {"baseColorFactor": [float(c) for c in m.get("base_color", (0.8, 0.8, 0.8, 1.0))]}
-            for key, gltf_key in (("metallic", "metallicFactor"), ("roughness", "roughnessFactor")):
-                if key in m:
-                    pbr[gltf_key] = float(m[key])
-            if m.get("base_color_image") and "TEXCOORD_0" in attributes:
-                data, mime = m["base_color_image"]
-                images.append({"bufferView": add_view(data), "mimeType": mime})
-                pbr["baseColorTexture"] = {"index": len(images) - 1}
-            materials.append({"name": m["name"], "pbrMetallicRoughness": pbr})
-        document = {"asset": {"version": "2.0", "generator": "g2p Blender add-on"}, "scene": 0,
-                    "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": self.name}],
-                    "meshes": [{"name": self.name, "primitives": primitives}], "materials": materials,
-                    "accessors": accessors, "bufferViews": views, "buffers": [{"byteLength": len(blob)}]}
-        if images:
-            document["images"] = images
-            document["textures"] = [{"source": i} for i in range(len(images))]
-        text = json.dumps(document).encode()
-        text += b" " * (-len(text) % 4)
-        chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(blob), 0x004E4942) + blob
-        return bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks)
-
-    def model(self, g2p, height_m=0.0, longest_side_m=0.0):
-        return g2p.load_model_from_memory(self.glb(), "glb", height_m=height_m, longest_side_m=longest_side_m)
-
-
-def split_by_uv(triangles, corner_uvs):
-    """Per-vertex texture coordinates from per-corner ones (Blender's loops):
-    a vertex with several UVs (a seam) becomes several vertices, as in any
-    glTF. Returns (source vertex per new vertex, new triangles, uvs)."""
-    corners = np.concatenate([triangles.reshape(-1, 1).astype(np.float64), corner_uvs.reshape(-1, 2)], axis=1)
-    keys, inverse = np.unique(corners, axis=0, return_inverse=True)
-    return keys[:, 0].astype(np.int64), inverse.reshape(-1, 3), keys[:, 1:]
 
 
 def correction_overrides(g2p, corrections, table, faces_total):
@@ -233,14 +114,39 @@ def contact_settings(records):
     return friction, restitution
 
 
+class ResultCache:
+    """The last few runs' results, by a key the scene keeps on the body object,
+    so that a correction resumes its run instead of starting over. Blender
+    cannot store them in the .blend file; after a reload a correction reruns
+    the pipeline from the source objects, with the same outcome."""
+
+    def __init__(self, size=4):
+        self.size = size
+        self._items = {}  # key -> result, oldest first
+
+    def put(self, result):
+        key = uuid.uuid4().hex
+        self._items[key] = result
+        while len(self._items) > self.size:
+            del self._items[next(iter(self._items))]
+        return key
+
+    def get(self, key):
+        return self._items.get(key)
+
+
 class Run:
     """A pipeline run on a worker thread: progress and cancellation through
-    g2p.RunContext, the result or the error when it is done."""
+    g2p.RunContext, the result or the error when it is done. With `previous`
+    (an earlier run's result) it resumes that run with options.overrides: the
+    library goes back as far as they change (classes: complete; properties:
+    properties) and reuses the views, labels and parts before that."""
 
-    def __init__(self, g2p, model, options):
+    def __init__(self, g2p, model, options, previous=None):
         self.g2p = g2p
         self.model = model
         self.options = options
+        self.previous = previous
         self.progress = 0.0
         self.message = "starting"
         self.result = None
@@ -256,7 +162,11 @@ class Run:
     def run(self):
         """Runs on this thread (the tests, Blender in background mode)."""
         try:
-            self.result = self.g2p.Pipeline(self.options).run(self.model, context=self._context)
+            pipeline = self.g2p.Pipeline(self.options)
+            if self.previous is not None:
+                self.result = pipeline.resume(self.previous, self.g2p.Stage.EXPORT, context=self._context)
+            else:
+                self.result = pipeline.run(self.model, context=self._context)
         except Exception as e:  # a g2p.Error, or what a stage raised: shown to the user
             self.error = e
 

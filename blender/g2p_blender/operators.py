@@ -2,103 +2,61 @@
 polling a worker thread), and rerun it with a part's correction."""
 
 import json
+import os
+import shutil
+import tempfile
 
+import addon_utils
 import bpy
 import numpy as np
 
 from . import core, ui
 
-
-def gather(context, objects, name):
-    """The objects' evaluated geometry (modifiers applied, world transform
-    applied, triangulated) and material slots as a core.MeshInput."""
-    depsgraph = context.evaluated_depsgraph_get()
-    data = core.MeshInput(name)
-    for ob in objects:
-        ob_eval = ob.evaluated_get(depsgraph)
-        mesh = ob_eval.to_mesh()
-        try:
-            mesh.calc_loop_triangles()
-            positions = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
-            mesh.vertices.foreach_get("co", positions)
-            triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-            mesh.loop_triangles.foreach_get("vertices", triangles)
-            slots = np.empty(len(mesh.loop_triangles), dtype=np.int32)
-            mesh.loop_triangles.foreach_get("material_index", slots)
-            corner_uvs = None
-            if mesh.uv_layers.active is not None and any(textured(s.material) for s in ob.material_slots):
-                loops = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-                mesh.loop_triangles.foreach_get("loops", loops)
-                loop_uvs = np.empty(len(mesh.loops) * 2, dtype=np.float64)
-                mesh.uv_layers.active.data.foreach_get("uv", loop_uvs)
-                corner_uvs = loop_uvs.reshape(-1, 2)[loops]
-        finally:
-            ob_eval.to_mesh_clear()
-        matrix = np.array(ob.matrix_world, dtype=np.float64)
-        positions = positions.reshape(-1, 3) @ matrix[:3, :3].T + matrix[:3, 3]
-        triangles = triangles.reshape(-1, 3)
-        uvs = None
-        if corner_uvs is not None:
-            source, triangles, uvs = core.split_by_uv(triangles, corner_uvs)
-            positions = positions[source]
-        if np.linalg.det(matrix[:3, :3]) < 0:  # a mirroring transform turns the faces inside out
-            triangles = triangles[:, ::-1]
-        materials = [(s.material.name_full, material_record(s.material)) if s.material else None
-                     for s in ob.material_slots]
-        data.add(positions, triangles, materials, slots, uvs)
-    return data
+# The recent runs' results, so that a correction resumes its run (core.ResultCache).
+RESULTS = core.ResultCache()
 
 
-def principled(material):
-    if material is None or not material.use_nodes or material.node_tree is None:
-        return None
-    return next((n for n in material.node_tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
-
-
-def base_color_image(material):
-    """The image node feeding the Principled base colour directly, if any."""
-    bsdf = principled(material)
-    if bsdf is None or not bsdf.inputs["Base Color"].is_linked:
-        return None
-    node = bsdf.inputs["Base Color"].links[0].from_node
-    return node.image if node.type == "TEX_IMAGE" else None
-
-
-def image_bytes(image):
-    """(bytes, MIME type) of a PNG or JPEG image as packed or on disk, or None:
-    other images are not re-encoded (cheap only)."""
-    mime = {"PNG": "image/png", "JPEG": "image/jpeg"}.get(image.file_format)
-    if mime is None:
-        return None
-    if image.packed_file is not None:
-        return bytes(image.packed_file.data), mime
-    path = bpy.path.abspath(image.filepath)
+def export_glb(context, objects):
+    """The objects as GLB bytes, written by Blender's own glTF exporter into a
+    temporary folder the add-on removes: modifiers and world transforms applied,
+    and every material channel glTF carries (base colour, metallic-roughness,
+    normal, occlusion and emissive textures with their transforms, transmission,
+    vertex colours), so the library reads the selection as `g2p run` reads a
+    file. The selection and visibility are put back as they were."""
+    if not hasattr(bpy.ops.export_scene, "gltf"):
+        addon_utils.enable("io_scene_gltf2", default_set=False)
+        if not hasattr(bpy.ops.export_scene, "gltf"):
+            raise ValueError("Blender's glTF exporter (the io_scene_gltf2 add-on) is not available")
+    layer = context.view_layer
+    selected = [ob for ob in layer.objects if ob.select_get()]
+    active = layer.objects.active
+    hidden = [ob for ob in objects if ob.hide_get()]
+    folder = tempfile.mkdtemp(prefix="g2p-blender-")
     try:
+        for ob in hidden:
+            ob.hide_set(False)
+        for ob in selected:
+            ob.select_set(False)
+        for ob in objects:
+            ob.select_set(True)
+        path = os.path.join(folder, "selection.glb")
+        outcome = bpy.ops.export_scene.gltf(
+            filepath=path, export_format="GLB", use_selection=True, export_apply=True, export_yup=True,
+            export_cameras=False, export_lights=False, export_animations=False, export_extras=False,
+            will_save_settings=False)
+        if outcome != {"FINISHED"} or not os.path.isfile(path):
+            raise ValueError(f"Blender's glTF exporter did not write the selection ({outcome})")
         with open(path, "rb") as f:
-            return f.read(), mime
-    except OSError:
-        return None
-
-
-def textured(material):
-    image = base_color_image(material)
-    return image is not None and image_bytes(image) is not None
-
-
-def material_record(material):
-    """A material's name and look, as glTF would carry them (linear base colour)."""
-    record = {"name": material.name, "base_color": tuple(material.diffuse_color)}
-    bsdf = principled(material)
-    if bsdf is not None:
-        record["base_color"] = tuple(bsdf.inputs["Base Color"].default_value)
-        for key, socket in (("metallic", "Metallic"), ("roughness", "Roughness")):
-            if not bsdf.inputs[socket].is_linked:  # a texture drives it otherwise: glTF's default factor, 1
-                record[key] = bsdf.inputs[socket].default_value
-        image = base_color_image(material)
-        if image is not None and image_bytes(image) is not None:
-            record["base_color_image"] = image_bytes(image)
-            record["base_color"] = (1.0, 1.0, 1.0, 1.0)  # the input's factor is not recovered; glTF's default
-    return record
+            return f.read()
+    finally:
+        for ob in objects:
+            ob.select_set(False)
+        for ob in selected:
+            ob.select_set(True)
+        for ob in hidden:
+            ob.hide_set(True)
+        layer.objects.active = active
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def class_material(name, colour_srgb):
@@ -148,6 +106,9 @@ def build_scene(context, name, result, sources, corrections):
         body = mesh_object(name + " (g2p)", [], [], collection)
         created.append(body)
         body["g2p_collection"] = collection.name
+        body["g2p_name"] = name
+        body["g2p_run"] = RESULTS.put(result)  # a correction resumes this run
+        body["g2p_stages"] = json.dumps([s["stage"] for s in result.stages])
         body.location = com
         body["g2p_mass_kg"] = result.mass_kg
         body["g2p_kind"] = result.kind
@@ -254,8 +215,15 @@ class G2P_OT_make_parts(bpy.types.Operator):
         name = active.name if active in objects else objects[0].name
         settings = context.scene.g2p
         try:
-            data = gather(context, objects, name)
-            model = data.model(g2p)
+            resumed = self.resume(g2p, settings)
+        except (ValueError, g2p.Error) as e:
+            self.report({"ERROR"}, f"g2p: {e}")
+            return None
+        if resumed is not None:
+            return resumed
+        try:
+            model = g2p.load_model_from_memory(export_glb(context, objects), "glb", height_m=settings.height_m,
+                                               longest_side_m=settings.longest_side_m)
             overrides = None
             if self._corrections:
                 overrides = core.correction_overrides(g2p, self._corrections, g2p.MaterialTable(), model.num_faces)
@@ -266,6 +234,24 @@ class G2P_OT_make_parts(bpy.types.Operator):
             return None
         self._name = name
         return core.Run(g2p, model, options)
+
+    def resume(self, g2p, settings):
+        """A correction of a body whose run is still held (RESULTS): that run
+        resumed with the new corrections only (its own already apply), or None
+        to run from the source objects. The body's name stays the run's name."""
+        body = bpy.data.objects.get(self.replace) if self.replace else None
+        if body is None or not self._corrections:
+            return None
+        previous = RESULTS.get(body.get("g2p_run", ""))
+        applied = json.loads(body.get("g2p_corrections", "[]"))
+        if previous is None or self._corrections[:len(applied)] != applied:
+            return None
+        overrides = core.correction_overrides(g2p, self._corrections[len(applied):], g2p.MaterialTable(),
+                                              len(previous.face_labels))
+        options = core.pipeline_options(g2p, "" if settings.segmenter == ui.DEFAULT else settings.segmenter,
+                                        settings.object_words.strip(), settings.max_hulls, overrides)
+        self._name = body.get("g2p_name", body.name)
+        return core.Run(g2p, None, options, previous)
 
     def finish(self, context, run):
         """Reports the run's outcome; builds the scene only when it succeeded."""
@@ -293,7 +279,8 @@ class G2P_OT_make_parts(bpy.types.Operator):
         context.view_layer.objects.active = body
         for w in run.result.warnings:
             self.report({"WARNING"}, f"g2p: {w}")
-        self.report({"INFO"}, f"g2p: {len(run.result.properties)} parts, {run.result.mass_kg:.4g} kg")
+        resumed = f" (resumed at {run.result.stages[0]['stage']})" if run.previous is not None and run.result.stages else ""
+        self.report({"INFO"}, f"g2p: {len(run.result.properties)} parts, {run.result.mass_kg:.4g} kg{resumed}")
         return {"FINISHED"}
 
     def execute(self, context):

@@ -2,14 +2,16 @@
 
   BLENDER_USER_SCRIPTS=$(mktemp -d) BLENDER_USER_CONFIG=$(mktemp -d) \
   blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
-      --module build/python --hammer examples/data/hammer.obj --asset ../shared/assets/X/X.glb [--segmenter S]
+      --module build/python --hammer examples/data/hammer.obj --asset ../shared/assets/X/X.glb [--segmenter S] \
+      [--same-as-run ../shared/assets/Y/Y.glb]
 
 Installs the add-on from its zip into BLENDER_USER_SCRIPTS (without it, registers it from the
 source tree), checks the error when the g2p module is not found, then imports each model, runs the add-on's operator on it, checks the parts and
 masses against the Python pipeline's run of the same file with the same
 options (what `g2p run` reports), checks the rigid body settings, and drops
 the asset onto a plane in Blender's rigid body world: it must come to rest,
-upright. Run outside Blender, it exits 77 (skipped) saying why."""
+upright; each --same-as-run model gets the library's parts and masses with the
+default segmenter. Run outside Blender, it exits 77 (skipped) saying why."""
 
 import argparse
 import json
@@ -38,6 +40,9 @@ def parse_args():
     parser.add_argument("--hammer", default=os.path.join(REPO, "examples", "data", "hammer.obj"))
     parser.add_argument("--asset", required=True, help="a shared asset (.glb)")
     parser.add_argument("--segmenter", default="", help="for the asset; '' = the library's default")
+    parser.add_argument("--same-as-run", action="append", default=[], metavar="GLB",
+                        help="a model whose parts and masses through the add-on, with the library's default "
+                             "segmenter, must be the library's run of the file (repeatable)")
     return parser.parse_args(argv)
 
 
@@ -248,6 +253,8 @@ def main():
           f"corrected handle: {wood['g2p_mass_kg']} kg, expected {wood_mass * 1000.0 / wood_density} kg")
     check(math.isclose(hammer.rigid_body.mass, hammer["g2p_mass_kg"], rel_tol=1e-6),
           "the rigid body's mass was not updated")
+    stages = json.loads(hammer["g2p_stages"])
+    check(stages[0] == "properties", f"the density correction ran {stages}, not from properties on")
     print(f"corrected handle: {wood_mass:.4f} kg at {wood_density} kg/m^3 -> {wood['g2p_mass_kg']:.4f} kg at 1000")
     # A second correction, the class: it accumulates on the first (whose density still stands).
     bpy.context.view_layer.objects.active = wood
@@ -259,6 +266,8 @@ def main():
     handle = next(ob for ob in hammer.children if ob.get("g2p_class") == "Plastic")
     check(math.isclose(handle["g2p_density_kg_m3"], 1000.0), f"the handle's density is {handle['g2p_density_kg_m3']}")
     check(len(json.loads(hammer["g2p_corrections"])) == 2, "the corrections did not accumulate")
+    stages = json.loads(hammer["g2p_stages"])
+    check(stages[0] == "complete", f"the class correction ran {stages}, not from complete on")
 
     # Failures change nothing: a correction the library refuses, a run that fails.
     select_sources(hammer)
@@ -267,12 +276,34 @@ def main():
     expect_error("failed run", "g2p run failed")
     bpy.context.scene.g2p.segmenter = "DEFAULT"
 
+    # The real size in the panel (--height): the parts come out 0.5 m tall, the input untouched.
+    select_sources(hammer)
+    source_height = max(ob.dimensions.z for ob in bpy.context.selected_objects)
+    bpy.context.scene.g2p.height_m = 0.5
+    check(bpy.ops.g2p.make_parts(synchronous=True) == {"FINISHED"}, "the run with a height failed")
+    bpy.context.scene.g2p.height_m = 0.0
+    tall = bpy.context.view_layer.objects.active
+    heights = [(ob.matrix_world @ v.co).z for ob in tall.children if "g2p_class" in ob for v in ob.data.vertices]
+    check(abs(max(heights) - min(heights) - 0.5) < 0.01, f"with Height 0.5 m the parts span {max(heights) - min(heights):.4f} m")
+    check(abs(max(ob.dimensions.z for ob in bpy.data.objects if ob.name in json.loads(tall["g2p_sources"]))
+              - source_height) < 1e-9, "the run with a height changed the input")
+    print(f"height 0.5 m: the parts span {max(heights) - min(heights):.4f} m (the input {source_height:.4f} m)")
+
     # The shared asset: the same checks, and the drop.
     asset = run_addon(args.asset, args.segmenter)
     expected = reference(g2p, args.asset, args.segmenter)
     check_parts(args.asset, asset, expected)
     check_rigid_body(args.asset, asset, expected)
     drop(args.asset, asset)
+
+    # Models whose look is in textures (metallic-roughness, emissive, normal, occlusion): through
+    # Blender's exporter the library sees what `g2p run` sees in the file.
+    for path in args.same_as_run:
+        if not os.path.exists(path):
+            print(f"{path} is missing: not compared")
+            continue
+        body = run_addon(path, "")
+        check_parts(path, body, reference(g2p, path, ""))
     print(f"OK in {time.time() - start:.1f} s")
 
 

@@ -764,6 +764,28 @@ class OverridesTest(unittest.TestCase):
         again = g2p.parse_overrides(overrides.to_json())
         self.assertEqual(again.to_json(), overrides.to_json())
 
+    def test_a_result_resumes_with_them_in_memory(self):
+        plain = g2p.Pipeline(quick_options()).run_file(HAMMER)
+        density = g2p.parse_overrides(json.dumps(dict(self.FIX, overrides=[{"part": 1, "density_kg_m3": 7000}])))
+        self.assertFalse(density.changes_classes)
+        # A property correction goes back to properties, not to the views.
+        resumed = g2p.Pipeline(quick_options(overrides=density)).resume(plain, g2p.Stage.EXPORT)
+        self.assertEqual([s["stage"] for s in resumed.stages], ["properties", "decompose", "export"])
+        self.assertAlmostEqual(resumed.properties[1]["density_kg_m3"], 7000.0)
+        head = plain.properties[1]
+        self.assertAlmostEqual(resumed.properties[1]["mass_kg"], head["mass_kg"] * 7000.0 / head["density_kg_m3"],
+                               delta=1e-9 + 1e-6 * head["mass_kg"])
+        self.assertEqual(resumed.properties[0]["mass_kg"], plain.properties[0]["mass_kg"])
+        # The earlier result is unchanged; the resumed one is the file-based run's.
+        self.assertNotAlmostEqual(plain.properties[1]["density_kg_m3"], 7000.0)
+        fixed = g2p.Pipeline(quick_options(overrides=density)).run_file(HAMMER)
+        self.assertAlmostEqual(resumed.mass_kg, fixed.mass_kg, delta=1e-9)
+        # A class correction goes back to complete.
+        plastic = g2p.parse_overrides(json.dumps(dict(self.FIX, overrides=self.FIX["overrides"][:1])))
+        relabelled = g2p.Pipeline(quick_options(overrides=plastic)).resume(plain, g2p.Stage.EXPORT)
+        self.assertEqual([s["stage"] for s in relabelled.stages][0], "complete")
+        self.assertEqual([p["class"] for p in relabelled.parts], ["Plastic", "Metal"])
+
     def test_a_bad_entry_is_named(self):
         bad = dict(self.FIX, overrides=[{"part": 0, "density_kg_m3": -1}])
         with self.assertRaises(g2p.InvalidArgumentError) as caught:

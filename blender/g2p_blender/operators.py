@@ -28,6 +28,9 @@ def export_glb(context, objects):
         if not hasattr(bpy.ops.export_scene, "gltf"):
             raise ValueError("Blender's glTF exporter (the io_scene_gltf2 add-on) is not available")
     layer = context.view_layer
+    outside = [ob.name for ob in objects if ob.name not in layer.objects]
+    if outside:
+        raise ValueError("not in the current view layer, so Blender cannot export them: " + ", ".join(outside))
     selected = [ob for ob in layer.objects if ob.select_get()]
     active = layer.objects.active
     hidden = [ob for ob in objects if ob.hide_get()]

@@ -275,6 +275,9 @@ def main():
     bpy.context.scene.g2p.segmenter = "oracle"  # needs a labels file: the run fails
     expect_error("failed run", "g2p run failed")
     bpy.context.scene.g2p.segmenter = "DEFAULT"
+    stray = bpy.data.objects.new("stray", bpy.data.meshes.new("stray"))  # in no scene
+    expect_error("outside the view layer", "not in the current view layer", sources='["stray"]')
+    bpy.data.objects.remove(stray)
 
     # The real size in the panel (--height): the parts come out 0.5 m tall, the input untouched.
     select_sources(hammer)

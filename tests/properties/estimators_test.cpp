@@ -38,6 +38,18 @@ Stage complete_object(Mesh mesh, std::vector<Part> parts) {
   return s;
 }
 
+// As the pipeline completes: a part whose faces already close (the cubes
+// below) is kept exactly as given, and the completer is not run.
+Stage keep_closed_object(Mesh mesh, std::vector<Part> parts) {
+  Stage s{std::move(mesh), std::move(parts), {}};
+  auto c = std::move(*make_completer("partition"));
+  Result<Completion> r = complete({&s.mesh, &s.parts, &table()}, *c);
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  if (r.ok()) s.completion = std::move(*r);
+  for (const CompletedPart& p : s.completion.parts) EXPECT_EQ(p.backend, "input") << p.part;
+  return s;
+}
+
 PropertiesReport report_of(const Stage& s, const std::string& estimator = "table") {
   auto e = std::move(*make_estimator(estimator));
   Result<PropertiesReport> r = estimate_properties(s.mesh, s.parts, s.completion, table(), *e);
@@ -299,7 +311,7 @@ class ScriptedVlm final : public VlmClient {
 
 TEST(VlmEstimator, UsesValidAnswersAndFallsBackOnBadOnes) {
   const Mesh cube = test::box_mesh({0, 0, 0}, {0.05f, 0.05f, 0.05f});
-  const Stage s = complete_object(cube, test::single_part(cube, kMetal));
+  const Stage s = keep_closed_object(cube, test::single_part(cube, kMetal));
   auto estimate = [&](Result<std::string> answer) {
     auto client = std::make_shared<ScriptedVlm>(std::move(answer));
     auto e = make_vlm_estimator(client);
@@ -335,7 +347,7 @@ TEST(VlmEstimator, UsesValidAnswersAndFallsBackOnBadOnes) {
 
 TEST(VlmEstimator, ShowsTheModelTheObjectWithThePartColouredIn) {
   const Mesh cube = test::box_mesh({0, 0, 0}, {0.05f, 0.05f, 0.05f});
-  const Stage s = complete_object(cube, test::single_part(cube, kMetal));
+  const Stage s = keep_closed_object(cube, test::single_part(cube, kMetal));
   Model model;
   model.mesh = cube;
   auto renderer = std::move(*renderer_registry().create("embree"));
@@ -356,7 +368,7 @@ TEST(VlmEstimator, ShowsTheModelTheObjectWithThePartColouredIn) {
 
 TEST(PropertiesReport, JsonHasEveryFieldWithUnits) {
   const Mesh cube = test::box_mesh({0, 0, 0}, {0.1f, 0.1f, 0.1f});
-  const PropertiesReport r = report_of(complete_object(cube, test::single_part(cube, kWood)));
+  const PropertiesReport r = report_of(keep_closed_object(cube, test::single_part(cube, kWood)));
   const std::string dir = test::scratch_dir("PropertiesReport");
   ASSERT_TRUE(write_report(dir + "/report.json", r, table()).ok());
   const nlohmann::json j = nlohmann::json::parse(test::read_file(dir + "/report.json"));
@@ -383,7 +395,7 @@ TEST(Estimators, RegistryAndSettings) {
   EXPECT_FALSE(make_estimator("oracle").ok());
   // Without a model configured the vlm estimator answers with the table's values.
   const Mesh cube = test::box_mesh({0, 0, 0}, {0.05f, 0.05f, 0.05f});
-  const Stage s = complete_object(cube, test::single_part(cube, kWood));
+  const Stage s = keep_closed_object(cube, test::single_part(cube, kWood));
   const PropertiesReport r = report_of(s, "vlm");
   ASSERT_EQ(r.parts.size(), 1u);
   EXPECT_EQ(r.parts[0].properties.density_kg_m3, 700);

@@ -138,9 +138,35 @@ double TriangleBins::distance(const Vector3d& p, double enough) const {
 std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs) const {
   std::vector<std::pair<int, int>> out;
   const long long ncell = static_cast<long long>(dims_.x()) * dims_.y() * dims_.z();
-  std::vector<Eigen::AlignedBox3d> boxes(static_cast<std::size_t>(mesh_.num_faces()));
-  for (int t = 0; t < mesh_.num_faces(); ++t)
-    for (int c = 0; c < 3; ++c) boxes[static_cast<std::size_t>(t)].extend(tri(t, c));
+  const std::size_t nf = static_cast<std::size_t>(mesh_.num_faces());
+  std::vector<Eigen::AlignedBox3d> boxes(nf);
+  // Each triangle's plane (unit normal, offset) and a tolerance from its size:
+  // a pair where one triangle lies wholly on one side of the other's plane
+  // cannot intersect, which rules out most pairs before the edge tests.
+  struct Plane {
+    Vector3d normal = Vector3d::Zero();
+    double offset = 0, tolerance = 0;
+  };
+  std::vector<Plane> planes(nf);
+  for (std::size_t t = 0; t < nf; ++t) {
+    const Vector3d a = tri(static_cast<int>(t), 0), b = tri(static_cast<int>(t), 1), c = tri(static_cast<int>(t), 2);
+    boxes[t].extend(a).extend(b).extend(c);
+    const Vector3d n = (b - a).cross(c - a);
+    const double length = n.norm();
+    if (length > 0) planes[t] = {n / length, n.dot(a) / length, 1e-9 * boxes[t].diagonal().norm()};
+  }
+  // Whether triangle `t`'s corners lie strictly on one side of `p`'s plane
+  // (never for a degenerate `p`, whose normal is zero).
+  auto one_side = [&](const Plane& p, const Vector3d corners[3]) {
+    if (p.tolerance <= 0) return false;
+    int above = 0, below = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = p.normal.dot(corners[k]) - p.offset;
+      above += d > p.tolerance;
+      below += d < -p.tolerance;
+    }
+    return above == 3 || below == 3;
+  };
   for (long long c = 0; c < ncell && static_cast<int>(out.size()) < max_pairs; ++c) {
     const int s0 = start_[static_cast<std::size_t>(c)], s1 = start_[static_cast<std::size_t>(c) + 1];
     for (int a = s0; a < s1; ++a) {
@@ -161,6 +187,8 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
         if (index(low.x(), low.y(), low.z()) != c) continue;
         const Vector3d t0[3] = {tri(ta, 0), tri(ta, 1), tri(ta, 2)};
         const Vector3d t1[3] = {tri(tb, 0), tri(tb, 1), tri(tb, 2)};
+        if (one_side(planes[static_cast<std::size_t>(ta)], t1) || one_side(planes[static_cast<std::size_t>(tb)], t0))
+          continue;
         if (triangles_intersect(t0, t1)) out.emplace_back(std::min(ta, tb), std::max(ta, tb));
       }
     }

@@ -10,10 +10,6 @@ namespace g2p {
 
 namespace {
 
-std::uint64_t edge_key(int from, int to) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) | static_cast<std::uint32_t>(to);
-}
-
 int find_root(std::vector<int>& parent, int x) {
   while (parent[static_cast<std::size_t>(x)] != x) {
     parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
@@ -22,48 +18,56 @@ int find_root(std::vector<int>& parent, int x) {
   return x;
 }
 
-// Directed edges, sorted, each with its face: closed and consistently
-// oriented iff every directed edge occurs once and its reverse once.
-class DirectedEdges {
- public:
-  explicit DirectedEdges(const Mesh& mesh) {
-    edges_.reserve(static_cast<std::size_t>(mesh.num_faces()) * 3);
-    for (int f = 0; f < mesh.num_faces(); ++f) {
-      const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
-      for (int e = 0; e < 3; ++e) edges_.emplace_back(edge_key(t[e], t[(e + 1) % 3]), f);
+constexpr int kNoOpposite = -1;   // a boundary edge
+constexpr int kBadOpposite = -2;  // more than two faces on the edge, or two wound the same way
+
+// The half-edges of every face, h = 3 f + e running from corner e to corner
+// e + 1, each paired with the half-edge running the other way along the same
+// edge. One sort by undirected edge, then linear passes: the checks below
+// look a neighbour up in O(1) rather than by a search per step.
+std::vector<int> opposite_half_edges(const Mesh& mesh) {
+  const std::size_t nh = static_cast<std::size_t>(mesh.num_faces()) * 3;
+  std::vector<std::pair<std::uint64_t, int>> edges(nh);  // (low vertex << 32 | high vertex, half-edge)
+  for (std::size_t h = 0; h < nh; ++h) {
+    const Eigen::Vector3i& t = mesh.triangles[h / 3];
+    const int e = static_cast<int>(h % 3);
+    const auto from = static_cast<std::uint32_t>(t[e]), to = static_cast<std::uint32_t>(t[(e + 1) % 3]);
+    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(from, to)) << 32) | std::max(from, to);
+    edges[h] = {key, static_cast<int>(h)};
+  }
+  std::sort(edges.begin(), edges.end());
+  auto forward = [&](int h) {  // runs from the lower vertex index to the higher
+    const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(h / 3)];
+    return t[h % 3] < t[(h % 3 + 1) % 3];
+  };
+  std::vector<int> opposite(nh, kNoOpposite);
+  for (std::size_t i = 0; i < nh;) {
+    std::size_t j = i + 1;
+    while (j < nh && edges[j].first == edges[i].first) ++j;
+    if (j - i == 2 && forward(edges[i].second) != forward(edges[i + 1].second)) {
+      opposite[static_cast<std::size_t>(edges[i].second)] = edges[i + 1].second;
+      opposite[static_cast<std::size_t>(edges[i + 1].second)] = edges[i].second;
+    } else if (j - i > 1) {
+      for (std::size_t k = i; k < j; ++k) opposite[static_cast<std::size_t>(edges[k].second)] = kBadOpposite;
     }
-    std::sort(edges_.begin(), edges_.end());
+    i = j;
   }
+  return opposite;
+}
 
-  // The face with the directed edge `key`: -1 if none, -2 if two have it.
-  int face_of(std::uint64_t key) const {
-    auto it = std::lower_bound(edges_.begin(), edges_.end(), std::make_pair(key, -1));
-    if (it == edges_.end() || it->first != key) return -1;
-    auto next = it + 1;
-    if (next != edges_.end() && next->first == key) return -2;  // the same directed edge twice
-    return it->second;
-  }
-
-  const std::vector<std::pair<std::uint64_t, int>>& edges() const { return edges_; }
-
- private:
-  std::vector<std::pair<std::uint64_t, int>> edges_;
-};
-
-// Whether every directed edge occurs once and its reverse once; counts the
-// edge-connected pieces (over the edges that do) in `num_components`.
-bool closed_and_oriented(int nf, const DirectedEdges& edges, int& num_components) {
+// Whether every edge has exactly two faces, wound in opposite directions;
+// counts the edge-connected pieces (over the edges that do) in `num_components`.
+bool closed_and_oriented(int nf, const std::vector<int>& opposite, int& num_components) {
   bool closed = true;
   std::vector<int> parent(static_cast<std::size_t>(nf));
   std::iota(parent.begin(), parent.end(), 0);
-  for (const auto& [key, f] : edges.edges()) {
-    const int from = static_cast<int>(key >> 32), to = static_cast<int>(key & 0xffffffffu);
-    const int g = edges.face_of(edge_key(to, from));
-    if (g < 0 || edges.face_of(key) < 0) {
+  for (std::size_t h = 0; h < opposite.size(); ++h) {
+    const int g = opposite[h];
+    if (g < 0) {
       closed = false;
       continue;
     }
-    parent[static_cast<std::size_t>(find_root(parent, f))] = find_root(parent, g);
+    parent[static_cast<std::size_t>(find_root(parent, static_cast<int>(h / 3)))] = find_root(parent, g / 3);
   }
   for (int f = 0; f < nf; ++f) num_components += find_root(parent, f) == f;
   return closed;
@@ -71,7 +75,7 @@ bool closed_and_oriented(int nf, const DirectedEdges& edges, int& num_components
 
 // Vertex manifoldness of a closed mesh: walking across edges around each
 // vertex visits all of its triangles in one cycle.
-bool vertex_manifold(const Mesh& mesh, const DirectedEdges& edges) {
+bool vertex_manifold(const Mesh& mesh, const std::vector<int>& opposite) {
   std::vector<int> incident(mesh.positions.size(), 0);
   for (const auto& t : mesh.triangles)
     for (int e = 0; e < 3; ++e) ++incident[static_cast<std::size_t>(t[e])];
@@ -86,8 +90,9 @@ bool vertex_manifold(const Mesh& mesh, const DirectedEdges& edges) {
       do {
         const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(face)];
         const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-        const int a = t[(k + 1) % 3];
-        face = edges.face_of(edge_key(a, v));  // the neighbour across edge (v, a)
+        // The neighbour across the edge from v to the next corner.
+        const int across = opposite[static_cast<std::size_t>(3 * face + k)];
+        face = across < 0 ? -1 : across / 3;
         ++steps;
       } while (face >= 0 && face != f && steps <= incident[static_cast<std::size_t>(v)]);
       if (face != f || steps != incident[static_cast<std::size_t>(v)]) return false;
@@ -137,9 +142,9 @@ MeshChecks check_closed_mesh(const Mesh& mesh, const Mesh* patch, const MeshChec
   if (nf == 0 || !validate(mesh).ok()) return c;
   c.area_m2 = surface_area(mesh);
 
-  const DirectedEdges edges(mesh);
-  c.closed = closed_and_oriented(nf, edges, c.num_components);
-  if (c.closed) c.manifold = vertex_manifold(mesh, edges);
+  const std::vector<int> opposite = opposite_half_edges(mesh);
+  c.closed = closed_and_oriented(nf, opposite, c.num_components);
+  if (c.closed) c.manifold = vertex_manifold(mesh, opposite);
 
   c.volume_m3 = enclosed_volume(mesh);
   const double diagonal = bounds(mesh).diagonal().norm();

@@ -120,6 +120,19 @@ TEST(Exporters, AFolderCheckComparesTheEngineWithTheReport) {
   EXPECT_FALSE(wrong->numbers_match);
   EXPECT_FALSE(wrong->pass());
   EXPECT_EQ(check_folder_in_mujoco(dir + "/none").status().code(), StatusCode::kNotFound);
+  // The drop's line says whether the body came to rest: 0.1 s after its
+  // release from 0.2 m the hammer is still falling; after 4 s it lies still.
+  auto drop = [&](double seconds, bool at_rest) {
+    Result<FolderCheck> check = check_folder_in_mujoco(dir, 0.2, seconds);
+    ASSERT_TRUE(check.ok());
+    EXPECT_EQ(check->engine.final_speed_m_s < 0.005, at_rest) << check->engine.final_speed_m_s;
+    const std::string text = folder_check_text(*check);
+    EXPECT_EQ(text.find(", at rest (") != std::string::npos, at_rest) << text;
+    EXPECT_EQ(text.find("still moving") != std::string::npos, !at_rest) << text;
+    EXPECT_EQ(text.find("--seconds longer") != std::string::npos, !at_rest) << text;
+  };
+  drop(0.1, false);
+  drop(4.0, true);
 }
 
 // |angular acceleration| of the hammer hinged on a horizontal axis (body y)

@@ -68,10 +68,7 @@ def import_model(path):
     before = set(bpy.data.objects)
     if path.endswith(".obj"):
         bpy.ops.wm.obj_import(filepath=path)
-    else:
-        import numpy
-        if not hasattr(numpy, "bool"):  # Debian 12's Blender 3.4.1 glTF importer uses np.bool, gone in numpy 1.24
-            numpy.bool = bool
+    else:  # on Debian 12's Blender 3.4.1 this works because the add-on puts numpy.bool back (register())
         bpy.ops.import_scene.gltf(filepath=path)
     objects = [ob for ob in bpy.data.objects if ob not in before and ob.type == "MESH"]
     check(objects, f"{path}: no mesh imported")

@@ -85,6 +85,13 @@ TEST(MassProperties, TwoMaterialHammerBalancesInItsHead) {
   EXPECT_GT(hammer.center_of_mass.z(), 0.30);
   EXPECT_LT(hammer.center_of_mass.z(), 0.34);
   EXPECT_GT(hammer.center_of_mass.z(), 0.5 * (0.0 + 0.34));  // far above the geometric middle
+  // Both parts are symmetric about the hammer's axis, so the centre of mass
+  // lies on it exactly, not the rounding's nanometre fractions off it
+  // (-7e-21 m printed by `g2p run` until 2026-11-29; 5e-12 m for this handle).
+  EXPECT_EQ(head.center_of_mass.x(), 0.0);
+  EXPECT_EQ(head.center_of_mass.y(), 0.0);
+  EXPECT_EQ(hammer.center_of_mass.x(), 0.0);
+  EXPECT_EQ(hammer.center_of_mass.y(), 0.0);
   // Parallel axis: combined inertia about x exceeds the sum of the parts' own.
   EXPECT_GT(hammer.inertia(0, 0), head.inertia(0, 0) + handle.inertia(0, 0));
 }

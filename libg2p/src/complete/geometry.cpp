@@ -155,7 +155,7 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
     const double length = n.norm();
     if (length > 0) planes[t] = {n / length, n.dot(a) / length, 1e-9 * boxes[t].diagonal().norm()};
   }
-  // Whether triangle `t`'s corners lie strictly on one side of `p`'s plane
+  // Whether all three `corners` lie strictly on one side of plane `p`
   // (never for a degenerate `p`, whose normal is zero).
   auto one_side = [&](const Plane& p, const Vector3d corners[3]) {
     if (p.tolerance <= 0) return false;

@@ -89,12 +89,20 @@ Moments moments_below(const Mesh& mesh, const Eigen::Vector3d& reference) {
   return m;
 }
 
-MassProperties finish(const Moments& m, double mass_per_unit, const Eigen::Vector3d& reference, double area) {
+// `extent`: the mesh's bounding-box diagonal. A coordinate of the centre of
+// mass within 1e-9 of it from zero is zero: the sums' rounding on a
+// symmetric solid (-7e-21 m on the hammer's axis) and the float vertices'
+// own (a 32-gon handle's 5e-12 m), below what float vertices can place
+// (about 1e-7 of the extent).
+MassProperties finish(const Moments& m, double mass_per_unit, const Eigen::Vector3d& reference, double area,
+                      double extent) {
   MassProperties p;
   p.area_m2 = area;
   p.mass_kg = mass_per_unit * m.zeroth;
   const Eigen::Vector3d com_local = m.first / m.zeroth;
   p.center_of_mass = reference + com_local;
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(p.center_of_mass[k]) <= 1e-9 * extent) p.center_of_mass[k] = 0.0;
   // Covariance about the centre of mass (parallel-axis shift of the second moment).
   const Eigen::Matrix3d c = mass_per_unit * (m.second - m.zeroth * com_local * com_local.transpose());
   p.inertia = inertia_from_covariance(0.5 * (c + c.transpose()));
@@ -124,7 +132,7 @@ Result<MassProperties> solid_mass_properties(const Mesh& mesh, double density_kg
   if (!(m.zeroth > 1e-12 * extent * extent * extent))
     return Status::InvalidArgument("mass properties: the enclosed volume is " + std::to_string(m.zeroth) +
                                    " m^3; the mesh must be closed and wound outward (complete it first)");
-  MassProperties p = finish(m, density_kg_m3, reference, surface_area(mesh));
+  MassProperties p = finish(m, density_kg_m3, reference, surface_area(mesh), extent);
   p.volume_m3 = m.zeroth;
   return p;
 }
@@ -138,7 +146,7 @@ Result<MassProperties> shell_mass_properties(const Mesh& mesh, double density_kg
     return 0.5 * (b - a).cross(c - a).norm();  // triangle area
   });
   if (!(m.zeroth > 0.0)) return Status::InvalidArgument("mass properties: the surface has no area");
-  MassProperties p = finish(m, density_kg_m3 * thickness_m, reference, m.zeroth);
+  MassProperties p = finish(m, density_kg_m3 * thickness_m, reference, m.zeroth, bounds(mesh).diagonal().norm());
   p.volume_m3 = m.zeroth * thickness_m;
   return p;
 }
@@ -170,7 +178,7 @@ Result<MassProperties> fill_mass_properties(const Mesh& closed, double density_k
   }
   if (!(below.zeroth > 0.0))
     return Status::InvalidArgument("fill: no volume below the level found; is the mesh closed and wound outward?");
-  MassProperties p = finish(below, density_kg_m3, reference, 0.0);
+  MassProperties p = finish(below, density_kg_m3, reference, 0.0, box.diagonal().norm());
   p.volume_m3 = below.zeroth;
   return p;
 }

@@ -125,8 +125,9 @@ std::string folder_check_text(const FolderCheck& f) {
     add(std::snprintf(line, sizeof line, "  mass %.6g kg (no report.json to compare with)\n", c.mass_kg));
   }
   if (c.dropped) {
-    // At rest under the probe balls' speed (ContactCheckOptions::rest_speed_m_s);
-    // a body still toppling at the end is said to be, with the way to see it settle.
+    // At rest: slower than the probe balls' limit (ContactCheckOptions::
+    // rest_speed_m_s). A body still moving at the end (a hammer toppling) is
+    // reported as moving, with the flag that gives it time to settle.
     const bool at_rest = c.finite && c.final_speed_m_s < ContactCheckOptions().rest_speed_m_s;
     add(std::snprintf(line, sizeof line,
                       "  drop from %.3g m for %.3g s: lowest point %.4g m, at the end %.4g m above the plane, %s "

@@ -169,6 +169,8 @@ py::list properties_list(const PipelineResult& r) {
     d["restitution"] = p.restitution;
     d["mass_kg"] = pr.mass.mass_kg;
     d["mass_range_kg"] = py::make_tuple(pr.mass_min_kg, pr.mass_max_kg);
+    if (pr.mass_median_kg > 0)  // the kind's mass posterior: median and 90 % interval
+      d["mass_interval_kg"] = py::make_tuple(pr.mass_p05_kg, pr.mass_median_kg, pr.mass_p95_kg);
     d["volume_m3"] = pr.mass.volume_m3 - pr.contents.volume_m3;
     d["contents_mass_kg"] = pr.contents.mass_kg;  // 0 when empty
     d["contents_fill"] = pr.contents.mass_kg > 0 ? p.contents_fill : 0.0;

@@ -306,9 +306,11 @@ def validate_kind(k, errors):
         errors.append("%s: materials must have 1-5 entries" % w)
     else:
         for m in mats:
-            if not (isinstance(m, dict) and set(m) == {"role", "class"} and isinstance(m["role"], str)
-                    and m["role"] and m["class"] in CLASSES):
+            if not (isinstance(m, dict) and {"role", "class"} <= set(m) <= {"role", "class", "max_share"}
+                    and isinstance(m["role"], str) and m["role"] and m["class"] in CLASSES):
                 errors.append("%s: bad material %r (class must be one of %s)" % (w, m, CLASSES))
+            elif "max_share" in m and not (_num(m["max_share"]) and 0 < m["max_share"] <= 1):
+                errors.append("%s: max_share of %r must be in (0, 1]" % (w, m["role"]))
     hid = k.get("hidden")
     if not isinstance(hid, list):
         errors.append("%s: hidden must be a list" % w)

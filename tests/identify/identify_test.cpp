@@ -411,6 +411,8 @@ TEST(KindProperties, ARefrigeratorIsAHollowBodyWithItsMachineryAtTheBottom) {
   o.completer = {"partition", {{"resolution", "32"}}};  // a box needs no finer grid (10 times faster)
   o.object = "refrigerator";
   o.identifier = {"object", {}};
+  o.kind_posterior = false;           // the kind's structure and hidden mass alone (posterior_test.cpp judges the mass)
+  o.size_policy = SizePolicy::kFile;  // the boxes' own sizes, whatever the kind's usual ones
   o.kind_properties = false;
   Result<PipelineResult> plain = Pipeline(o).run_file(box);
   ASSERT_TRUE(plain.ok()) << plain.status().to_string();
@@ -451,6 +453,8 @@ TEST(KindProperties, ASolidKindChangesNothingAndASolidBodyHoldsNoHiddenMass) {
   o.completer = {"partition", {{"resolution", "32"}}};  // a box needs no finer grid (10 times faster)
   o.last_stage = Stage::kProperties;                    // no hulls or files needed
   o.identifier = {"object", {}};
+  o.kind_posterior = false;           // the kind's structure and hidden mass alone (posterior_test.cpp judges the mass)
+  o.size_policy = SizePolicy::kFile;  // the boxes' own sizes, whatever the kind's usual ones
   struct Case {
     const char* object;
     double side;                                           // m
@@ -484,6 +488,8 @@ TEST(KindProperties, AHollowKindMakesASolidBodyAShell) {
   o.completer = {"partition", {{"resolution", "32"}}};  // a box needs no finer grid (10 times faster)
   o.last_stage = Stage::kProperties;                    // no hulls or files needed
   o.identifier = {"object", {}};
+  o.kind_posterior = false;           // the kind's structure and hidden mass alone (posterior_test.cpp judges the mass)
+  o.size_policy = SizePolicy::kFile;  // the boxes' own sizes, whatever the kind's usual ones
   o.object = "bucket";
   o.kind_properties = false;
   Result<PipelineResult> plain = Pipeline(o).run_file(box);

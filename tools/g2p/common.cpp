@@ -180,6 +180,12 @@ void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
                   "classes read from the image (1 = the kind's materials are not used)")
       ->check(finite_number(0.0, 1.0, true))
       ->capture_default_str();
+  cmd->add_option("--kind-mass", args.kind_mass,
+                  "on: with a kind the run acts on, each class covers no more of the surface than the kind allows "
+                  "and each part's structure is chosen against the kind's mass at the object's size "
+                  "(docs/properties.md); off: neither")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
 }
 
 Result<std::unique_ptr<Segmenter>> make_segmenter_flag(const std::string& command, const SegmenterArgs& args,

@@ -86,6 +86,7 @@ struct IdentifyArgs {
   std::string size_from = to_string(PipelineOptions{}.size_policy);
   double kind_confidence = PipelineOptions{}.kind_confidence;
   double kind_prior = PipelineOptions{}.kind_prior;
+  std::string kind_mass = PipelineOptions{}.kind_posterior ? "on" : "off";  // --kind-mass
 };
 
 void add_identify_flags(CLI::App* cmd, IdentifyArgs& args);

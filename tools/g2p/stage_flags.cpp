@@ -200,6 +200,7 @@ Result<PipelineOptions> pipeline_options(const PipelineArgs& args) {
   o.size_policy = *size_policy;
   o.kind_confidence = args.identify.kind_confidence;
   o.kind_prior = args.identify.kind_prior;
+  o.kind_posterior = args.identify.kind_mass == "on";
   o.completion_fallback = args.completer.fallback == "none" ? "" : args.completer.fallback;
   o.decompose = args.decomposer.options;
   if (!(args.memory_limit_gib >= 0))

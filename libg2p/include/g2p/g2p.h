@@ -15,6 +15,7 @@
 #include "g2p/model.h"
 #include "g2p/options_file.h"
 #include "g2p/pipeline.h"
+#include "g2p/posterior.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/refine.h"

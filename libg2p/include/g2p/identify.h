@@ -40,6 +40,9 @@ namespace g2p {
 struct KindMaterial {
   std::string role;            // "frame", "seat", "tyres", ...
   std::string material_class;  // a class of the paper's table: "Wood", "Metal", ...
+  // The most of the object's surface this role covers (a car's tyres, 0.2);
+  // 0 = not given (posterior.h's defaults apply).
+  double max_share = 0.0;
 };
 
 // Mass that no surface shows: a refrigerator's compressor, a bike's flywheel.

@@ -51,7 +51,11 @@ struct MaterialClass {
   double wall_thickness_m = 0.002;          // used when the part is hollow
   double max_solid_thickness_m = 0.0;       // thickest plausible solid piece; 0 = no limit (docs/properties.md)
   double max_wall_thickness_m = 0.0;        // thickest plausible single wall; 0 = no limit (docs/properties.md)
-  std::string source;                       // where the values come from
+  // The walls a hollow part of this class usually has, metres [thinnest,
+  // thickest] (sheet metal 0.6-3 mm): the kind's mass posterior chooses among
+  // them (posterior.h). {0, 0} = half to twice wall_thickness_m.
+  std::array<double, 2> wall_range_m{0.0, 0.0};
+  std::string source;  // where the values come from
 };
 
 class G2P_API MaterialTable {

@@ -30,6 +30,7 @@
 #include "g2p/materials.h"
 #include "g2p/model.h"
 #include "g2p/overrides.h"
+#include "g2p/posterior.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
 #include "g2p/refine.h"
@@ -126,6 +127,13 @@ struct PipelineOptions {
   double kind_confidence = 0.6;  // [0, 1]
   SizePolicy size_policy = SizePolicy::kKind;
   bool kind_properties = true;
+  // With a kind the run acts on, the kind decides what the surface cannot
+  // show (posterior.h): a class covers no more of the surface than the kind
+  // allows it (after refine), and each part's structure, wall and density are
+  // chosen against the kind's mass at the object's size (after properties),
+  // with a median and 90 % interval in the report. false: neither.
+  bool kind_posterior = true;
+  PosteriorOptions posterior;
   // The kind's materials by role (ObjectKind::materials) as evidence for the
   // classes decided from the image: the network's pixels and the `regions`
   // refiner's regions weigh each class the kind lists 1 and every other
@@ -248,9 +256,11 @@ struct G2P_API PipelineResult {
   Overrides overrides;  // the overrides applied, as face selections (as_face_selections; overrides.json)
   std::vector<std::uint8_t> image_decided;  // per face, 1 where the segmenter decided from the image alone
   double kind_scale = 1.0;                  // the factor that gave the mesh its kind's size (size_assumed_m)
-  Stage last_stage = Stage::kLoad;          // the last stage the result holds
-  double seconds = 0.0;                     // whole run
-  std::size_t peak_rss_bytes = 0;           // largest stage peak
+  // Parts whose class the kind's share changed (fit_classes_to_kind), in words.
+  std::vector<std::string> kind_class_changes;
+  Stage last_stage = Stage::kLoad;  // the last stage the result holds
+  double seconds = 0.0;             // whole run
+  std::size_t peak_rss_bytes = 0;   // largest stage peak
 
   const StageReport* stage(Stage s) const;  // null if it did not run
 };

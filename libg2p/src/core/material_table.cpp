@@ -40,9 +40,9 @@ std::string fmt(double x) {
 Status check_class(const MaterialClass& c) {
   auto bad = [&](const std::string& what) { return Status::InvalidArgument("class '" + c.name + "': " + what); };
   if (c.name.empty()) return Status::InvalidArgument("a class has an empty name");
-  const double values[] = {c.density_kg_m3,    c.density_min_kg_m3,     c.density_max_kg_m3,
-                           c.friction_static,  c.friction_dynamic,      c.restitution,
-                           c.wall_thickness_m, c.max_solid_thickness_m, c.max_wall_thickness_m};
+  const double values[] = {c.density_kg_m3,        c.density_min_kg_m3, c.density_max_kg_m3, c.friction_static,
+                           c.friction_dynamic,     c.restitution,       c.wall_thickness_m,  c.max_solid_thickness_m,
+                           c.max_wall_thickness_m, c.wall_range_m[0],   c.wall_range_m[1]};
   for (double v : values)
     if (!std::isfinite(v)) return bad("a value is not a finite number");
   if (c.density_kg_m3 <= 0.0) return bad("density_kg_m3 must be > 0, got " + fmt(c.density_kg_m3));
@@ -60,6 +60,10 @@ Status check_class(const MaterialClass& c) {
   if (c.max_wall_thickness_m < 0.0 || (c.max_wall_thickness_m > 0.0 && c.max_wall_thickness_m < c.wall_thickness_m))
     return bad("max_wall_thickness_m must be 0 (no limit) or at least wall_thickness_m (" + fmt(c.wall_thickness_m) +
                "), got " + fmt(c.max_wall_thickness_m));
+  if (!(c.wall_range_m[0] == 0.0 && c.wall_range_m[1] == 0.0) &&
+      !(c.wall_range_m[0] > 0.0 && c.wall_range_m[0] <= c.wall_range_m[1]))
+    return bad("wall_range_m [" + fmt(c.wall_range_m[0]) + ", " + fmt(c.wall_range_m[1]) +
+               "] must be positive and ordered (or absent)");
   if (c.max_wall_thickness_m > 0.0 && c.max_solid_thickness_m > 0.0 &&
       c.max_wall_thickness_m >= c.max_solid_thickness_m)
     return bad("max_wall_thickness_m (" + fmt(c.max_wall_thickness_m) + ") must be less than max_solid_thickness_m (" +
@@ -71,9 +75,9 @@ Status check_class(const MaterialClass& c) {
 // Keys a class object may have; anything else is a typo that would silently
 // leave a default in place, so it is an error.
 constexpr const char* kClassKeys[] = {
-    "name",        "color",     "density_kg_m3",    "density_range_kg_m3",   "friction",
-    "restitution", "structure", "wall_thickness_m", "max_solid_thickness_m", "max_wall_thickness_m",
-    "source"};
+    "name",         "color",     "density_kg_m3",    "density_range_kg_m3",   "friction",
+    "restitution",  "structure", "wall_thickness_m", "max_solid_thickness_m", "max_wall_thickness_m",
+    "wall_range_m", "source"};
 
 Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   if (!j.is_object()) return Status::ParseError(where + ": expected an object");
@@ -132,6 +136,11 @@ Result<MaterialClass> parse_class(const json& j, const std::string& where) {
   G2P_RETURN_IF_ERROR(number(j, "wall_thickness_m", c.wall_thickness_m, false));
   G2P_RETURN_IF_ERROR(number(j, "max_solid_thickness_m", c.max_solid_thickness_m, false));
   G2P_RETURN_IF_ERROR(number(j, "max_wall_thickness_m", c.max_wall_thickness_m, false));
+  if (auto w = j.find("wall_range_m"); w != j.end()) {
+    if (!w->is_array() || w->size() != 2 || !(*w)[0].is_number() || !(*w)[1].is_number())
+      return Status::ParseError(here + ": 'wall_range_m' must be [thinnest, thickest] in metres");
+    c.wall_range_m = {(*w)[0].get<double>(), (*w)[1].get<double>()};
+  }
   if (auto s = j.find("structure"); s != j.end()) {
     const std::string v = s->is_string() ? s->get<std::string>() : "";
     if (iequals(v, "solid"))
@@ -236,6 +245,7 @@ std::string MaterialTable::to_json() const {
     // without them stay readable by a libg2p that predates the keys.
     if (c.max_solid_thickness_m > 0) classes.back()["max_solid_thickness_m"] = c.max_solid_thickness_m;
     if (c.max_wall_thickness_m > 0) classes.back()["max_wall_thickness_m"] = c.max_wall_thickness_m;
+    if (c.wall_range_m[1] > 0) classes.back()["wall_range_m"] = {c.wall_range_m[0], c.wall_range_m[1]};
   }
   json doc = {{"format", kFormat}, {"version", kFormatVersion}, {"name", name_}, {"classes", classes}};
   return detail::json_text(doc, 2) + "\n";

@@ -58,7 +58,8 @@ class KindEstimator final : public PropertyEstimator {
       p = std::move(*r);
       // Only a shell around air: a sofa's or a flower pot's solid bulk already stands for what fills them.
       if (index == body_ && kind_.structure == "hollow" && p.structure == Structure::kSolid &&
-          p.structure_source != ValueSource::kUser && in.completed != nullptr) {
+          p.structure_source != ValueSource::kUser && p.structure_source != ValueSource::kKind &&
+          in.completed != nullptr) {  // kKind: the kind's mass posterior chose it already
         double wall =
             in.table != nullptr && in.table->valid_label(p.label) ? (*in.table)[p.label].wall_thickness_m : 0.0;
         if (!(wall > 0)) wall = MaterialClass{}.wall_thickness_m;

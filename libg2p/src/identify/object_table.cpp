@@ -86,7 +86,14 @@ Result<ObjectKind> read_kind(const json& k, const std::string& where, std::size_
     for (const json& m2 : k["materials"]) {
       if (!m2.is_object() || !m2.value("class", json()).is_string())
         return field_error(where, n, "each of 'materials' needs a 'class'");
-      kind.materials.push_back({m2.value("role", std::string()), m2["class"].get<std::string>()});
+      KindMaterial material{m2.value("role", std::string()), m2["class"].get<std::string>()};
+      if (m2.contains("max_share")) {
+        const json& share = m2["max_share"];
+        if (!share.is_number() || !(share.get<double>() > 0.0 && share.get<double>() <= 1.0))
+          return field_error(where, n, "a material's 'max_share' must be a number in (0, 1]");
+        material.max_share = share.get<double>();
+      }
+      kind.materials.push_back(std::move(material));
     }
   }
   if (k.contains("hidden")) {

@@ -67,6 +67,7 @@ json full_json(const RunOptions& r) {
             {"kind_confidence", o.kind_confidence},
             {"size_from", to_string(o.size_policy)},
             {"kind_properties", o.kind_properties},
+            {"kind_posterior", o.kind_posterior},
             {"kind_prior", o.kind_prior},
             {"segmenter", backend_json(o.segmenter)},
             {"project", detail::project_json(o.project)},
@@ -179,6 +180,8 @@ Result<RunOptions> options_of(const json& j, RunOptions r) {
   if (!size.ok()) return size.status().with_context("size_from");
   o.size_policy = *size;
   o.kind_properties = j.at("kind_properties").get<bool>();
+  // Absent from files written before #65: the default.
+  if (j.contains("kind_posterior")) o.kind_posterior = j.at("kind_posterior").get<bool>();
   o.kind_prior = j.at("kind_prior").get<double>();
   o.segmenter = backend_of(j.at("segmenter"));
   G2P_RETURN_IF_ERROR(detail::read_project_json(j.at("project"), o.project));

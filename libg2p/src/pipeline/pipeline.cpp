@@ -137,6 +137,7 @@ struct Pipeline::Impl {
   Status project_labels(RunState& s);
   Status refine_labels(RunState& s);
   Status apply_corrections(RunState& s, bool apply_classes);
+  void fit_classes(RunState& s) const;
   Status complete_parts(RunState& s);
   Status estimate(RunState& s);
   Status decompose_collision(RunState& s);
@@ -406,6 +407,26 @@ Status Pipeline::Impl::apply_corrections(RunState& s, bool apply_classes) {
   return Status::Ok();
 }
 
+// The kind's share of each class (posterior.h), after the corrections: the
+// parts a person gave a class keep it.
+void Pipeline::Impl::fit_classes(RunState& s) const {
+  PipelineResult& r = s.r;
+  if (!options.kind_posterior || r.kind.name.empty()) return;
+  std::vector<bool> pinned(r.projection.parts.size(), false);
+  if (s.resolved)
+    for (std::size_t i = 0; i < r.projection.parts.size(); ++i)
+      for (int f : r.projection.parts[i].faces)
+        if (f >= 0 && static_cast<std::size_t>(f) < s.resolved->class_entry.size() &&
+            s.resolved->class_entry[static_cast<std::size_t>(f)] >= 0)
+          pinned[i] = true;
+  const std::vector<std::string> notes = fit_classes_to_kind(r.projection, r.kind, r.table, pinned, options.posterior);
+  if (notes.empty()) return;
+  for (StageReport& stage : r.stages)
+    if (stage.stage == Stage::kRefine)
+      for (const std::string& n : notes) stage.notes.push_back("the kind's classes: " + n);
+  r.kind_class_changes = notes;
+}
+
 // 5. complete: every part closed into a watertight volume.
 Status Pipeline::Impl::complete_parts(RunState& s) {
   PipelineResult& r = s.r;
@@ -465,6 +486,29 @@ Status Pipeline::Impl::estimate(RunState& s) {
                                         progress)
           : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views, progress);
   if (!report.ok()) return report.status().with_context("properties");
+  // The kind's mass: each part's structure chosen against it, weighed again
+  // where the choice differs from the estimator's.
+  if (o.kind_posterior && !r.kind.name.empty()) {
+    const double longest = bounds(mesh).sizes().maxCoeff();
+    Result<MassPosterior> posterior =
+        fit_mass_to_kind(r.projection.parts, r.completion, r.table, *report, r.kind, longest, o.posterior);
+    if (!posterior.ok()) {
+      r.warnings.push_back("properties: the kind's mass was not judged: " + posterior.status().message());
+    } else {
+      if (posterior->changed()) {
+        std::unique_ptr<PropertyEstimator> by_posterior = make_posterior_estimator(chosen, *posterior);
+        Result<PropertiesReport> again =
+            o.kind_properties
+                ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, *by_posterior, r.kind,
+                                              views, progress)
+                : estimate_properties(mesh, r.projection.parts, r.completion, r.table, *by_posterior, views, progress);
+        if (!again.ok()) return again.status().with_context("properties");
+        report = std::move(again);
+      }
+      apply_intervals(*posterior, *report);
+      for (const std::string& n : r.kind_class_changes) report->notes.push_back("kind's classes: " + n);
+    }
+  }
   r.properties = std::move(*report);
   r.properties.size = object_size(r.model);
   if (s.resolved)
@@ -593,6 +637,7 @@ Status Pipeline::Impl::run_stages(PipelineResult& r, RunContext& context, Stage 
     // even when the run starts after complete.
     if (e.stage == Stage::kRefine && first <= Stage::kProperties)
       G2P_RETURN_IF_ERROR(apply_corrections(s, /*apply_classes=*/first <= Stage::kComplete));
+    if (e.stage == Stage::kRefine && first <= Stage::kComplete && last >= Stage::kComplete) fit_classes(s);
     if (e.stage >= first || r.last_stage < e.stage) r.last_stage = e.stage;
   }
   return Status::Ok();
@@ -625,10 +670,37 @@ void scale_run(PipelineResult& r, double s) {
 // warning says what was assumed, or why not.
 void Pipeline::Impl::assume_kind_size(PipelineResult& r, const std::string& said, StageReport& report) const {
   ImportInfo& info = r.model.info;
-  if (!info.looks_normalised || info.scale_source != "file") return;
+  if (info.scale_source != "file") return;
   const PipelineOptions& o = options;
   const Identification& ident = r.identification;
   const bool confident = !r.kind.name.empty();
+  // A size the kind excludes (a 1.9 m camera, a 1.5 m toy train) is no more
+  // the object's than a normalised one: beyond kImplausibleSize times its
+  // usual longest sides either way.
+  constexpr double kImplausibleSize = 1.25;
+  if (!info.looks_normalised) {
+    const double longest = bounds(r.model.mesh).sizes().maxCoeff();
+    const std::array<double, 2>& usual = r.kind.longest_side_m;
+    if (!confident || o.size_policy != SizePolicy::kKind || !(usual[0] > 0.0) || !(longest > 0.0) ||
+        !std::isfinite(longest) || (longest >= usual[0] / kImplausibleSize && longest <= usual[1] * kImplausibleSize))
+      return;
+    const double target = r.kind.typical_longest_side_m;
+    if (!(target > 0.0)) return;
+    scale_run(r, target / longest);
+    r.kind_scale = target / longest;
+    info.scale_source = "kind";
+    r.size_assumed_m = target;
+    info.warnings.push_back("the file says the object is " + fixed(longest) + " m long, outside " +
+                            (std::string("aeiou").find(r.kind.name.front()) != std::string::npos ? "an " : "a ") +
+                            r.kind.name + "'s usual " + fixed(usual[0]) + "-" + fixed(usual[1]) +
+                            " m, and it is identified as " + said + ": it is scaled to a " + r.kind.name +
+                            "'s typical longest side, " + fixed(target) +
+                            " m (the object table). Give the real size with --height or --longest-side, or keep the "
+                            "file's with --size-from file (PipelineOptions::size_policy)");
+    report.notes.push_back("size assumed: longest side " + fixed(target) + " m, a " + r.kind.name + "'s (the file's " +
+                           fixed(longest) + " m is outside its usual range)");
+    return;
+  }
   auto normalised_warning = [&info] {
     return std::find_if(info.warnings.begin(), info.warnings.end(),
                         [](const std::string& w) { return w.rfind("the model looks normalised", 0) == 0; });

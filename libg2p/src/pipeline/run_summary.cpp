@@ -90,6 +90,13 @@ std::string pipeline_summary_text(const PipelineResult& r) {
     std::snprintf(line, sizeof line, "mass: %.4g kg (range %.3g - %.3g), centre of mass (%.4g %.4g %.4g) m\n",
                   r.properties.object.mass_kg, r.properties.mass_min_kg, r.properties.mass_max_kg, c.x(), c.y(), c.z());
     out += line;
+    if (r.properties.mass_median_kg > 0.0) {
+      std::snprintf(line, sizeof line,
+                    "  with its kind: median %.3g kg, 90 %% interval %.3g - %.3g kg (%s's %.3g-%.3g kg)\n",
+                    r.properties.mass_median_kg, r.properties.mass_p05_kg, r.properties.mass_p95_kg,
+                    r.kind.name.c_str(), r.properties.kind_range_kg[0], r.properties.kind_range_kg[1]);
+      out += line;
+    }
   }
   return out;
 }

@@ -292,11 +292,16 @@ std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
   h << "<h1>" << escape(r.asset.name) << "</h1>\n<p>" << escape(r.model.info.path) << ": " << r.model.mesh.num_faces()
     << " triangles, " << r.views.size() << " views, " << r.projection.parts.size() << " parts. Total mass <b>"
     << number(m.mass_kg) << " kg</b> (plausible range " << number(r.properties.mass_min_kg) << " to "
-    << number(r.properties.mass_max_kg) << " kg), centre of mass (" << number(m.center_of_mass.x()) << ", "
-    << number(m.center_of_mass.y()) << ", " << number(m.center_of_mass.z()) << ") m. Size "
-    << number(r.properties.size.extent_m.x()) << " x " << number(r.properties.size.extent_m.y()) << " x "
-    << number(r.properties.size.extent_m.z()) << " m (height last; scale from " << escape(size_source(r.model.info))
-    << "). Run time " << number(r.seconds, "%.2f") << " s.</p>\n";
+    << number(r.properties.mass_max_kg) << " kg"
+    << (r.properties.mass_median_kg > 0
+            ? "; with its kind, median " + number(r.properties.mass_median_kg) + " kg, 90 % interval " +
+                  number(r.properties.mass_p05_kg) + " to " + number(r.properties.mass_p95_kg) + " kg"
+            : std::string())
+    << "), centre of mass (" << number(m.center_of_mass.x()) << ", " << number(m.center_of_mass.y()) << ", "
+    << number(m.center_of_mass.z()) << ") m. Size " << number(r.properties.size.extent_m.x()) << " x "
+    << number(r.properties.size.extent_m.y()) << " x " << number(r.properties.size.extent_m.z())
+    << " m (height last; scale from " << escape(size_source(r.model.info)) << "). Run time "
+    << number(r.seconds, "%.2f") << " s.</p>\n";
   object_line(h, r, o.kind_confidence);
   warnings_banner(h, r);
   if (!r.overrides_applied.empty()) {

@@ -122,6 +122,12 @@ json mat(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+// The kind's mass posterior's median and 90 % interval, or null where it did not judge.
+json interval_json(double median, double p05, double p95) {
+  if (!(median > 0.0)) return nullptr;
+  return {{"median", median}, {"p05", p05}, {"p95", p95}};
+}
+
 json mass_json(const MassProperties& m) {
   return {{"mass_kg", m.mass_kg},
           {"center_of_mass_m", vec(m.center_of_mass)},
@@ -157,6 +163,7 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
     j["area_m2"] = r.mass.area_m2;
     j["mass_min_kg"] = r.mass_min_kg;
     j["mass_max_kg"] = r.mass_max_kg;
+    j["mass_interval_kg"] = interval_json(r.mass_median_kg, r.mass_p05_kg, r.mass_p95_kg);
     j["friction_static"] = p.friction_static;
     j["friction_dynamic"] = p.friction_dynamic;
     j["restitution"] = p.restitution;
@@ -177,6 +184,9 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
   json object = mass_json(report.object);
   object["mass_min_kg"] = report.mass_min_kg;
   object["mass_max_kg"] = report.mass_max_kg;
+  object["mass_interval_kg"] = interval_json(report.mass_median_kg, report.mass_p05_kg, report.mass_p95_kg);
+  object["kind_mass_range_kg"] =
+      report.kind_range_kg[1] > 0.0 ? json::array({report.kind_range_kg[0], report.kind_range_kg[1]}) : json(nullptr);
   double contents_volume = 0.0;
   for (const PartReport& r : report.parts) contents_volume += r.contents.volume_m3;
   object["material_volume_m3"] = report.object.volume_m3 - contents_volume;

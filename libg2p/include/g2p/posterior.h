@@ -1,0 +1,137 @@
+// posterior: what the object's kind decides where its surface cannot show it
+// (issue #65). The paper asks its vision-language model for each part's
+// structure and wall thickness with the object in view; offline, the kind
+// (identify.h) is the context. Two steps, both only for an object whose kind
+// the run acts on:
+//  - fit_classes_to_kind, after refine: a class may cover only the share of
+//    the object's surface the kind allows it (a car's Rubber is its tyres, a
+//    small share); the largest parts of a class beyond its share take the
+//    most probable class the kind allows, from their own votes.
+//  - fit_mass_to_kind, after properties: every part has the structures its
+//    class allows (solid, a shell of a wall from the class's set, a fill of
+//    foam or fabric, at the low, nominal or high density of its class), each
+//    with a prior; the kind's mass range, scaled to the object's size, is the
+//    likelihood of the total. The assignment with the highest posterior is
+//    chosen and weighed physically (each part its volume times its density,
+//    never a scaled total); importance sampling gives the median and 90 %
+//    interval of the object and of each part.
+// docs/properties.md#the-kinds-mass-posterior states the rules.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "g2p/complete.h"
+#include "g2p/identify.h"
+#include "g2p/materials.h"
+#include "g2p/mesh.h"
+#include "g2p/project.h"
+#include "g2p/properties.h"
+#include "g2p/status.h"
+#include "g2p/visibility.h"
+
+namespace g2p {
+
+struct PosteriorOptions {
+  // Within a kind, mass grows as (size / typical size)^size_exponent. 2.0 is
+  // the slope of log mass on log longest side over the 47 validation models
+  // whose name names a kind (data/mass-ranges/val.json; docs/accuracy.md).
+  double size_exponent = 2.0;
+  // The kind's mass range is read as this central share of a log-normal
+  // belief about the real object's mass; inside the range, less `margin` of
+  // its width (in log) at either end, every mass is as likely; beyond, the
+  // belief falls off with that log-normal's tails. The margin keeps a chosen
+  // mass off the range's very edge.
+  double range_share = 0.98;  // (0, 1)
+  double margin = 0.1;        // [0, 0.5)
+  // Largest share of the object's surface area a class may cover when the
+  // kind does not list it (a badge, screws, a label), and when it lists it
+  // for a role other than its first (main) one and gives no share itself
+  // (KindMaterial::max_share). The main role's class may cover everything.
+  double unlisted_share = 0.25;  // [0, 1]
+  double minor_share = 0.6;      // [0, 1]
+  // Prior weights of the structures a part may have, relative to the one the
+  // estimator chose from the geometry (weight 1).
+  double other_wall_weight = 0.5;       // the same structure, another wall from the class's set
+  double other_structure_weight = 0.3;  // solid for hollow or hollow for solid
+  double other_density_weight = 0.5;    // the class's lowest or highest density instead of its nominal
+  double fill_weight = 0.5;             // foam or fabric over a frame, a share of its closed volume filled
+  int samples = 4000;                   // importance samples for the intervals; 0 = no intervals
+  std::uint32_t seed = 1;               // the sampler's, for reproducible intervals
+};
+
+// The most of the object's surface area each class of `table` may cover for
+// an object of `kind` (per label; 1 = no limit).
+G2P_API std::vector<double> kind_class_shares(const ObjectKind& kind, const MaterialTable& table,
+                                              const PosteriorOptions& options = {});
+
+// Relabels the parts (and their faces in `projection.labels`) whose class
+// covers more of the surface than the kind allows, largest part first, each
+// to the most probable class of its faces' votes (`projection.votes`; the
+// kind's main class where the votes name none) that the kind allows at the
+// share it would then reach. Parts with `pinned[i]` (a person's class) are
+// left alone. Returns one note per change ("part 3 (0.62 of the surface):
+// Rubber -> Metal: a car's Rubber (tyres) covers at most 20 % of it").
+G2P_API std::vector<std::string> fit_classes_to_kind(Projection& projection, const ObjectKind& kind,
+                                                     const MaterialTable& table, const std::vector<bool>& pinned = {},
+                                                     const PosteriorOptions& options = {});
+
+// One way a part may be: its class, structure and density.
+struct PartHypothesis {
+  Structure structure = Structure::kSolid;
+  double wall_thickness_m = 0.0;  // hollow: the shell's thickness
+  bool double_walled = false;     // hollow: both faces of the wall modelled, each carries t / 2
+  double fill = 1.0;              // solid: the share of the closed volume filled (foam, stuffing)
+  double density_kg_m3 = 0.0;     // of the material (a fill weighs fill x density)
+  double mass_kg = 0.0;           // this part's mass so
+  double prior = 1.0;             // relative prior weight
+  bool estimated = false;         // the estimator's own answer
+  std::string words;              // "hollow, 2 mm walls", "solid, 60 % filled", "solid"
+};
+
+struct PartPosterior {
+  int part = -1;
+  std::vector<PartHypothesis> hypotheses;  // [0] is the estimator's
+  int chosen = 0;                          // into hypotheses
+  bool pinned = false;                     // a person's structure or density: kept
+  double median_kg = 0.0, p05_kg = 0.0, p95_kg = 0.0;
+  std::string note;  // why it changed, in words; "" when the estimator's answer stands
+};
+
+struct MassPosterior {
+  std::string kind;                 // the kind's name
+  double longest_side_m = 0.0;      // the object's size it was judged at
+  double range_kg[2] = {0.0, 0.0};  // the kind's range scaled to that size
+  double hidden_fraction = 0.0;     // the kind's hidden mass, a share of the whole (added where the body is hollow)
+  int body = -1;                    // the part that holds it
+  std::vector<PartPosterior> parts;
+  double mass_kg = 0.0;       // the chosen assignment's total (hidden mass included)
+  double estimated_kg = 0.0;  // the estimator's total, before
+  double median_kg = 0.0, p05_kg = 0.0, p95_kg = 0.0;
+  bool in_range = false;           // the chosen total lies in range_kg
+  double effective_samples = 0.0;  // of the importance sampler
+  std::vector<std::string> notes;  // the choice in words; the part that breaks the range when none reaches it
+  bool changed() const;            // some part's chosen hypothesis is not the estimator's
+};
+
+// Judges `report` (estimate_properties or estimate_properties_of_kind for
+// `kind`) against the kind's mass at `longest_side_m`. Parts whose structure,
+// wall or density a person set (ValueSource::kUser) keep them.
+G2P_API Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
+                                               const MaterialTable& table, const PropertiesReport& report,
+                                               const ObjectKind& kind, double longest_side_m,
+                                               const PosteriorOptions& options = {});
+
+// An estimator that answers as `base` except where `posterior` chose another
+// hypothesis, which it gives with source "kind" and the posterior's note.
+// `base` and `posterior` must outlive it.
+G2P_API std::unique_ptr<PropertyEstimator> make_posterior_estimator(const PropertyEstimator& base,
+                                                                    const MassPosterior& posterior);
+
+// Writes the posterior's intervals into `report` (PartReport and
+// PropertiesReport mass_median_kg, mass_p05_kg, mass_p95_kg) and its notes.
+G2P_API void apply_intervals(const MassPosterior& posterior, PropertiesReport& report);
+
+}  // namespace g2p

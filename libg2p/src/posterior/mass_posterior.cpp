@@ -1,0 +1,448 @@
+// fit_mass_to_kind: the structure of every part chosen against the kind's
+// mass (posterior.h); the posterior's median and 90 % interval by importance
+// sampling.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <random>
+
+#include "g2p/posterior.h"
+
+namespace g2p {
+
+namespace {
+
+std::string mm(double m) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g mm", m * 1000.0);
+  return text;
+}
+
+std::string kg(double m) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g kg", m);
+  return text;
+}
+
+std::string article(const std::string& noun) {
+  const bool vowel = !noun.empty() && std::string("aeiou").find(noun.front()) != std::string::npos;
+  return (vowel ? "an " : "a ") + noun;
+}
+
+// The standard normal quantile (Acklam's rational approximation, relative
+// error below 1.2e-9), for the range's share of the log-normal.
+double normal_quantile(double p) {
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  const double lo = 0.02425;
+  if (p < lo) {
+    const double q = std::sqrt(-2 * std::log(p));
+    return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+  }
+  if (p > 1 - lo) return -normal_quantile(1 - p);
+  const double q = p - 0.5, r = q * q;
+  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+}
+
+// log of the likelihood of a total mass: 0 inside [lo, hi], the log-normal's
+// tail (sigma in log units) outside.
+struct MassLikelihood {
+  double lo = 0.0, hi = 0.0, sigma = 1.0;
+  double operator()(double m) const {
+    if (!(m > 0.0)) return -1e9;
+    const double below = std::log(lo / m), above = std::log(m / hi);
+    const double out = std::max({below, above, 0.0});
+    return -0.5 * out * out / (sigma * sigma);
+  }
+};
+
+// Weighted quantile of (value, weight) pairs, sorted by value in place.
+double weighted_quantile(std::vector<std::pair<double, double>>& v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  double total = 0.0;
+  for (const auto& x : v) total += x.second;
+  if (!(total > 0.0)) return v[v.size() / 2].first;
+  double run = 0.0;
+  for (const auto& x : v) {
+    run += x.second;
+    if (run >= q * total) return x.first;
+  }
+  return v.back().first;
+}
+
+bool same(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); }
+
+// The walls a hollow part of class `c` may have: four from its range,
+// spaced evenly in log.
+std::vector<double> wall_set(const MaterialClass& c) {
+  double lo = c.wall_range_m[0], hi = c.wall_range_m[1];
+  if (!(lo > 0.0 && hi >= lo)) {
+    lo = 0.5 * c.wall_thickness_m;
+    hi = 2.0 * c.wall_thickness_m;
+  }
+  std::vector<double> walls;
+  for (int i = 0; i < 4; ++i) walls.push_back(lo * std::pow(hi / lo, i / 3.0));
+  return walls;
+}
+
+// Every way part `r` may be, the estimator's first.
+std::vector<PartHypothesis> hypotheses_of(const PartReport& r, const Part& part, const CompletedPart& completed,
+                                          const MaterialClass& c, const PosteriorOptions& o) {
+  const PartProperties& p = r.properties;
+  std::vector<PartHypothesis> out;
+  PartHypothesis own;
+  own.structure = p.structure;
+  own.wall_thickness_m = p.wall_thickness_m;
+  own.double_walled = p.double_walled;
+  own.density_kg_m3 = p.density_kg_m3;
+  own.mass_kg = r.mass.mass_kg - r.contents.mass_kg;
+  own.estimated = true;
+  own.words = p.structure == Structure::kHollow
+                  ? "hollow, " + mm(p.wall_thickness_m) + (p.double_walled ? " walls modelled on both faces" : " walls")
+                  : std::string("solid");
+  out.push_back(own);
+  const bool pinned = p.structure_source == ValueSource::kUser || p.density_source == ValueSource::kUser ||
+                      p.thickness_source == ValueSource::kUser;
+  if (pinned) return out;
+  const double volume = completed.checks.volume_m3, area = part.area_m2;
+  if (!(volume > 0.0) || !(area > 0.0)) return out;
+  // A volume the input's faces disagree with: its own sheet is as likely as its closed volume.
+  const bool doubtful = !completed.ok;
+  std::vector<std::pair<double, double>> densities = {{p.density_kg_m3, 1.0}};
+  for (double d : {c.density_min_kg_m3, c.density_max_kg_m3})
+    if (d > 0.0 && !same(d, p.density_kg_m3)) densities.push_back({d, o.other_density_weight});
+  const bool thin_measured = p.walls.rays > 0;
+  for (const auto& [density, density_weight] : densities) {
+    auto add = [&](PartHypothesis h, double weight) {
+      h.density_kg_m3 = density;
+      h.prior = weight * density_weight;
+      if (h.structure == own.structure && same(h.wall_thickness_m, own.wall_thickness_m) && same(h.fill, 1.0) &&
+          h.double_walled == own.double_walled && same(density, own.density_kg_m3))
+        return;  // the estimator's, already first
+      out.push_back(h);
+    };
+    // Solid, or a fill of a light class (foam, stuffing) over a frame.
+    PartHypothesis solid;
+    solid.structure = Structure::kSolid;
+    solid.mass_kg = volume * density;
+    solid.words = "solid";
+    const double solid_weight = own.structure == Structure::kSolid ? 1.0 : (doubtful ? 1.0 : o.other_structure_weight);
+    add(solid, solid_weight);
+    if (c.density_kg_m3 < 500.0)
+      for (double fill : {0.25, 0.5}) {
+        PartHypothesis h = solid;
+        h.fill = fill;
+        h.mass_kg = volume * density * fill;
+        char words[48];
+        std::snprintf(words, sizeof words, "solid, %.0f %% filled", 100.0 * fill);
+        h.words = words;
+        add(h, solid_weight * o.fill_weight);
+      }
+    // A single-walled shell from the class's walls.
+    for (double t : wall_set(c)) {
+      if (area * t >= volume) continue;                             // the shell would outweigh the volume
+      if (thin_measured && p.walls.thickness_m <= 2 * t) continue;  // the walls would fill it
+      PartHypothesis h;
+      h.structure = Structure::kHollow;
+      h.wall_thickness_m = t;
+      h.mass_kg = area * t * density;
+      h.words = "hollow, " + mm(t) + " walls";
+      double weight =
+          own.structure == Structure::kHollow ? o.other_wall_weight : (doubtful ? 1.0 : o.other_structure_weight);
+      if (own.structure == Structure::kHollow && !own.double_walled && same(t, own.wall_thickness_m)) weight = 1.0;
+      add(h, weight);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool MassPosterior::changed() const {
+  for (const PartPosterior& p : parts)
+    if (p.chosen != 0) return true;
+  return false;
+}
+
+Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
+                                       const MaterialTable& table, const PropertiesReport& report,
+                                       const ObjectKind& kind, double longest_side_m, const PosteriorOptions& o) {
+  if (!(kind.mass_kg[0] > 0.0 && kind.mass_kg[1] >= kind.mass_kg[0]))
+    return Status::InvalidArgument("posterior: the kind '" + kind.name + "' has no mass range");
+  if (!(longest_side_m > 0.0) || !std::isfinite(longest_side_m))
+    return Status::InvalidArgument("posterior: the object's longest side must be positive");
+  if (!(o.range_share > 0.0 && o.range_share < 1.0))
+    return Status::InvalidArgument("posterior: range_share must lie in (0, 1)");
+  MassPosterior post;
+  post.kind = kind.name;
+  post.longest_side_m = longest_side_m;
+  const double typical = kind.typical_longest_side_m > 0.0 ? kind.typical_longest_side_m : longest_side_m;
+  const double scale = std::pow(longest_side_m / typical, o.size_exponent);
+  post.range_kg[0] = kind.mass_kg[0] * scale;
+  post.range_kg[1] = kind.mass_kg[1] * scale;
+  if (!(o.margin >= 0.0 && o.margin < 0.5)) return Status::InvalidArgument("posterior: margin must lie in [0, 0.5)");
+  MassLikelihood likelihood;
+  const double width = std::log(post.range_kg[1] / post.range_kg[0]);
+  likelihood.lo = post.range_kg[0] * std::exp(o.margin * width);
+  likelihood.hi = post.range_kg[1] * std::exp(-o.margin * width);
+  const double z = normal_quantile(0.5 + 0.5 * o.range_share);
+  likelihood.sigma = std::max(0.05, width / (2.0 * z));
+
+  // The hidden mass rides on a hollow body (estimate_properties_of_kind): a
+  // share F of the whole, the visible mass times 1 / (1 - F).
+  for (const HiddenContent& h : kind.hidden) post.hidden_fraction += h.mass_fraction;
+  post.hidden_fraction = std::min(post.hidden_fraction, 0.9);
+  double largest = 0.0;
+  for (std::size_t i = 0; i < completion.parts.size(); ++i)
+    if (completion.parts[i].ok && completion.parts[i].checks.volume_m3 > largest) {
+      largest = completion.parts[i].checks.volume_m3;
+      post.body = static_cast<int>(i);
+    }
+  bool hidden_added = false;
+  for (const std::string& n : report.notes) hidden_added = hidden_added || n.rfind("hidden mass: ", 0) == 0;
+  for (const PartReport& r : report.parts)
+    if (r.part == post.body && r.contents.mass_kg > 0.0) hidden_added = true;
+  // The report's notes say whether the kind's hidden mass was added; where it
+  // was not (solid body, no cavity), it stays out of every total here too.
+  if (!hidden_added) post.hidden_fraction = 0.0;
+
+  double fixed_kg = 0.0;  // contents other than the kind's hidden mass (a person's fill)
+  for (const PartReport& r : report.parts) {
+    if (r.mass.mass_kg <= 0.0 || r.part < 0 || static_cast<std::size_t>(r.part) >= parts.size() ||
+        static_cast<std::size_t>(r.part) >= completion.parts.size() || !table.valid_label(r.properties.label))
+      continue;
+    if (r.part != post.body) fixed_kg += r.contents.mass_kg;
+    PartPosterior pp;
+    pp.part = r.part;
+    pp.hypotheses = hypotheses_of(r, parts[static_cast<std::size_t>(r.part)],
+                                  completion.parts[static_cast<std::size_t>(r.part)], table[r.properties.label], o);
+    pp.pinned = pp.hypotheses.size() == 1;
+    post.parts.push_back(std::move(pp));
+  }
+  if (post.parts.empty()) return Status::InvalidArgument("posterior: no part has a mass");
+  const int body_index = [&] {
+    for (std::size_t i = 0; i < post.parts.size(); ++i)
+      if (post.parts[i].part == post.body) return static_cast<int>(i);
+    return -1;
+  }();
+  // The object's total for choices `at` (index per part).
+  auto total = [&](const std::vector<int>& at, const std::vector<double>* masses = nullptr) {
+    double visible = fixed_kg;
+    for (std::size_t i = 0; i < post.parts.size(); ++i)
+      visible += masses != nullptr ? (*masses)[i] : post.parts[i].hypotheses[static_cast<std::size_t>(at[i])].mass_kg;
+    const bool hollow_body = body_index >= 0 && post.parts[static_cast<std::size_t>(body_index)]
+                                                        .hypotheses[static_cast<std::size_t>(at[body_index])]
+                                                        .structure == Structure::kHollow;
+    return hollow_body ? visible / (1.0 - post.hidden_fraction) : visible;
+  };
+  auto log_prior = [&](const std::vector<int>& at) {
+    double s = 0.0;
+    for (std::size_t i = 0; i < post.parts.size(); ++i)
+      s += std::log(post.parts[i].hypotheses[static_cast<std::size_t>(at[i])].prior);
+    return s;
+  };
+  std::vector<int> at(post.parts.size(), 0);
+  post.estimated_kg = total(at);
+  // Coordinate ascent on the log posterior, heaviest parts first; each sweep
+  // moves each part to its best hypothesis with the others held.
+  std::vector<std::size_t> order(post.parts.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return post.parts[a].hypotheses[0].mass_kg > post.parts[b].hypotheses[0].mass_kg;
+  });
+  double best = log_prior(at) + likelihood(total(at));
+  for (int sweep = 0; sweep < 50; ++sweep) {
+    bool moved = false;
+    for (std::size_t i : order) {
+      const int was = at[i];
+      int pick = was;
+      for (std::size_t h = 0; h < post.parts[i].hypotheses.size(); ++h) {
+        at[i] = static_cast<int>(h);
+        const double score = log_prior(at) + likelihood(total(at));
+        if (score > best + 1e-12) {
+          best = score;
+          pick = static_cast<int>(h);
+        }
+      }
+      at[i] = pick;
+      moved = moved || pick != was;
+    }
+    if (!moved) break;
+  }
+  post.mass_kg = total(at);
+  post.in_range = post.mass_kg >= post.range_kg[0] * (1 - 1e-9) && post.mass_kg <= post.range_kg[1] * (1 + 1e-9);
+
+  char range[96];
+  std::snprintf(range, sizeof range, "%.3g-%.3g kg at %.3g m", post.range_kg[0], post.range_kg[1], longest_side_m);
+  const std::string whose = article(kind.name) + "'s " + range;
+  for (std::size_t i = 0; i < post.parts.size(); ++i) {
+    PartPosterior& pp = post.parts[i];
+    pp.chosen = at[i];
+    if (pp.chosen == 0) continue;
+    std::vector<int> reverted = at;
+    reverted[i] = 0;
+    const double before = total(reverted);
+    const PartHypothesis& h = pp.hypotheses[static_cast<std::size_t>(pp.chosen)];
+    const PartHypothesis& own = pp.hypotheses[0];
+    char density[48];
+    std::snprintf(density, sizeof density, "%.0f kg/m^3", h.density_kg_m3);
+    std::string cls;
+    for (const PartReport& r : report.parts)
+      if (r.part == pp.part) cls = table[r.properties.label].name;
+    pp.note = h.words + " at " + density + ": " + cls + " " + own.words +
+              (same(own.density_kg_m3, h.density_kg_m3) ? "" : " at its nominal density") + " would make the object " +
+              kg(before) + ", " +
+              (before > post.range_kg[1]   ? "beyond "
+               : before < post.range_kg[0] ? "short of "
+                                           : "within ") +
+              whose + " (the kind's mass)";
+    post.notes.push_back("part " + std::to_string(pp.part) + " (" + cls + "): " + pp.note);
+  }
+  if (!post.in_range) {
+    // The part that breaks it: the heaviest when too heavy, the one that could
+    // gain most when too light.
+    std::size_t worst = 0;
+    double worst_kg = -1.0;
+    for (std::size_t i = 0; i < post.parts.size(); ++i) {
+      double extreme = post.mass_kg > post.range_kg[1] ? 1e300 : 0.0;
+      for (const PartHypothesis& h : post.parts[i].hypotheses)
+        extreme = post.mass_kg > post.range_kg[1] ? std::min(extreme, h.mass_kg) : std::max(extreme, h.mass_kg);
+      if (extreme > worst_kg) {
+        worst_kg = extreme;
+        worst = i;
+      }
+    }
+    const PartPosterior& w = post.parts[worst];
+    std::string cls;
+    for (const PartReport& r : report.parts)
+      if (r.part == w.part) cls = table[r.properties.label].name;
+    post.notes.push_back(
+        "no assignment of the parts' structures reaches " + whose + ": the object weighs " + kg(post.mass_kg) +
+        (post.mass_kg > post.range_kg[1]
+             ? "; part " + std::to_string(w.part) + " (" + cls + ") alone weighs at least " + kg(worst_kg)
+             : "; part " + std::to_string(w.part) + " (" + cls + ") weighs at most " + kg(worst_kg)) +
+        " (check its class, the object's size or what it is)");
+  }
+
+  // Importance sampling: hypotheses drawn by their priors, weighed by the
+  // likelihood of the total they make.
+  if (o.samples > 0) {
+    std::mt19937 rng(o.seed);
+    std::vector<std::discrete_distribution<int>> draw;
+    for (const PartPosterior& pp : post.parts) {
+      std::vector<double> w;
+      for (const PartHypothesis& h : pp.hypotheses) w.push_back(h.prior);
+      draw.emplace_back(w.begin(), w.end());
+    }
+    std::vector<std::pair<double, double>> totals;
+    std::vector<std::vector<std::pair<double, double>>> each(post.parts.size());
+    std::vector<int> sample(post.parts.size(), 0);
+    double sum = 0.0, sum2 = 0.0;
+    for (int s = 0; s < o.samples; ++s) {
+      for (std::size_t i = 0; i < post.parts.size(); ++i) sample[i] = draw[i](rng);
+      const double m = total(sample);
+      const double w = std::exp(likelihood(m));
+      sum += w;
+      sum2 += w * w;
+      totals.push_back({m, w});
+      for (std::size_t i = 0; i < post.parts.size(); ++i)
+        each[i].push_back({post.parts[i].hypotheses[static_cast<std::size_t>(sample[i])].mass_kg, w});
+    }
+    post.effective_samples = sum2 > 0.0 ? sum * sum / sum2 : 0.0;
+    if (!(sum > 0.0)) {  // no sample near the range: the prior's spread
+      for (auto& t : totals) t.second = 1.0;
+      for (auto& e : each)
+        for (auto& x : e) x.second = 1.0;
+    }
+    post.median_kg = weighted_quantile(totals, 0.5);
+    post.p05_kg = weighted_quantile(totals, 0.05);
+    post.p95_kg = weighted_quantile(totals, 0.95);
+    for (std::size_t i = 0; i < post.parts.size(); ++i) {
+      PartPosterior& pp = post.parts[i];
+      pp.median_kg = weighted_quantile(each[i], 0.5);
+      pp.p05_kg = weighted_quantile(each[i], 0.05);
+      pp.p95_kg = weighted_quantile(each[i], 0.95);
+    }
+  }
+  return post;
+}
+
+namespace {
+
+class PosteriorEstimator final : public PropertyEstimator {
+ public:
+  PosteriorEstimator(const PropertyEstimator& base, const MassPosterior& posterior) : base_(base) {
+    for (const PartPosterior& p : posterior.parts)
+      if (p.chosen > 0) chosen_[p.part] = &p;
+  }
+  Result<PartProperties> estimate(const PropertyInput& in) const override {
+    Result<PartProperties> r = base_.estimate(in);
+    if (!r.ok() || in.part == nullptr || in.all_parts == nullptr) return r;
+    const int index = static_cast<int>(in.part - in.all_parts->data());
+    const auto it = chosen_.find(index);
+    if (it == chosen_.end()) return r;
+    const PartPosterior& pp = *it->second;
+    const PartHypothesis& h = pp.hypotheses[static_cast<std::size_t>(pp.chosen)];
+    PartProperties& p = *r;
+    const double nominal = p.density_kg_m3;
+    p.structure = h.structure;
+    p.wall_thickness_m = h.structure == Structure::kHollow ? h.wall_thickness_m : p.wall_thickness_m;
+    p.double_walled = h.structure == Structure::kHollow && h.double_walled;
+    const double density = h.density_kg_m3 * h.fill;
+    if (nominal > 0.0 && !same(density, nominal)) {
+      p.density_min_kg_m3 *= density / nominal;
+      p.density_max_kg_m3 *= density / nominal;
+      p.density_min_kg_m3 = std::min(p.density_min_kg_m3, density);
+      p.density_max_kg_m3 = std::max(p.density_max_kg_m3, density);
+      p.density_source = ValueSource::kKind;
+    }
+    p.density_kg_m3 = density;
+    p.structure_source = ValueSource::kKind;
+    if (h.structure == Structure::kHollow) p.thickness_source = ValueSource::kKind;
+    p.notes.push_back("the kind's mass: " + pp.note);
+    return r;
+  }
+
+ private:
+  const PropertyEstimator& base_;
+  std::map<int, const PartPosterior*> chosen_;
+};
+
+}  // namespace
+
+std::unique_ptr<PropertyEstimator> make_posterior_estimator(const PropertyEstimator& base,
+                                                            const MassPosterior& posterior) {
+  return std::make_unique<PosteriorEstimator>(base, posterior);
+}
+
+void apply_intervals(const MassPosterior& posterior, PropertiesReport& report) {
+  for (PartReport& r : report.parts)
+    for (const PartPosterior& p : posterior.parts)
+      if (p.part == r.part && p.median_kg > 0.0) {
+        r.mass_median_kg = p.median_kg;
+        r.mass_p05_kg = p.p05_kg;
+        r.mass_p95_kg = p.p95_kg;
+      }
+  if (posterior.median_kg > 0.0) {
+    report.mass_median_kg = posterior.median_kg;
+    report.mass_p05_kg = posterior.p05_kg;
+    report.mass_p95_kg = posterior.p95_kg;
+  }
+  report.kind_range_kg[0] = posterior.range_kg[0];
+  report.kind_range_kg[1] = posterior.range_kg[1];
+  for (const std::string& n : posterior.notes) report.notes.push_back("kind's mass: " + n);
+}
+
+}  // namespace g2p

@@ -1,0 +1,276 @@
+// The kind's classes by share and the kind's mass posterior (posterior.h).
+#include "g2p/posterior.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "g2p/export.h"
+#include "g2p/pipeline.h"
+#include "support/test_data.h"
+
+namespace g2p {
+namespace {
+
+const MaterialTable& table() { return MaterialTable::paper_default(); }
+int cls(const char* name) { return table().find(name); }
+
+const ObjectKind& kind(const char* name) {
+  const ObjectTable& objects = ObjectTable::shipped();
+  const int k = objects.find(name);
+  EXPECT_GE(k, 0) << name;
+  return objects.kinds()[static_cast<std::size_t>(k)];
+}
+
+TEST(KindClassShares, ACarsTyresAreASmallShareItsBodyAny) {
+  const std::vector<double> share = kind_class_shares(kind("car"), table());
+  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Metal"))], 1.0);   // the body, the main role
+  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Rubber"))], 0.2);  // the tyres (the object table)
+  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Glass"))], PosteriorOptions{}.minor_share);
+  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Stone"))], PosteriorOptions{}.unlisted_share);
+}
+
+// Three parts of one face each; part 0's face voted mostly Rubber, then Metal.
+Projection car_projection(double body_area) {
+  Projection p;
+  const int n = table().size();
+  p.votes.num_classes = n;
+  p.votes.row = {0, 1, 2};
+  p.votes.histogram.assign(static_cast<std::size_t>(3 * n), 0.0f);
+  p.votes.histogram[static_cast<std::size_t>(0 * n + cls("Rubber"))] = 80;
+  p.votes.histogram[static_cast<std::size_t>(0 * n + cls("Glass"))] = 5;
+  p.votes.histogram[static_cast<std::size_t>(0 * n + cls("Metal"))] = 15;
+  p.votes.histogram[static_cast<std::size_t>(1 * n + cls("Rubber"))] = 100;
+  p.votes.histogram[static_cast<std::size_t>(2 * n + cls("Glass"))] = 100;
+  p.votes.total = {100, 100, 100};
+  p.labels.label = {cls("Rubber"), cls("Rubber"), cls("Glass")};
+  p.parts = {{cls("Rubber"), {0}, body_area}, {cls("Rubber"), {1}, 0.1}, {cls("Glass"), {2}, 0.2}};
+  p.face_part = {0, 1, 2};
+  return p;
+}
+
+TEST(FitClassesToKind, ACarBodyLabelledRubberTakesItsNextMostProbableClassTheKindAllows) {
+  Projection p = car_projection(0.7);
+  const std::vector<std::string> notes = fit_classes_to_kind(p, kind("car"), table());
+  ASSERT_EQ(notes.size(), 1u);
+  // Glass (5 votes) would fit its share too, Metal (15) is more probable.
+  EXPECT_EQ(p.parts[0].label, cls("Metal"));
+  EXPECT_EQ(p.labels.label[0], cls("Metal"));
+  EXPECT_EQ(p.parts[1].label, cls("Rubber"));  // a tyre: 10 % of the surface, within a car's 20 %
+  EXPECT_EQ(p.parts[2].label, cls("Glass"));
+  EXPECT_NE(notes[0].find("part 0"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("Rubber -> Metal"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("tyres"), std::string::npos) << notes[0];
+}
+
+TEST(FitClassesToKind, ClassesWithinTheirSharesAndAPersonsClassesStay) {
+  Projection p = car_projection(0.05);  // the Rubber parts cover 0.15 / 0.35 = 43 %: too much for tyres...
+  p.parts[2].area_m2 = 0.85;            // ...but 0.15 / 1.0 is a car's tyres, with a body of metal
+  p.parts[2].label = p.labels.label[2] = cls("Metal");
+  EXPECT_TRUE(fit_classes_to_kind(p, kind("car"), table()).empty());
+  EXPECT_EQ(p.parts[0].label, cls("Rubber"));
+
+  Projection pinned = car_projection(0.7);
+  const std::vector<std::string> notes = fit_classes_to_kind(pinned, kind("car"), table(), {true, false, false});
+  // The pinned body stays Rubber; the tyre alone cannot bring the share down, and is moved too.
+  EXPECT_EQ(pinned.parts[0].label, cls("Rubber"));
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("a person's corrections"), std::string::npos) << notes.back();
+}
+
+// One part of `label`, weighed solid or hollow by the table's values, with a
+// closed volume and a surface area of its own.
+struct Weighed {
+  std::vector<Part> parts;
+  Completion completion;
+  PropertiesReport report;
+
+  void add(int label, double volume_m3, double area_m2, Structure structure = Structure::kSolid,
+           ValueSource source = ValueSource::kTable) {
+    const MaterialClass& c = table()[label];
+    const int index = static_cast<int>(parts.size());
+    parts.push_back({label, {index}, area_m2});
+    CompletedPart done;
+    done.part = index;
+    done.label = label;
+    done.ok = true;
+    done.checks.volume_m3 = volume_m3;
+    done.checks.area_m2 = area_m2;
+    completion.parts.push_back(done);
+    PartReport r;
+    r.part = index;
+    r.completed_ok = true;
+    r.properties.label = label;
+    r.properties.density_kg_m3 = c.density_kg_m3;
+    r.properties.density_min_kg_m3 = c.density_min_kg_m3;
+    r.properties.density_max_kg_m3 = c.density_max_kg_m3;
+    r.properties.structure = structure;
+    r.properties.wall_thickness_m = c.wall_thickness_m;
+    r.properties.structure_source = source;
+    r.mass.mass_kg =
+        structure == Structure::kSolid ? volume_m3 * c.density_kg_m3 : area_m2 * c.wall_thickness_m * c.density_kg_m3;
+    report.parts.push_back(r);
+    report.object.mass_kg += r.mass.mass_kg;
+  }
+};
+
+TEST(FitMassToKind, ASolidWoodChairFrameBecomesWhatAChairWeighs) {
+  Weighed w;
+  w.add(cls("Wood"), 0.025, 2.2);   // a carved frame, 17.5 kg solid
+  w.add(cls("Fabric"), 0.03, 1.0);  // the seat's upholstery, 3 kg
+  ASSERT_GT(w.report.object.mass_kg, 20.0);
+  Result<MassPosterior> post = fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 0.95);
+  ASSERT_TRUE(post.ok()) << post.status().to_string();
+  // The table's 2.5-12 kg at a chair's 0.88 m, scaled by (0.95 / 0.88)^2.
+  const double scale = std::pow(0.95 / kind("chair").typical_longest_side_m, 2.0);
+  EXPECT_NEAR(post->range_kg[0], 2.5 * scale, 1e-9);
+  EXPECT_NEAR(post->range_kg[1], 12 * scale, 1e-9);
+  EXPECT_TRUE(post->in_range) << post->mass_kg;
+  EXPECT_NEAR(post->estimated_kg, w.report.object.mass_kg, 1e-9);
+  ASSERT_EQ(post->parts.size(), 2u);
+  const PartPosterior& frame = post->parts[0];
+  ASSERT_NE(frame.chosen, 0);  // not the estimator's solid at 700 kg/m^3
+  const PartHypothesis& h = frame.hypotheses[static_cast<std::size_t>(frame.chosen)];
+  // Physical: the part weighs its own volume or shell times its density, never a scaled total.
+  const double physical =
+      h.structure == Structure::kHollow ? 2.2 * h.wall_thickness_m * h.density_kg_m3 : 0.025 * h.density_kg_m3 * h.fill;
+  EXPECT_NEAR(h.mass_kg, physical, 1e-9);
+  EXPECT_NE(frame.note.find("chair"), std::string::npos) << frame.note;
+  EXPECT_NE(frame.note.find("beyond"), std::string::npos) << frame.note;
+  // The interval: ordered, and the median inside the kind's range.
+  EXPECT_LE(post->p05_kg, post->median_kg);
+  EXPECT_LE(post->median_kg, post->p95_kg);
+  EXPECT_GE(post->median_kg, post->range_kg[0]);
+  EXPECT_LE(post->median_kg, post->range_kg[1]);
+  EXPECT_GT(post->effective_samples, 100.0);
+}
+
+TEST(FitMassToKind, AMassInTheKindsRangeIsKeptExactly) {
+  Weighed w;
+  w.add(cls("Wood"), 2.1e-4, 0.03);      // a hammer's handle, 0.147 kg
+  w.add(cls("Metal"), 1.68e-4, 0.0208);  // its head, 1.31 kg
+  Result<MassPosterior> post = fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("hammer"), 0.33);
+  ASSERT_TRUE(post.ok()) << post.status().to_string();
+  EXPECT_FALSE(post->changed());
+  EXPECT_DOUBLE_EQ(post->mass_kg, w.report.object.mass_kg);
+  EXPECT_TRUE(post->notes.empty());
+}
+
+TEST(FitMassToKind, APersonsStructureStaysAndWhatBreaksTheRangeIsNamed) {
+  Weighed w;
+  w.add(cls("Metal"), 0.2, 3.0, Structure::kSolid, ValueSource::kUser);  // 1.56 t of steel, a person's
+  w.add(cls("Plastic"), 0.001, 0.1, Structure::kHollow);
+  Result<MassPosterior> post = fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 0.9);
+  ASSERT_TRUE(post.ok());
+  EXPECT_TRUE(post->parts[0].pinned);
+  EXPECT_EQ(post->parts[0].chosen, 0);
+  EXPECT_FALSE(post->in_range);
+  ASSERT_FALSE(post->notes.empty());
+  EXPECT_NE(post->notes.back().find("no assignment"), std::string::npos) << post->notes.back();
+  EXPECT_NE(post->notes.back().find("part 0 (Metal)"), std::string::npos) << post->notes.back();
+}
+
+TEST(FitMassToKind, BadInputIsAnErrorNamingIt) {
+  Weighed w;
+  w.add(cls("Wood"), 0.01, 0.5);
+  EXPECT_FALSE(fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 0.0).ok());
+  ObjectKind massless = kind("chair");
+  massless.mass_kg = {0.0, 0.0};
+  const Status s = fit_mass_to_kind(w.parts, w.completion, table(), w.report, massless, 0.9).status();
+  EXPECT_NE(s.message().find("mass range"), std::string::npos) << s.message();
+}
+
+}  // namespace
+}  // namespace g2p
+
+namespace g2p {
+namespace {
+
+// A chair of boxes as an OBJ: four 8 cm wooden legs, an 8 cm seat board and
+// back, and a fabric cushion on the seat; 1.03 m tall.
+std::string write_box_chair(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream mtl(dir + "/chair.mtl");
+  mtl << "newmtl wood\nKd 0.6 0.4 0.2\nnewmtl fabric\nKd 0.8 0.1 0.4\n";
+  std::ofstream obj(dir + "/chair.obj");
+  obj << "mtllib chair.mtl\n";
+  int base = 0;
+  auto box = [&](double x0, double y0, double z0, double x1, double y1, double z1) {
+    for (int i = 0; i < 8; ++i)
+      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 2 ? y1 : y0) << " " << (i & 4 ? z1 : z0) << "\n";
+    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    for (const auto& q : quads)
+      obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " "
+          << base + q[2] << " " << base + q[3] << "\n";
+    base += 8;
+  };
+  obj << "usemtl wood\n";
+  for (double x : {0.0, 0.42})
+    for (double y : {0.0, 0.42}) box(x, y, 0.0, x + 0.08, y + 0.08, 0.45);
+  box(0.0, 0.0, 0.45, 0.5, 0.5, 0.53);   // seat board
+  box(0.0, 0.42, 0.53, 0.5, 0.5, 1.03);  // back
+  obj << "usemtl fabric\n";
+  box(0.03, 0.03, 0.53, 0.42, 0.42, 0.61);  // cushion
+  return dir + "/chair.obj";
+}
+
+TEST(KindPosterior, AChairOfSolidBoardsWeighsAsAChairAndMujocoWeighsItsPartsWhereTheyAre) {
+  const std::string dir = test::scratch_dir("KindPosteriorChair");
+  const std::string chair = write_box_chair(dir);
+  PipelineOptions o;
+  o.views.width = o.views.height = 192;                 // enough for two materials by name
+  o.completer = {"partition", {{"resolution", "48"}}};  // boxes need no finer grid
+  o.identifier = {"object", {}};
+  o.object = "chair";
+  o.kind_posterior = false;
+  Result<PipelineResult> plain = Pipeline(o).run_file(chair);
+  ASSERT_TRUE(plain.ok()) << plain.status().to_string();
+  o.kind_posterior = true;
+  Result<PipelineResult> r = Pipeline(o).run_file(chair);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  const double range_lo = r->properties.kind_range_kg[0], range_hi = r->properties.kind_range_kg[1];
+  ASSERT_GT(range_hi, range_lo);
+  // Solid boards of 700 kg/m^3 make a chair too heavy; the posterior brings it into a chair's range.
+  EXPECT_GT(plain->properties.object.mass_kg, range_hi);
+  EXPECT_GE(r->properties.object.mass_kg, range_lo);
+  EXPECT_LE(r->properties.object.mass_kg, range_hi);
+  int by_kind = 0;
+  for (const PartReport& p : r->properties.parts) {
+    if (p.properties.structure_source != ValueSource::kKind) continue;
+    ++by_kind;
+    bool noted = false;
+    for (const std::string& n : p.properties.notes) noted |= n.rfind("the kind's mass: ", 0) == 0;
+    EXPECT_TRUE(noted) << "part " << p.part;
+  }
+  EXPECT_GT(by_kind, 0);
+  EXPECT_GT(r->properties.mass_median_kg, 0.0);
+  EXPECT_LE(r->properties.mass_p05_kg, r->properties.mass_median_kg);
+  EXPECT_LE(r->properties.mass_median_kg, r->properties.mass_p95_kg);
+  // report.json carries the interval and the kind's range.
+  const nlohmann::json report = nlohmann::json::parse(report_json(r->properties, r->table));
+  EXPECT_DOUBLE_EQ(report["object"]["mass_interval_kg"]["median"].get<double>(), r->properties.mass_median_kg);
+  EXPECT_DOUBLE_EQ(report["object"]["kind_mass_range_kg"][1].get<double>(), range_hi);
+
+  // MuJoCo weighs the exported body: the chosen structures' mass, centre of mass and inertia.
+  if (!have_mujoco()) GTEST_SKIP() << "built without MuJoCo";
+  const std::string out = dir + "/out";
+  std::filesystem::remove_all(out);
+  ASSERT_TRUE(write_pipeline_output(out, *r, o).ok());
+  Result<EngineCheck> engine = check_in_mujoco(out + "/chair.xml");
+  ASSERT_TRUE(engine.ok()) << engine.status().to_string();
+  const MassProperties& m = r->properties.object;
+  EXPECT_NEAR(engine->mass_kg, m.mass_kg, 1e-6 * m.mass_kg);
+  EXPECT_LT((engine->center_of_mass - m.center_of_mass).norm(), 1e-4);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(engine->principal_moments[i], m.principal_moments()[i], 1e-4 * m.principal_moments().maxCoeff());
+  // It stands: dropped on the floor, it comes to rest.
+  EXPECT_TRUE(engine->finite);
+  EXPECT_LT(engine->final_speed_m_s, 0.05);
+}
+
+}  // namespace
+}  // namespace g2p

@@ -201,7 +201,8 @@ std::string write_box_chair(const std::string& dir) {
   int base = 0;
   auto box = [&](double x0, double y0, double z0, double x1, double y1, double z1) {
     for (int i = 0; i < 8; ++i)
-      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 2 ? y1 : y0) << " " << (i & 4 ? z1 : z0) << "\n";
+      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 4 ? z1 : z0) << " " << -(i & 2 ? y1 : y0)
+          << "\n";  // OBJ is +Y up
     const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
     for (const auto& q : quads)
       obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " "
@@ -260,6 +261,14 @@ TEST(KindPosterior, AChairOfSolidBoardsWeighsAsAChairAndMujocoWeighsItsPartsWher
   const std::string out = dir + "/out";
   std::filesystem::remove_all(out);
   ASSERT_TRUE(write_pipeline_output(out, *r, o).ok());
+  // ranges.json: the posterior's interval per part, to sample from.
+  const nlohmann::json ranges = nlohmann::json::parse(test::read_file(out + "/ranges.json"));
+  EXPECT_EQ(ranges["format"], "g2p-ranges");
+  EXPECT_EQ(ranges["object_mass_kg"]["from"], "posterior");
+  EXPECT_DOUBLE_EQ(ranges["object_mass_kg"]["min"].get<double>(), r->properties.mass_p05_kg);
+  ASSERT_FALSE(ranges["parts"].empty());
+  for (const nlohmann::json& p : ranges["parts"])
+    EXPECT_LE(p["mass_kg"]["min"].get<double>(), p["mass_kg"]["max"].get<double>()) << p.dump();
   Result<EngineCheck> engine = check_in_mujoco(out + "/chair.xml");
   ASSERT_TRUE(engine.ok()) << engine.status().to_string();
   const MassProperties& m = r->properties.object;
@@ -270,6 +279,75 @@ TEST(KindPosterior, AChairOfSolidBoardsWeighsAsAChairAndMujocoWeighsItsPartsWher
   // It stands: dropped on the floor, it comes to rest.
   EXPECT_TRUE(engine->finite);
   EXPECT_LT(engine->final_speed_m_s, 0.05);
+}
+
+// A car of boxes as an OBJ: a 4 x 1.8 x 1.1 m body on four 0.6 m wheels
+// beside it, all of one dark material named "rubber" (as a generated car's
+// dark paint reads).
+std::string write_box_car(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream mtl(dir + "/car.mtl");
+  mtl << "newmtl rubber\nKd 0.1 0.1 0.1\n";
+  std::ofstream obj(dir + "/car.obj");
+  obj << "mtllib car.mtl\nusemtl rubber\n";
+  int base = 0;
+  auto box = [&](double x0, double y0, double z0, double x1, double y1, double z1) {
+    for (int i = 0; i < 8; ++i)
+      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 4 ? z1 : z0) << " " << -(i & 2 ? y1 : y0)
+          << "\n";  // OBJ is +Y up
+    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    for (const auto& q : quads)
+      obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " "
+          << base + q[2] << " " << base + q[3] << "\n";
+    base += 8;
+  };
+  box(0.0, 0.0, 0.3, 4.0, 1.8, 1.4);  // body
+  for (double x : {0.4, 3.0})
+    for (double y : {-0.26, 1.81}) box(x, y, 0.0, x + 0.6, y + 0.25, 0.6);  // wheels
+  return dir + "/car.obj";
+}
+
+TEST(KindPosterior, ACarBodyVotedRubberIsSheetMetalWithItsMachineryAndRestsOnItsWheels) {
+  const std::string dir = test::scratch_dir("KindPosteriorCar");
+  const std::string car = write_box_car(dir);
+  PipelineOptions o;
+  o.views.width = o.views.height = 192;
+  o.completer = {"partition", {{"resolution", "48"}}};
+  o.identifier = {"object", {}};
+  o.object = "car";
+  Result<PipelineResult> r = Pipeline(o).run_file(car);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  // The body (the largest part) is Metal now, the wheels still Rubber, and the notes say why.
+  int body = -1;
+  for (std::size_t i = 0; i < r->projection.parts.size(); ++i)
+    if (body < 0 || r->projection.parts[i].area_m2 > r->projection.parts[static_cast<std::size_t>(body)].area_m2)
+      body = static_cast<int>(i);
+  ASSERT_GE(body, 0);
+  EXPECT_EQ(r->projection.parts[static_cast<std::size_t>(body)].label, table().find("Metal"));
+  for (std::size_t i = 0; i < r->projection.parts.size(); ++i)
+    if (static_cast<int>(i) != body) EXPECT_EQ(r->projection.parts[i].label, table().find("Rubber")) << i;
+  ASSERT_FALSE(r->kind_class_changes.empty());
+  EXPECT_NE(r->kind_class_changes[0].find("Rubber -> Metal"), std::string::npos) << r->kind_class_changes[0];
+  // A car's mass at 4 m, the machinery inside its hollow body.
+  EXPECT_GE(r->properties.object.mass_kg, r->properties.kind_range_kg[0]);
+  EXPECT_LE(r->properties.object.mass_kg, r->properties.kind_range_kg[1]);
+  const PartReport& shell = r->properties.parts[static_cast<std::size_t>(body)];
+  EXPECT_EQ(shell.properties.structure, Structure::kHollow);
+  EXPECT_GT(shell.contents.mass_kg, 0.0);
+
+  // Dropped in MuJoCo it comes to rest on its wheels, upright.
+  if (!have_mujoco()) GTEST_SKIP() << "built without MuJoCo";
+  const std::string out = dir + "/out";
+  std::filesystem::remove_all(out);
+  ASSERT_TRUE(write_pipeline_output(out, *r, o).ok());
+  Result<EngineCheck> engine = check_in_mujoco(out + "/car.xml");
+  ASSERT_TRUE(engine.ok()) << engine.status().to_string();
+  EXPECT_NEAR(engine->mass_kg, r->properties.object.mass_kg, 1e-6 * r->properties.object.mass_kg);
+  EXPECT_TRUE(engine->finite);
+  EXPECT_LT(engine->final_speed_m_s, 0.05);
+  EXPECT_NEAR(engine->resting_lowest_m, 0.0, 0.02);  // the wheels on the floor
+  // Upright: the centre of mass ends as high above the floor as it sits above the wheels' bottoms.
+  EXPECT_NEAR(engine->final_height_m, r->properties.object.center_of_mass.z(), 0.05);
 }
 
 }  // namespace

@@ -40,18 +40,16 @@ struct PosteriorOptions {
   // whose name names a kind (data/mass-ranges/val.json; docs/accuracy.md).
   double size_exponent = 2.0;
   // The kind's mass range is read as this central share of a log-normal
-  // belief about the real object's mass; inside the range, less `margin` of
-  // its width (in log) at either end, every mass is as likely; beyond, the
-  // belief falls off with that log-normal's tails. The margin keeps a chosen
-  // mass off the range's very edge.
-  double range_share = 0.98;  // (0, 1)
-  double margin = 0.1;        // [0, 0.5)
+  // belief about the real object's mass, centred on the range's geometric
+  // centre. An estimate already inside the range stands as it is; one
+  // outside takes the assignment with the highest posterior.
+  double range_share = 0.9;  // (0, 1)
   // Largest share of the object's surface area a class may cover when the
   // kind does not list it (a badge, screws, a label), and when it lists it
   // for a role other than its first (main) one and gives no share itself
   // (KindMaterial::max_share). The main role's class may cover everything.
   double unlisted_share = 0.25;  // [0, 1]
-  double minor_share = 0.6;      // [0, 1]
+  double minor_share = 0.35;     // [0, 1]
   // Prior weights of the structures a part may have, relative to the one the
   // estimator chose from the geometry (weight 1).
   double other_wall_weight = 0.5;       // the same structure, another wall from the class's set
@@ -113,7 +111,12 @@ struct MassPosterior {
   bool in_range = false;           // the chosen total lies in range_kg
   double effective_samples = 0.0;  // of the importance sampler
   std::vector<std::string> notes;  // the choice in words; the part that breaks the range when none reaches it
-  bool changed() const;            // some part's chosen hypothesis is not the estimator's
+  // Some part's chosen hypothesis is not the estimator's.
+  bool changed() const {
+    for (const PartPosterior& p : parts)
+      if (p.chosen != 0) return true;
+    return false;
+  }
 };
 
 // Judges `report` (estimate_properties or estimate_properties_of_kind for

@@ -1,5 +1,6 @@
 // Writing the output folder: what a result holds, as far as its last stage
 // went, committed atomically (folder/commit.h).
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -102,6 +103,45 @@ Status write_labels(const std::string& tmp, const PipelineResult& r, const Outpu
   return write_text_file(tmp + "/refine.json", refine_json(r));
 }
 
+// ranges.json (docs/report-schema.md#rangesjson): per part, the mass and
+// contact ranges a simulation may sample for domain randomisation. The mass
+// is the kind's posterior's 90 % interval where it judged the object, else
+// the range of the class's densities; friction and restitution are the
+// class's values widened by kContactSpread either way (libg2p's estimate:
+// no surveyed table gives their spread).
+std::string ranges_json(const PipelineResult& r) {
+  constexpr double kContactSpread = 0.25;
+  using nlohmann::json;
+  const PropertiesReport& p = r.properties;
+  const bool posterior = p.mass_median_kg > 0.0;
+  auto spread = [](double v, double lo_limit, double hi_limit) {
+    return json::array(
+        {std::max(lo_limit, v * (1.0 - kContactSpread)), std::min(hi_limit, v * (1.0 + kContactSpread))});
+  };
+  json parts = json::array();
+  for (const PartReport& part : p.parts) {
+    if (!(part.mass.mass_kg > 0.0)) continue;
+    const PartProperties& pp = part.properties;
+    const bool judged = part.mass_median_kg > 0.0;
+    parts.push_back({{"part", part.part},
+                     {"material", class_name(r.table, pp.label)},
+                     {"mass_kg",
+                      {{"nominal", part.mass.mass_kg},
+                       {"min", judged ? part.mass_p05_kg : part.mass_min_kg},
+                       {"max", judged ? part.mass_p95_kg : part.mass_max_kg},
+                       {"from", judged ? "posterior" : "density range"}}},
+                     {"friction_static", spread(pp.friction_static, 0.0, 10.0)},
+                     {"friction_dynamic", spread(pp.friction_dynamic, 0.0, 10.0)},
+                     {"restitution", spread(pp.restitution, 0.0, 1.0)}});
+  }
+  const json object = {{"nominal", p.object.mass_kg},
+                       {"min", posterior ? p.mass_p05_kg : p.mass_min_kg},
+                       {"max", posterior ? p.mass_p95_kg : p.mass_max_kg},
+                       {"from", posterior ? "posterior" : "density range"}};
+  const json doc = {{"format", "g2p-ranges"}, {"version", 1}, {"object_mass_kg", object}, {"parts", parts}};
+  return detail::json_text(doc, 2) + "\n";
+}
+
 // The simulation asset in the chosen formats.
 Status write_asset_files(const std::string& tmp, const PipelineResult& r, const PipelineOptions& o) {
   std::vector<std::string> engine_formats;
@@ -114,6 +154,7 @@ Status write_asset_files(const std::string& tmp, const PipelineResult& r, const 
   }
   G2P_RETURN_IF_ERROR(write_asset(tmp, r.asset, engine_formats, o.export_options));
   if (glb) G2P_RETURN_IF_ERROR(write_glb(tmp + "/" + r.asset.name + ".glb", r.model, r.projection.parts, r.asset));
+  G2P_RETURN_IF_ERROR(write_text_file(tmp + "/ranges.json", ranges_json(r)));
   return write_asset_report(tmp + "/report.json", r.properties, r.asset, r.table);
 }
 

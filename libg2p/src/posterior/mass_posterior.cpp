@@ -55,15 +55,14 @@ double normal_quantile(double p) {
          (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
 }
 
-// log of the likelihood of a total mass: 0 inside [lo, hi], the log-normal's
-// tail (sigma in log units) outside.
+// log of the likelihood of a total mass: a log-normal about `centre` (kg)
+// with `sigma` in log units, up to a constant.
 struct MassLikelihood {
-  double lo = 0.0, hi = 0.0, sigma = 1.0;
+  double centre = 1.0, sigma = 1.0;
   double operator()(double m) const {
     if (!(m > 0.0)) return -1e9;
-    const double below = std::log(lo / m), above = std::log(m / hi);
-    const double out = std::max({below, above, 0.0});
-    return -0.5 * out * out / (sigma * sigma);
+    const double d = std::log(m / centre);
+    return -0.5 * d * d / (sigma * sigma);
   }
 };
 
@@ -170,12 +169,6 @@ std::vector<PartHypothesis> hypotheses_of(const PartReport& r, const Part& part,
 
 }  // namespace
 
-bool MassPosterior::changed() const {
-  for (const PartPosterior& p : parts)
-    if (p.chosen != 0) return true;
-  return false;
-}
-
 Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
                                        const MaterialTable& table, const PropertiesReport& report,
                                        const ObjectKind& kind, double longest_side_m, const PosteriorOptions& o) {
@@ -192,11 +185,9 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   const double scale = std::pow(longest_side_m / typical, o.size_exponent);
   post.range_kg[0] = kind.mass_kg[0] * scale;
   post.range_kg[1] = kind.mass_kg[1] * scale;
-  if (!(o.margin >= 0.0 && o.margin < 0.5)) return Status::InvalidArgument("posterior: margin must lie in [0, 0.5)");
   MassLikelihood likelihood;
   const double width = std::log(post.range_kg[1] / post.range_kg[0]);
-  likelihood.lo = post.range_kg[0] * std::exp(o.margin * width);
-  likelihood.hi = post.range_kg[1] * std::exp(-o.margin * width);
+  likelihood.centre = std::sqrt(post.range_kg[0] * post.range_kg[1]);
   const double z = normal_quantile(0.5 + 0.5 * o.range_share);
   likelihood.sigma = std::max(0.05, width / (2.0 * z));
 
@@ -255,6 +246,9 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   };
   std::vector<int> at(post.parts.size(), 0);
   post.estimated_kg = total(at);
+  auto in_range = [&post](double m) {
+    return m >= post.range_kg[0] * (1 - 1e-9) && m <= post.range_kg[1] * (1 + 1e-9);
+  };
   // Coordinate ascent on the log posterior, heaviest parts first; each sweep
   // moves each part to its best hypothesis with the others held.
   std::vector<std::size_t> order(post.parts.size());
@@ -263,7 +257,8 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     return post.parts[a].hypotheses[0].mass_kg > post.parts[b].hypotheses[0].mass_kg;
   });
   double best = log_prior(at) + likelihood(total(at));
-  for (int sweep = 0; sweep < 50; ++sweep) {
+  // An estimate the kind agrees with stands.
+  for (int sweep = 0; sweep < 50 && !in_range(post.estimated_kg); ++sweep) {
     bool moved = false;
     for (std::size_t i : order) {
       const int was = at[i];
@@ -282,7 +277,7 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     if (!moved) break;
   }
   post.mass_kg = total(at);
-  post.in_range = post.mass_kg >= post.range_kg[0] * (1 - 1e-9) && post.mass_kg <= post.range_kg[1] * (1 + 1e-9);
+  post.in_range = in_range(post.mass_kg);
 
   char range[96];
   std::snprintf(range, sizeof range, "%.3g-%.3g kg at %.3g m", post.range_kg[0], post.range_kg[1], longest_side_m);

@@ -227,13 +227,40 @@ TEST(Identify, WordsThatNameNoKindFailThePipelineBeforeAnyWork) {
   EXPECT_NE(s.message().find("nearest"), std::string::npos);
 }
 
+TEST(Identify, AFileSizeTheKindExcludesTakesTheKindsTypicalSize) {
+  PipelineOptions o;
+  o.object = "refrigerator";  // a 0.33 m file named a refrigerator: its size is not a refrigerator's
+  o.last_stage = Stage::kIdentify;
+  Result<PipelineResult> r = Pipeline(o).run_file(source_path("examples/data/hammer.obj"));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  ASSERT_GT(r->kind.typical_longest_side_m, 1.0);
+  EXPECT_DOUBLE_EQ(r->size_assumed_m, r->kind.typical_longest_side_m);
+  EXPECT_NEAR(bounds(r->model.mesh).sizes().maxCoeff(), r->kind.typical_longest_side_m, 1e-3);
+  bool said = false;
+  for (const std::string& w : r->model.info.warnings)
+    said |= w.find("outside a refrigerator's usual") != std::string::npos &&
+            w.find("--size-from file") != std::string::npos;
+  EXPECT_TRUE(said);
+  // A hammer called a hammer keeps its size; --size-from file keeps any.
+  o.object = "hammer";
+  r = Pipeline(o).run_file(source_path("examples/data/hammer.obj"));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->size_assumed_m, 0.0);
+  o.object = "refrigerator";
+  o.size_policy = SizePolicy::kFile;
+  r = Pipeline(o).run_file(source_path("examples/data/hammer.obj"));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->size_assumed_m, 0.0);
+}
+
 TEST(Identify, AKindsMassRangeChecksTheFinishedObject) {
   PipelineOptions o;
-  o.object = "refrigerator";  // the 1.4 kg hammer is no refrigerator
+  o.object = "refrigerator";          // the 1.4 kg hammer is no refrigerator
+  o.size_policy = SizePolicy::kFile;  // its own 0.33 m kept (by default a refrigerator's size is taken)
   Pipeline p(o);
   Result<PipelineResult> r = p.run_file(source_path("examples/data/hammer.obj"));
   ASSERT_TRUE(r.ok()) << r.status().to_string();
-  EXPECT_EQ(r->size_assumed_m, 0.0);  // the hammer's size is not normalised: kept
+  EXPECT_EQ(r->size_assumed_m, 0.0);
   bool warned = false;
   for (const std::string& w : r->warnings) warned |= w.find("outside a refrigerator's usual") != std::string::npos;
   EXPECT_TRUE(warned);

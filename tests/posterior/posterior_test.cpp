@@ -30,8 +30,11 @@ TEST(KindClassShares, ACarsTyresAreASmallShareItsBodyAny) {
   const std::vector<double> share = kind_class_shares(kind("car"), table());
   EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Metal"))], 1.0);   // the body, the main role
   EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Rubber"))], 0.2);  // the tyres (the object table)
-  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Glass"))], PosteriorOptions{}.minor_share);
-  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Stone"))], PosteriorOptions{}.unlisted_share);
+  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Glass"))], 1.0);   // windows: the table gives no share
+  EXPECT_DOUBLE_EQ(share[static_cast<std::size_t>(cls("Stone"))], 1.0);   // not listed: no limit by default
+  PosteriorOptions strict;
+  strict.unlisted_share = 0.1;
+  EXPECT_DOUBLE_EQ(kind_class_shares(kind("car"), table(), strict)[static_cast<std::size_t>(cls("Stone"))], 0.1);
 }
 
 // Three parts of one face each; part 0's face voted mostly Rubber, then Metal.
@@ -57,7 +60,7 @@ TEST(FitClassesToKind, ACarBodyLabelledRubberTakesItsNextMostProbableClassTheKin
   Projection p = car_projection(0.7);
   const std::vector<std::string> notes = fit_classes_to_kind(p, kind("car"), table());
   ASSERT_EQ(notes.size(), 1u);
-  // Glass (5 votes) would fit its share too, Metal (15) is more probable.
+  // Metal (15 votes), the body's class; Glass (5), the windows', could not take 70 % of a car.
   EXPECT_EQ(p.parts[0].label, cls("Metal"));
   EXPECT_EQ(p.labels.label[0], cls("Metal"));
   EXPECT_EQ(p.parts[1].label, cls("Rubber"));  // a tyre: 10 % of the surface, within a car's 20 %
@@ -73,6 +76,11 @@ TEST(FitClassesToKind, ClassesWithinTheirSharesAndAPersonsClassesStay) {
   p.parts[2].label = p.labels.label[2] = cls("Metal");
   EXPECT_TRUE(fit_classes_to_kind(p, kind("car"), table()).empty());
   EXPECT_EQ(p.parts[0].label, cls("Rubber"));
+
+  // A kind that gives no shares changes nothing: a hammer of Rubber is a rubber mallet.
+  Projection mallet = car_projection(0.7);
+  EXPECT_TRUE(fit_classes_to_kind(mallet, kind("hammer"), table()).empty());
+  EXPECT_EQ(mallet.parts[0].label, cls("Rubber"));
 
   Projection pinned = car_projection(0.7);
   const std::vector<std::string> notes = fit_classes_to_kind(pinned, kind("car"), table(), {true, false, false});

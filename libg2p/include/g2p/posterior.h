@@ -45,11 +45,15 @@ struct PosteriorOptions {
   // outside takes the assignment with the highest posterior.
   double range_share = 0.9;  // (0, 1)
   // Largest share of the object's surface area a class may cover when the
-  // kind does not list it (a badge, screws, a label), and when it lists it
-  // for a role other than its first (main) one and gives no share itself
-  // (KindMaterial::max_share). The main role's class may cover everything.
-  double unlisted_share = 0.25;  // [0, 1]
-  double minor_share = 0.35;     // [0, 1]
+  // kind does not list it; 1 = no limit (a hammer's handle may be plastic).
+  // A listed class may cover what its role's KindMaterial::max_share says
+  // (a car's tyres 0.2), its main (first) role's class everything.
+  double unlisted_share = 1.0;  // [0, 1]
+  // A part that takes another class takes one the kind lists: its main
+  // role's at any share, another role's up to its max_share or, where the
+  // table gives none, up to this share of the surface (a car body voted
+  // Rubber is not its seats' Fabric).
+  double minor_share = 0.35;  // [0, 1]
   // Prior weights of the structures a part may have, relative to the one the
   // estimator chose from the geometry (weight 1).
   double other_wall_weight = 0.5;       // the same structure, another wall from the class's set

@@ -45,7 +45,7 @@ std::vector<double> kind_class_shares(const ObjectKind& kind, const MaterialTabl
     const KindMaterial& m = kind.materials[i];
     const int c = table.find(m.material_class);
     if (c < 0) continue;
-    const double s = i == 0 ? 1.0 : (m.max_share > 0.0 ? m.max_share : std::clamp(options.minor_share, 0.0, 1.0));
+    const double s = i == 0 || !(m.max_share > 0.0) ? 1.0 : m.max_share;
     double& to = share[static_cast<std::size_t>(c)];
     to = listed[static_cast<std::size_t>(c)] ? std::max(to, s) : s;  // a class listed for two roles: the larger
     listed[static_cast<std::size_t>(c)] = true;
@@ -61,6 +61,17 @@ std::vector<std::string> fit_classes_to_kind(Projection& projection, const Objec
   const int main_class = table.find(kind.materials.front().material_class);
   if (main_class < 0) return notes;
   const std::vector<double> share = kind_class_shares(kind, table, options);
+  // What a part may become: a class the kind lists, within its role's share
+  // (the main role's any, a minor role's without a share of its own up to
+  // minor_share); unlisted classes are no replacement.
+  std::vector<double> takes(static_cast<std::size_t>(n), 0.0);
+  for (std::size_t i = 0; i < kind.materials.size(); ++i) {
+    const KindMaterial& m = kind.materials[i];
+    const int c = table.find(m.material_class);
+    if (c < 0) continue;
+    const double s = i == 0 ? 1.0 : (m.max_share > 0.0 ? m.max_share : std::clamp(options.minor_share, 0.0, 1.0));
+    takes[static_cast<std::size_t>(c)] = std::max(takes[static_cast<std::size_t>(c)], s);
+  }
   std::vector<Part>& parts = projection.parts;
   double total = 0.0;
   std::vector<double> area(static_cast<std::size_t>(n), 0.0);
@@ -113,7 +124,7 @@ std::vector<std::string> fit_classes_to_kind(Projection& projection, const Objec
     for (int c = 0; c < n; ++c) {
       if (c == over) continue;
       const double fits = (area[static_cast<std::size_t>(c)] + part.area_m2) / total;
-      if (fits > share[static_cast<std::size_t>(c)] + 1e-9) continue;
+      if (fits > std::min(share[static_cast<std::size_t>(c)], takes[static_cast<std::size_t>(c)]) + 1e-9) continue;
       const double prob = p.empty() ? 0.0 : p[static_cast<std::size_t>(c)];
       if (prob > best || (prob == best && c == main_class)) {
         best = prob;

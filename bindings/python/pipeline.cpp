@@ -303,6 +303,9 @@ void bind_pipeline(py::module_& m) {
           "'kind' (a normalised mesh takes its identified kind's typical size) or 'file'")
       .def_readwrite("kind_properties", &PipelineOptions::kind_properties,
                      "use a known kind's structure and hidden mass in the properties stage")
+      .def_readwrite("kind_posterior", &PipelineOptions::kind_posterior,
+                     "with a known kind, limit classes to the kind's share of the surface and choose each part's "
+                     "structure against the kind's mass (g2p run --kind-mass; docs/properties.md)")
       .def_readwrite("kind_confidence", &PipelineOptions::kind_confidence,
                      "the least identification confidence for which the run acts on the kind (size, structure, "
                      "hidden mass, mass check)")

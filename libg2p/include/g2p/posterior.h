@@ -35,7 +35,8 @@
 namespace g2p {
 
 struct PosteriorOptions {
-  // Within a kind, mass grows as (size / typical size)^size_exponent. 2.0 is
+  // Within a kind, mass grows as (size / typical size)^size_exponent, the
+  // size held within the kind's usual longest sides. 2.0 is
   // the slope of log mass on log longest side over the 47 validation models
   // whose name names a kind (data/mass-ranges/val.json; docs/accuracy.md).
   double size_exponent = 2.0;

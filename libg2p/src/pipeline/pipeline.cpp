@@ -91,10 +91,17 @@ void plausibility_warnings(PipelineResult& r) {
   const double mass = r.asset.total.mass_kg;
   char what[160];
   std::snprintf(what, sizeof what, "%.3g kg and %.3g m long", mass, longest);
-  // The kind's usual mass: the plausibility check once the object is known.
-  if (!r.kind.name.empty() && mass > 0.0 && (mass < r.kind.mass_kg[0] || mass > r.kind.mass_kg[1])) {
+  // The kind's usual mass: the plausibility check once the object is known,
+  // at the object's size where the kind's mass posterior scaled it.
+  const bool scaled = r.properties.kind_range_kg[1] > 0.0;
+  const double lo = scaled ? r.properties.kind_range_kg[0] : r.kind.mass_kg[0];
+  const double hi = scaled ? r.properties.kind_range_kg[1] : r.kind.mass_kg[1];
+  if (!r.kind.name.empty() && mass > 0.0 && (mass < lo || mass > hi)) {
     char range[96];
-    std::snprintf(range, sizeof range, "%.3g-%.3g kg", r.kind.mass_kg[0], r.kind.mass_kg[1]);
+    if (scaled)
+      std::snprintf(range, sizeof range, "%.3g-%.3g kg at %.3g m long", lo, hi, longest);
+    else
+      std::snprintf(range, sizeof range, "%.3g-%.3g kg", lo, hi);
     const bool vowel = std::string("aeiou").find(r.kind.name.front()) != std::string::npos;
     r.warnings.push_back("mass: the object weighs " + fixed_mass(mass) + ", outside " + (vowel ? "an " : "a ") +
                          r.kind.name + "'s usual " + range +

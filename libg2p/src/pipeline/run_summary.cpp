@@ -131,9 +131,12 @@ std::string pipeline_summary_json(const PipelineResult& r, const PipelineOptions
           : nlohmann::json::parse(r.asset.identification_json, nullptr, /*allow_exceptions=*/false);
   if (identification.is_object()) {
     const bool known = !r.kind.name.empty() && m.mass_kg > 0;
+    // At the object's size where the kind's mass posterior scaled the range (PropertiesReport::kind_range_kg).
+    const bool scaled = r.properties.kind_range_kg[1] > 0.0;
+    const double lo = scaled ? r.properties.kind_range_kg[0] : r.kind.mass_kg[0];
+    const double hi = scaled ? r.properties.kind_range_kg[1] : r.kind.mass_kg[1];
     identification["mass_in_kind_range"] =
-        known ? nlohmann::json(m.mass_kg >= r.kind.mass_kg[0] && m.mass_kg <= r.kind.mass_kg[1])
-              : nlohmann::json(nullptr);
+        known ? nlohmann::json(m.mass_kg >= lo && m.mass_kg <= hi) : nlohmann::json(nullptr);
   }
   const nlohmann::json j = {{"format", "g2p-run"},
                             {"version", 1},

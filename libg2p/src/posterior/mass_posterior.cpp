@@ -182,7 +182,12 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   post.kind = kind.name;
   post.longest_side_m = longest_side_m;
   const double typical = kind.typical_longest_side_m > 0.0 ? kind.typical_longest_side_m : longest_side_m;
-  const double scale = std::pow(longest_side_m / typical, o.size_exponent);
+  // Within the kind's usual sizes: a 0.3 m "refrigerator" weighs as the smallest refrigerator, not as
+  // a refrigerator scaled down 40 times in mass.
+  double judged_at = longest_side_m;
+  if (kind.longest_side_m[0] > 0.0 && kind.longest_side_m[1] >= kind.longest_side_m[0])
+    judged_at = std::clamp(judged_at, kind.longest_side_m[0], kind.longest_side_m[1]);
+  const double scale = std::pow(judged_at / typical, o.size_exponent);
   post.range_kg[0] = kind.mass_kg[0] * scale;
   post.range_kg[1] = kind.mass_kg[1] * scale;
   MassLikelihood likelihood;

@@ -2,7 +2,7 @@
 """Score the mass of `g2p run` on the generated set when told the kind, the size, or both (#65).
 
     /usr/bin/python3 scripts/generated_set/score_mass.py --out OUT [--g2p BIN] [--jobs 2] [--only ID ...]
-        [--conditions kind_size,kind,size] [--json FILE] [-- EXTRA g2p run FLAGS]
+        [--conditions kind_size,kind,size] [--json FILE] [--reuse] [-- EXTRA g2p run FLAGS]
 
 Each model of data/generated/manifest.json is read from ../shared/generated/ID.glb (a model whose
 file is absent is listed and left out) and copied under the file name its generator wrote, so that
@@ -14,7 +14,7 @@ KIND is the annotated kind, or the first of its alternatives that names a kind o
 a model with neither runs without --object. From each report.json it reads the object's mass and
 the kind's median and 90 % interval, and prints, per condition, how many masses lie in the
 annotated range (data/generated/objects.json) and how often the interval covers the range's
-geometric midpoint.
+geometric midpoint. --reuse scores the outputs already in OUT without running g2p.
 """
 import argparse
 import json
@@ -35,7 +35,9 @@ def table_names():
         return {k["name"] for k in json.load(f)["kinds"]}
 
 
-def run(g2p, path, out, kind, size, extra):
+def run(g2p, path, out, kind, size, extra, reuse=False):
+    if reuse:
+        return read(out)
     cmd = [g2p, "run", path, "-o", out, "--overwrite", "-q"]
     if kind:
         cmd += ["--object", kind]
@@ -45,6 +47,12 @@ def run(g2p, path, out, kind, size, extra):
     done = subprocess.run(cmd + extra, capture_output=True, text=True)
     if done.returncode != 0:
         return {"error": (done.stderr.strip().splitlines() or ["exit %d" % done.returncode])[-1]}
+    return read(out)
+
+
+def read(out):
+    if not os.path.isfile(os.path.join(out, "report.json")):
+        return {"error": "no report.json in " + out}
     with open(os.path.join(out, "report.json")) as f:
         report = json.load(f)
     with open(os.path.join(out, "run.json")) as f:
@@ -62,6 +70,7 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--only", nargs="*")
     ap.add_argument("--json")
+    ap.add_argument("--reuse", action="store_true")
     ap.add_argument("--conditions", default="kind_size,kind,size")
     ap.add_argument("extra", nargs="*")
     a = ap.parse_args(argv)
@@ -85,13 +94,13 @@ def main(argv=None):
         os.makedirs(os.path.dirname(named), exist_ok=True)
         shutil.copyfile(path, named)
         kind = next((w for w in [ann["kind"]] + ann.get("kind_alternatives", []) if w in names), None)
-        rows[mid] = {"id": mid, "kind": ann["kind"], "told": kind, "range": ann["mass_kg"]}
+        rows[mid] = {"id": mid, "annotated": ann["kind"], "told": kind, "range": ann["mass_kg"], "runs": {}}
         for cond in conditions:
             jobs.append((mid, cond, named, kind if cond.startswith("kind") else None,
                          ann["real_size"] if cond in ("kind_size", "size") else None))
     with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
         results = pool.map(lambda j: (j[0], j[1], run(a.g2p, j[2], os.path.join(a.out, j[1], j[0]), j[3], j[4],
-                                                      a.extra)), jobs)
+                                                      a.extra, a.reuse)), jobs)
         for mid, cond, res in results:
             lo, hi = rows[mid]["range"]
             if "mass_kg" in res:
@@ -99,17 +108,18 @@ def main(argv=None):
                 p05, _, p95 = res["interval"]
                 mid_kg = math.sqrt(lo * hi)
                 res["covers"] = p05 is not None and p05 <= mid_kg <= p95
-            rows[mid][cond] = res
+            rows[mid]["runs"][cond] = res
     summary = {"models": len(rows), "missing": missing}
     for cond in conditions:
-        ok = [r[cond] for r in rows.values() if "mass_kg" in r.get(cond, {})]
+        ok = [r["runs"][cond] for r in rows.values() if "mass_kg" in r["runs"].get(cond, {})]
         judged = [x for x in ok if x["interval"][0] is not None]
         summary[cond] = {"runs": len(ok), "mass_in_range": sum(x["in_range"] for x in ok),
                          "intervals": len(judged), "interval_covers_midpoint": sum(x["covers"] for x in judged)}
     for r in rows.values():
-        print("%-26s %-16s %-10s %s" % (r["id"], r["kind"][:16], "%g-%g" % tuple(r["range"]), "  ".join(
-            "%s: %s" % (c, ("%.3g kg %s" % (r[c]["mass_kg"], "in" if r[c]["in_range"] else "out"))
-                        if "mass_kg" in r.get(c, {}) else "ERR " + r.get(c, {}).get("error", "?"))
+        runs = r["runs"]
+        print("%-26s %-16s %-10s %s" % (r["id"], r["annotated"][:16], "%g-%g" % tuple(r["range"]), "  ".join(
+            "%s: %s" % (c, ("%.3g kg %s" % (runs[c]["mass_kg"], "in" if runs[c]["in_range"] else "out"))
+                        if "mass_kg" in runs.get(c, {}) else "ERR " + runs.get(c, {}).get("error", "?"))
             for c in conditions)))
     print(json.dumps(summary, indent=1))
     if a.json:

@@ -186,6 +186,8 @@ TEST(FitMassToKind, BadInputIsAnErrorNamingIt) {
   Weighed w;
   w.add(cls("Wood"), 0.01, 0.5);
   EXPECT_FALSE(fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 0.0).ok());
+  const Status far = fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 5.0).status();
+  EXPECT_NE(far.message().find("far outside a chair's usual"), std::string::npos) << far.message();
   ObjectKind massless = kind("chair");
   massless.mass_kg = {0.0, 0.0};
   const Status s = fit_mass_to_kind(w.parts, w.completion, table(), w.report, massless, 0.9).status();
@@ -198,6 +200,22 @@ TEST(FitMassToKind, BadInputIsAnErrorNamingIt) {
 namespace g2p {
 namespace {
 
+// Appends closed, outward boxes to an OBJ, given in libg2p's frame (+Z up;
+// OBJ's +Y is up, so each vertex is written as x, z, -y).
+struct ObjBoxes {
+  std::ofstream& obj;
+  int base = 0;
+  void operator()(double x0, double y0, double z0, double x1, double y1, double z1) {
+    for (int i = 0; i < 8; ++i)
+      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 4 ? z1 : z0) << " " << -(i & 2 ? y1 : y0) << "\n";
+    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    for (const auto& q : quads)
+      obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " "
+          << base + q[2] << " " << base + q[3] << "\n";
+    base += 8;
+  }
+};
+
 // A chair of boxes as an OBJ: four 8 cm wooden legs, an 8 cm seat board and
 // back, and a fabric cushion on the seat; 1.03 m tall.
 std::string write_box_chair(const std::string& dir) {
@@ -206,17 +224,7 @@ std::string write_box_chair(const std::string& dir) {
   mtl << "newmtl wood\nKd 0.6 0.4 0.2\nnewmtl fabric\nKd 0.8 0.1 0.4\n";
   std::ofstream obj(dir + "/chair.obj");
   obj << "mtllib chair.mtl\n";
-  int base = 0;
-  auto box = [&](double x0, double y0, double z0, double x1, double y1, double z1) {
-    for (int i = 0; i < 8; ++i)
-      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 4 ? z1 : z0) << " " << -(i & 2 ? y1 : y0)
-          << "\n";  // OBJ is +Y up
-    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
-    for (const auto& q : quads)
-      obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " "
-          << base + q[2] << " " << base + q[3] << "\n";
-    base += 8;
-  };
+  ObjBoxes box{obj};
   obj << "usemtl wood\n";
   for (double x : {0.0, 0.42})
     for (double y : {0.0, 0.42}) box(x, y, 0.0, x + 0.08, y + 0.08, 0.45);
@@ -298,17 +306,7 @@ std::string write_box_car(const std::string& dir) {
   mtl << "newmtl rubber\nKd 0.1 0.1 0.1\n";
   std::ofstream obj(dir + "/car.obj");
   obj << "mtllib car.mtl\nusemtl rubber\n";
-  int base = 0;
-  auto box = [&](double x0, double y0, double z0, double x1, double y1, double z1) {
-    for (int i = 0; i < 8; ++i)
-      obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 4 ? z1 : z0) << " " << -(i & 2 ? y1 : y0)
-          << "\n";  // OBJ is +Y up
-    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
-    for (const auto& q : quads)
-      obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " "
-          << base + q[2] << " " << base + q[3] << "\n";
-    base += 8;
-  };
+  ObjBoxes box{obj};
   box(0.0, 0.0, 0.3, 4.0, 1.8, 1.4);  // body
   for (double x : {0.4, 3.0})
     for (double y : {-0.26, 1.81}) box(x, y, 0.0, x + 0.6, y + 0.25, 0.6);  // wheels

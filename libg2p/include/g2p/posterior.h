@@ -126,7 +126,9 @@ struct MassPosterior {
 
 // Judges `report` (estimate_properties or estimate_properties_of_kind for
 // `kind`) against the kind's mass at `longest_side_m`. Parts whose structure,
-// wall or density a person set (ValueSource::kUser) keep them.
+// wall or density a person set (ValueSource::kUser) keep them. Fails for an
+// object longer or shorter than 1.25 times the kind's usual longest sides
+// (not one of the kind as the table knows it: a toy train called a train).
 G2P_API Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
                                                const MaterialTable& table, const PropertiesReport& report,
                                                const ObjectKind& kind, double longest_side_m,

@@ -2,6 +2,7 @@
 // mass (posterior.h); the posterior's median and 90 % interval by importance
 // sampling.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -182,11 +183,25 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   post.kind = kind.name;
   post.longest_side_m = longest_side_m;
   const double typical = kind.typical_longest_side_m > 0.0 ? kind.typical_longest_side_m : longest_side_m;
-  // Within the kind's usual sizes: a 0.3 m "refrigerator" weighs as the smallest refrigerator, not as
-  // a refrigerator scaled down 40 times in mass.
+  // Within the kind's usual sizes. Far beyond them the object is not of the
+  // kind as the table knows it (a toy train taken for a train, a hammer
+  // called a refrigerator), and its mass is not judged; a little beyond
+  // (kSizeTolerance, as the pipeline's size rule) it is judged at the
+  // nearest usual size.
+  constexpr double kSizeTolerance = 1.25;
   double judged_at = longest_side_m;
-  if (kind.longest_side_m[0] > 0.0 && kind.longest_side_m[1] >= kind.longest_side_m[0])
-    judged_at = std::clamp(judged_at, kind.longest_side_m[0], kind.longest_side_m[1]);
+  const std::array<double, 2>& usual = kind.longest_side_m;
+  if (usual[0] > 0.0 && usual[1] >= usual[0]) {
+    if (longest_side_m < usual[0] / kSizeTolerance || longest_side_m > usual[1] * kSizeTolerance) {
+      char why[256];
+      std::snprintf(why, sizeof why,
+                    "the object is %.3g m long, far outside %s's usual %.3g-%.3g m: its mass is not judged "
+                    "against the kind's (is it one? check --object and the size given)",
+                    longest_side_m, article(kind.name).c_str(), usual[0], usual[1]);
+      return Status::InvalidArgument(why);
+    }
+    judged_at = std::clamp(judged_at, usual[0], usual[1]);
+  }
   const double scale = std::pow(judged_at / typical, o.size_exponent);
   post.range_kg[0] = kind.mass_kg[0] * scale;
   post.range_kg[1] = kind.mass_kg[1] * scale;

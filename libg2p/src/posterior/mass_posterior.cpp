@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <mutex>
@@ -249,19 +250,26 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     return -1;
   }();
   // The object's total for choices `at` (index per part).
-  auto total = [&](const std::vector<int>& at, const std::vector<double>* masses = nullptr) {
-    double visible = fixed_kg;
-    for (std::size_t i = 0; i < post.parts.size(); ++i)
-      visible += masses != nullptr ? (*masses)[i] : post.parts[i].hypotheses[static_cast<std::size_t>(at[i])].mass_kg;
-    const bool hollow_body = body_index >= 0 && post.parts[static_cast<std::size_t>(body_index)]
-                                                        .hypotheses[static_cast<std::size_t>(at[body_index])]
-                                                        .structure == Structure::kHollow;
+  auto hypothesis = [&post](std::size_t part, int h) -> const PartHypothesis& {
+    return post.parts[part].hypotheses[static_cast<std::size_t>(h)];
+  };
+  // The object's total from the parts' visible mass, with the hidden mass
+  // where the body is hollow.
+  auto with_hidden = [&](double visible, const std::vector<int>& at) {
+    const bool hollow_body =
+        body_index >= 0 &&
+        hypothesis(static_cast<std::size_t>(body_index), at[static_cast<std::size_t>(body_index)]).structure ==
+            Structure::kHollow;
     return hollow_body ? visible / (1.0 - post.hidden_fraction) : visible;
+  };
+  auto total = [&](const std::vector<int>& at) {
+    double visible = fixed_kg;
+    for (std::size_t i = 0; i < post.parts.size(); ++i) visible += hypothesis(i, at[i]).mass_kg;
+    return with_hidden(visible, at);
   };
   auto log_prior = [&](const std::vector<int>& at) {
     double s = 0.0;
-    for (std::size_t i = 0; i < post.parts.size(); ++i)
-      s += std::log(post.parts[i].hypotheses[static_cast<std::size_t>(at[i])].prior);
+    for (std::size_t i = 0; i < post.parts.size(); ++i) s += std::log(hypothesis(i, at[i]).prior);
     return s;
   };
   std::vector<int> at(post.parts.size(), 0);
@@ -276,22 +284,30 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return post.parts[a].hypotheses[0].mass_kg > post.parts[b].hypotheses[0].mass_kg;
   });
-  double best = log_prior(at) + likelihood(total(at));
+  // The sums kept as parts move, so that a sweep costs parts x hypotheses.
+  double prior = log_prior(at), visible = fixed_kg;
+  for (std::size_t i = 0; i < post.parts.size(); ++i) visible += hypothesis(i, 0).mass_kg;
+  double best = prior + likelihood(with_hidden(visible, at));
   // An estimate the kind agrees with stands.
   for (int sweep = 0; sweep < 50 && !in_range(post.estimated_kg); ++sweep) {
     bool moved = false;
     for (std::size_t i : order) {
       const int was = at[i];
+      const double rest_kg = visible - hypothesis(i, was).mass_kg;
+      const double rest_prior = prior - std::log(hypothesis(i, was).prior);
       int pick = was;
       for (std::size_t h = 0; h < post.parts[i].hypotheses.size(); ++h) {
         at[i] = static_cast<int>(h);
-        const double score = log_prior(at) + likelihood(total(at));
+        const PartHypothesis& c = hypothesis(i, at[i]);
+        const double score = rest_prior + std::log(c.prior) + likelihood(with_hidden(rest_kg + c.mass_kg, at));
         if (score > best + 1e-12) {
           best = score;
           pick = static_cast<int>(h);
         }
       }
       at[i] = pick;
+      visible = rest_kg + hypothesis(i, pick).mass_kg;
+      prior = rest_prior + std::log(hypothesis(i, pick).prior);
       moved = moved || pick != was;
     }
     if (!moved) break;
@@ -361,34 +377,37 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
       for (const PartHypothesis& h : pp.hypotheses) w.push_back(h.prior);
       draw.emplace_back(w.begin(), w.end());
     }
-    std::vector<std::pair<double, double>> totals;
-    std::vector<std::vector<std::pair<double, double>>> each(post.parts.size());
-    std::vector<int> sample(post.parts.size(), 0);
+    const std::size_t n = static_cast<std::size_t>(o.samples), count = post.parts.size();
+    std::vector<std::pair<double, double>> totals(n);
+    std::vector<std::uint16_t> drawn(n * count);  // sample s, part i: its hypothesis (at most a few dozen)
+    std::vector<int> sample(parts, 0);
     double sum = 0.0, sum2 = 0.0;
-    for (int s = 0; s < o.samples; ++s) {
-      for (std::size_t i = 0; i < post.parts.size(); ++i) sample[i] = draw[i](rng);
+    for (std::size_t s = 0; s < n; ++s) {
+      for (std::size_t i = 0; i < count; ++i) {
+        sample[i] = draw[i](rng);
+        drawn[s * count + i] = static_cast<std::uint16_t>(sample[i]);
+      }
       const double m = total(sample);
       const double w = std::exp(likelihood(m));
       sum += w;
       sum2 += w * w;
-      totals.push_back({m, w});
-      for (std::size_t i = 0; i < post.parts.size(); ++i)
-        each[i].push_back({post.parts[i].hypotheses[static_cast<std::size_t>(sample[i])].mass_kg, w});
+      totals[s] = {m, w};
     }
     post.effective_samples = sum2 > 0.0 ? sum * sum / sum2 : 0.0;
-    if (!(sum > 0.0)) {  // no sample near the range: the prior's spread
+    if (!(sum > 0.0))  // no sample near the range: the prior's spread
       for (auto& t : totals) t.second = 1.0;
-      for (auto& e : each)
-        for (auto& x : e) x.second = 1.0;
-    }
+    std::vector<double> weight(n);
+    for (std::size_t s = 0; s < n; ++s) weight[s] = totals[s].second;
     post.median_kg = weighted_quantile(totals, 0.5);
     post.p05_kg = weighted_quantile(totals, 0.05);
     post.p95_kg = weighted_quantile(totals, 0.95);
-    for (std::size_t i = 0; i < post.parts.size(); ++i) {
+    std::vector<std::pair<double, double>> each(n);
+    for (std::size_t i = 0; i < count; ++i) {
+      for (std::size_t s = 0; s < n; ++s) each[s] = {hypothesis(i, drawn[s * count + i]).mass_kg, weight[s]};
       PartPosterior& pp = post.parts[i];
-      pp.median_kg = weighted_quantile(each[i], 0.5);
-      pp.p05_kg = weighted_quantile(each[i], 0.05);
-      pp.p95_kg = weighted_quantile(each[i], 0.95);
+      pp.median_kg = weighted_quantile(each, 0.5);
+      pp.p05_kg = weighted_quantile(each, 0.05);
+      pp.p95_kg = weighted_quantile(each, 0.95);
     }
   }
   return post;

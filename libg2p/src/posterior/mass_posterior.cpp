@@ -380,7 +380,7 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     const std::size_t n = static_cast<std::size_t>(o.samples), count = post.parts.size();
     std::vector<std::pair<double, double>> totals(n);
     std::vector<std::uint16_t> drawn(n * count);  // sample s, part i: its hypothesis (at most a few dozen)
-    std::vector<int> sample(parts, 0);
+    std::vector<int> sample(count, 0);
     double sum = 0.0, sum2 = 0.0;
     for (std::size_t s = 0; s < n; ++s) {
       for (std::size_t i = 0; i < count; ++i) {

@@ -199,7 +199,12 @@ enum class SizePolicy {
           // longest side (the default)
   kFile,  // always keep the file's size
 };
-G2P_API const char* to_string(SizePolicy policy);                       // "kind", "file"
+G2P_API const char* to_string(SizePolicy policy);  // "kind", "file"
+// A size beyond this factor of a kind's usual longest sides, either way, is
+// not the kind's: with SizePolicy::kKind and no size given the run takes the
+// kind's typical size instead (a 1.9 m camera), and the kind's mass posterior
+// does not judge an object given such a size (a toy train called a train).
+inline constexpr double kKindSizeTolerance = 1.25;
 G2P_API Result<SizePolicy> parse_size_policy(const std::string& text);  // the flag's words
 
 // The properties stage for an object of a known kind: estimate_properties

@@ -682,14 +682,13 @@ void Pipeline::Impl::assume_kind_size(PipelineResult& r, const std::string& said
   const Identification& ident = r.identification;
   const bool confident = !r.kind.name.empty();
   // A size the kind excludes (a 1.9 m camera, a 1.5 m toy train) is no more
-  // the object's than a normalised one: beyond kImplausibleSize times its
-  // usual longest sides either way.
-  constexpr double kImplausibleSize = 1.25;
+  // the object's than a normalised one (kKindSizeTolerance).
   if (!info.looks_normalised) {
     const double longest = bounds(r.model.mesh).sizes().maxCoeff();
     const std::array<double, 2>& usual = r.kind.longest_side_m;
     if (!confident || o.size_policy != SizePolicy::kKind || !(usual[0] > 0.0) || !(longest > 0.0) ||
-        !std::isfinite(longest) || (longest >= usual[0] / kImplausibleSize && longest <= usual[1] * kImplausibleSize))
+        !std::isfinite(longest) ||
+        (longest >= usual[0] / kKindSizeTolerance && longest <= usual[1] * kKindSizeTolerance))
       return;
     const double target = r.kind.typical_longest_side_m;
     if (!(target > 0.0)) return;

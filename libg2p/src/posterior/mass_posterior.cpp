@@ -184,16 +184,14 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   post.kind = kind.name;
   post.longest_side_m = longest_side_m;
   const double typical = kind.typical_longest_side_m > 0.0 ? kind.typical_longest_side_m : longest_side_m;
-  // Within the kind's usual sizes. Far beyond them the object is not of the
-  // kind as the table knows it (a toy train taken for a train, a hammer
-  // called a refrigerator), and its mass is not judged; a little beyond
-  // (kSizeTolerance, as the pipeline's size rule) it is judged at the
-  // nearest usual size.
-  constexpr double kSizeTolerance = 1.25;
+  // Within the kind's usual sizes. Far beyond them (kKindSizeTolerance) the
+  // object is not of the kind as the table knows it (a toy train taken for a
+  // train, a hammer called a refrigerator), and its mass is not judged; a
+  // little beyond, it is judged at the nearest usual size.
   double judged_at = longest_side_m;
   const std::array<double, 2>& usual = kind.longest_side_m;
   if (usual[0] > 0.0 && usual[1] >= usual[0]) {
-    if (longest_side_m < usual[0] / kSizeTolerance || longest_side_m > usual[1] * kSizeTolerance) {
+    if (longest_side_m < usual[0] / kKindSizeTolerance || longest_side_m > usual[1] * kKindSizeTolerance) {
       char why[256];
       std::snprintf(why, sizeof why,
                     "the object is %.3g m long, far outside %s's usual %.3g-%.3g m: its mass is not judged "

@@ -93,11 +93,13 @@ TEST(Pipeline, WarnsOfAnImplausibleSizeAndOfPartsLeftOut) {
   o.import = hundredfold;
   Result<PipelineResult> big = Pipeline(o).run_file(hammer());
   ASSERT_TRUE(big.ok()) << big.status().to_string();
-  // Two warnings: the size, and the mass against a hammer's (its names say what it is).
-  ASSERT_EQ(big->warnings.size(), 2u);
-  EXPECT_NE(big->warnings[0].find("outside a hammer's usual"), std::string::npos) << big->warnings[0];
-  EXPECT_NE(big->warnings[1].find("--unit"), std::string::npos) << big->warnings[1];
-  EXPECT_NE(big->warnings[1].find("34 m long"), std::string::npos) << big->warnings[1];
+  // Three warnings: a 34 m object is not judged as a hammer (its names say what it is), its mass
+  // is far from a hammer's, and its size from anything household.
+  ASSERT_EQ(big->warnings.size(), 3u);
+  EXPECT_NE(big->warnings[0].find("far outside a hammer's usual"), std::string::npos) << big->warnings[0];
+  EXPECT_NE(big->warnings[1].find("outside a hammer's usual"), std::string::npos) << big->warnings[1];
+  EXPECT_NE(big->warnings[2].find("--unit"), std::string::npos) << big->warnings[2];
+  EXPECT_NE(big->warnings[2].find("34 m long"), std::string::npos) << big->warnings[2];
 
   // Debian's spider (centimetres in an OBJ, so about 190 m): many thin parts
   // get no closed volume, and the warning names them.

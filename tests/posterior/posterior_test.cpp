@@ -188,6 +188,10 @@ TEST(FitMassToKind, BadInputIsAnErrorNamingIt) {
   EXPECT_FALSE(fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 0.0).ok());
   const Status far = fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 5.0).status();
   EXPECT_NE(far.message().find("far outside a chair's usual"), std::string::npos) << far.message();
+  PosteriorOptions bad;
+  bad.fill_weight = -1.0;
+  const Status weight = fit_mass_to_kind(w.parts, w.completion, table(), w.report, kind("chair"), 0.9, bad).status();
+  EXPECT_NE(weight.message().find("fill_weight"), std::string::npos) << weight.message();
   ObjectKind massless = kind("chair");
   massless.mass_kg = {0.0, 0.0};
   const Status s = fit_mass_to_kind(w.parts, w.completion, table(), w.report, massless, 0.9).status();

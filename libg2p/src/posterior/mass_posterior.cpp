@@ -180,6 +180,14 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     return Status::InvalidArgument("posterior: the object's longest side must be positive");
   if (!(o.range_share > 0.0 && o.range_share < 1.0))
     return Status::InvalidArgument("posterior: range_share must lie in (0, 1)");
+  for (const auto& [name, weight] : {std::pair<const char*, double>{"other_wall_weight", o.other_wall_weight},
+                                     {"other_structure_weight", o.other_structure_weight},
+                                     {"other_density_weight", o.other_density_weight},
+                                     {"fill_weight", o.fill_weight}})
+    if (!(weight > 0.0 && weight <= 1.0))
+      return Status::InvalidArgument(std::string("posterior: ") + name + " must lie in (0, 1]");
+  if (!(std::isfinite(o.size_exponent) && o.size_exponent >= 0.0))
+    return Status::InvalidArgument("posterior: size_exponent must be a number >= 0");
   MassPosterior post;
   post.kind = kind.name;
   post.longest_side_m = longest_side_m;

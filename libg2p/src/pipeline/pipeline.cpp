@@ -439,7 +439,10 @@ Status Pipeline::Impl::complete_parts(RunState& s) {
   PipelineResult& r = s.r;
   detail::StageClock clock(Stage::kComplete, completer.backend(options.completer), options.measure_stage_memory);
   G2P_RETURN_IF_ERROR(s.context.report(Stage::kComplete, 0.0, std::to_string(r.projection.parts.size()) + " parts"));
-  CompletionInput input{&r.model.mesh, &r.projection.parts, &r.table, nullptr, {}};
+  CompletionInput input;
+  input.mesh = &r.model.mesh;
+  input.parts = &r.projection.parts;
+  input.table = &r.table;
   RunContext& context = s.context;
   input.progress = [&context](double fraction, const std::string& message) {
     return context.report(Stage::kComplete, fraction, message);

@@ -126,7 +126,9 @@ std::vector<PartHypothesis> hypotheses_of(const PartReport& r, const Part& part,
   for (double d : {c.density_min_kg_m3, c.density_max_kg_m3})
     if (d > 0.0 && !same(d, p.density_kg_m3)) densities.push_back({d, o.other_density_weight});
   const bool thin_measured = p.walls.rays > 0;
-  for (const auto& [density, density_weight] : densities) {
+  for (const auto& density_and_weight : densities) {
+    // Named, not bound: a lambda may not capture a structured binding before C++20.
+    const double density = density_and_weight.first, density_weight = density_and_weight.second;
     auto add = [&](PartHypothesis h, double weight) {
       h.density_kg_m3 = density;
       h.prior = weight * density_weight;

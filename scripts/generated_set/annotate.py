@@ -47,9 +47,15 @@ PALETTE = {"Wood": (150, 90, 40), "Rubber": (30, 30, 30), "Fabric": (200, 60, 16
            "ignore": (255, 255, 255)}
 
 
+# The model files come from public repositories and are never committed here:
+# they are read from ../shared/generated, named by the basename of the
+# manifest's `file`.
+SHARED = os.path.join(os.path.dirname(ROOT), "shared", "generated")
+
+
 def model_path(entry):
-    """The model file: committed under data/generated/, or fetched to external/."""
-    return os.path.join(SET, entry["file"])
+    """The model file in ../shared/generated (it may be absent)."""
+    return os.path.join(SHARED, os.path.basename(entry["file"]))
 
 
 def features(model):

@@ -4,8 +4,8 @@
     /usr/bin/python3 scripts/generated_set/score_identify.py --out OUT [--g2p BIN] [--only ID ...]
         [--json FILE] [--conditions nosize,size] [-- EXTRA g2p run FLAGS]
 
-Each model of data/generated/manifest.json (committed under models/, or fetched into external/ by
-fetch.py; missing ones are listed and left out) is copied under the file name its generator wrote
+Each model of data/generated/manifest.json (read from ../shared/generated; missing ones are listed
+and left out) is copied under the file name its generator wrote
 (the manifest's source path: sample.glb, mesh.glb, pot.glb), so that the names the identifier sees
 are the generator's, not this set's ids. Then `g2p run` runs twice per model:
   - nosize: the file as it is (a normalised mesh may take its identified kind's size);
@@ -30,11 +30,9 @@ SET = os.path.join(ROOT, "data", "generated")
 
 
 def model_file(entry):
-    """Committed under data/generated/, or fetched to external/ (fetch.py); None if neither."""
-    for path in (os.path.join(SET, entry["file"]), os.path.join(SET, "external", os.path.basename(entry["file"]))):
-        if os.path.isfile(path):
-            return path
-    return None
+    """The model in ../shared/generated, named by the basename of the manifest's file; None if absent."""
+    path = os.path.join(os.path.dirname(ROOT), "shared", "generated", os.path.basename(entry["file"]))
+    return path if os.path.isfile(path) else None
 
 
 def table_kinds():

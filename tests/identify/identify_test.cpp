@@ -147,15 +147,16 @@ Result<PipelineResult> identify_run(PipelineOptions o, const std::string& file) 
   return p.run_file(file);
 }
 
-const std::string kBicycle = "data/generated/models/trellis_bicycle.glb";
+const std::string kBicycle = test::generated_path("trellis_bicycle.glb");
 
 TEST(Identify, TheDetectorRecognisesAGeneratedBicycleWithoutNames) {
+  G2P_SKIP_WITHOUT(kBicycle);
   Result<std::unique_ptr<Identifier>> detector = make_identifier("detector");
   ASSERT_TRUE(detector.ok());
   PipelineOptions o;
   o.anonymize_names = true;
   o.identifier = {"detector", {}};
-  Result<PipelineResult> r = identify_run(o, source_path(kBicycle));
+  Result<PipelineResult> r = identify_run(o, kBicycle);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   const Identification& id = r->identification;
   for (const std::string& w : id.warnings)
@@ -177,10 +178,11 @@ TEST(Identify, AMissingDetectorModelDegradesWithAWarning) {
 }
 
 TEST(Identify, ANormalisedMeshTakesItsKindsSizeOnlyWhenConfidentAndAllowed) {
+  G2P_SKIP_WITHOUT(kBicycle);
   PipelineOptions o;
   o.object = "bicycle";
   o.identifier = {"auto", {{"detector", "off"}}};
-  Result<PipelineResult> r = identify_run(o, source_path(kBicycle));
+  Result<PipelineResult> r = identify_run(o, kBicycle);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   const ObjectKind& bike =
       ObjectTable::shipped().kinds()[static_cast<std::size_t>(ObjectTable::shipped().find("bicycle"))];
@@ -204,7 +206,7 @@ TEST(Identify, ANormalisedMeshTakesItsKindsSizeOnlyWhenConfidentAndAllowed) {
 
   PipelineOptions keep = o;
   keep.size_policy = SizePolicy::kFile;
-  r = identify_run(keep, source_path(kBicycle));
+  r = identify_run(keep, kBicycle);
   ASSERT_TRUE(r.ok());
   EXPECT_NEAR(bounds(r->model.mesh).sizes().maxCoeff(), 1.0, 0.03);
   EXPECT_EQ(r->size_assumed_m, 0.0);
@@ -212,7 +214,7 @@ TEST(Identify, ANormalisedMeshTakesItsKindsSizeOnlyWhenConfidentAndAllowed) {
   PipelineOptions strict = o;
   strict.object.clear();
   strict.anonymize_names = true;  // nothing names it; the detector is off
-  r = identify_run(strict, source_path(kBicycle));
+  r = identify_run(strict, kBicycle);
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r->identification.known());
   EXPECT_EQ(r->size_assumed_m, 0.0);
@@ -333,6 +335,7 @@ TEST(KindMaterials, TheKindsClassesWeighOneAndTheOthersLess) {
 // (one material, so the network decides every face), a bicycle's classes
 // gain pixels and the segment stage says so; an unknown object is untouched.
 TEST(KindMaterials, AKnownKindTipsTheNetworksPixelsTowardsItsMaterials) {
+  G2P_SKIP_WITHOUT(kBicycle);
   auto labelled = [](double prior, bool known, PipelineResult& out) {
     PipelineOptions o;
     o.last_stage = Stage::kSegment;
@@ -344,7 +347,7 @@ TEST(KindMaterials, AKnownKindTipsTheNetworksPixelsTowardsItsMaterials) {
     o.size_policy = SizePolicy::kFile;
     o.kind_prior = prior;
     Pipeline p(o);
-    Result<PipelineResult> r = p.run_file(source_path(kBicycle));
+    Result<PipelineResult> r = p.run_file(kBicycle);
     ASSERT_TRUE(r.ok()) << r.status().to_string();
     out = std::move(*r);
   };

@@ -1,6 +1,7 @@
 // Paths of the real data the tests use, and small helpers to make files.
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 namespace g2p::test {
@@ -12,6 +13,11 @@ std::string labels_json_path();
 std::string assimp_model(const std::string& relative);
 // A file of the source tree, e.g. source_path("examples/data/hammer.obj").
 std::string source_path(const std::string& relative);
+// A model of the generated set, ../shared/generated/<file>, e.g.
+// generated_path("trellis_shell_chair.glb"). Those files come from public
+// repositories and are never committed here; a test that needs one skips
+// without it (G2P_SKIP_WITHOUT).
+std::string generated_path(const std::string& file);
 
 // A fresh, empty folder under the build tree, kept apart per running test
 // (build/tests/scratch/Suite.Test/NAME), so tests that share a name can run in parallel.
@@ -23,3 +29,12 @@ std::string gltf_json_text(const std::string& path);
 void write_file(const std::string& path, const std::string& bytes);
 
 }  // namespace g2p::test
+
+// Skips the running test, saying why, when `path` (a file the test reads from
+// ../shared) is absent.
+#define G2P_SKIP_WITHOUT(path)                                                                             \
+  do {                                                                                                     \
+    if (!std::filesystem::exists(path))                                                                    \
+      GTEST_SKIP() << (path) << " is absent: the generated set's files are read from ../shared/generated " \
+                   << "(cmake -DG2P_SHARED_GENERATED=DIR)";                                                \
+  } while (false)

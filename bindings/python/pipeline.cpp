@@ -305,7 +305,8 @@ void bind_pipeline(py::module_& m) {
                      "use a known kind's structure and hidden mass in the properties stage")
       .def_readwrite("kind_posterior", &PipelineOptions::kind_posterior,
                      "with a known kind, limit classes to the kind's share of the surface and choose each part's "
-                     "structure against the kind's mass (g2p run --kind-mass; docs/properties.md)")
+                     "structure against the kind's mass; of an unknown kind, against everyday objects' bulk density "
+                     "(g2p run --kind-mass; docs/properties.md)")
       .def_readwrite("kind_confidence", &PipelineOptions::kind_confidence,
                      "the least identification confidence for which the run acts on the kind (size, structure, "
                      "hidden mass, mass check)")

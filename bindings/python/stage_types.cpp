@@ -328,7 +328,8 @@ void bind_stage_types(py::module_& m) {
       .def_readonly("contents", &PartReport::contents, "the contents alone (zero mass when empty)")
       .def_readonly("mass_min_kg", &PartReport::mass_min_kg)
       .def_readonly("mass_max_kg", &PartReport::mass_max_kg)
-      .def_readonly("mass_median_kg", &PartReport::mass_median_kg, "the kind's mass posterior; 0 = not judged")
+      .def_readonly("mass_median_kg", &PartReport::mass_median_kg,
+                    "the mass posterior (the kind's or bulk density's); 0 = not judged")
       .def_readonly("mass_p05_kg", &PartReport::mass_p05_kg)
       .def_readonly("mass_p95_kg", &PartReport::mass_p95_kg)
       .def_readonly("completed_ok", &PartReport::completed_ok);
@@ -338,9 +339,11 @@ void bind_stage_types(py::module_& m) {
       .def_readonly("mass_min_kg", &PropertiesReport::mass_min_kg)
       .def_readonly("mass_max_kg", &PropertiesReport::mass_max_kg)
       .def_readonly("mass_median_kg", &PropertiesReport::mass_median_kg,
-                    "the kind's mass posterior's median; 0 = not judged (docs/properties.md)")
+                    "the mass posterior's median; 0 = not judged (docs/properties.md)")
       .def_readonly("mass_p05_kg", &PropertiesReport::mass_p05_kg)
       .def_readonly("mass_p95_kg", &PropertiesReport::mass_p95_kg)
+      .def_readonly("mass_judged_by", &PropertiesReport::mass_judged_by,
+                    "what the interval was judged by, in words; '' = not judged")
       .def_property_readonly(
           "kind_range_kg",
           [](const PropertiesReport& r) { return py::make_tuple(r.kind_range_kg[0], r.kind_range_kg[1]); })

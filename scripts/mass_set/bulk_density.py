@@ -4,12 +4,13 @@
     /usr/bin/python3 scripts/mass_set/bulk_density.py --set val --out OUT
 
 OUT is a folder of `scripts/mass_set/score.py --set val --out OUT` (one folder per model, in the
-set's order, NNN_name). For every scored model whose run closed at least one part, the bulk
+set's order, NNN_name). For every scored model whose parts have a volume, the bulk
 density is the geometric centre of its annotated mass range over the sum of its parts' closed
-volumes (run.json's parts[].volume_m3): what a real object of that shape weighs per cubic metre of
-its closed outline. Prints the count, the geometric mean, the spread (standard deviation of the
+volumes (run.json's parts[].volume_m3, every part the complete stage closed, whether or not its
+checks passed: the volumes the properties stage weighs): what a real object of that shape weighs
+per cubic metre of its closed outline. Prints the count, the geometric mean, the spread (standard deviation of the
 natural log) and the 5, 50 and 95 % quantiles: the prior the kind's mass posterior uses when the
-kind is unknown (PosteriorOptions::bulk_density_kg_m3, bulk_density_sigma).
+kind is unknown (PosteriorOptions::bulk_density_kg_m3, bulk_density_log_sd).
 """
 import argparse
 import json
@@ -38,7 +39,7 @@ def main():
             continue
         with open(run) as f:
             parts = json.load(f).get("parts", [])
-        volume = sum(p.get("volume_m3") or 0.0 for p in parts if p.get("closed"))
+        volume = sum(p.get("volume_m3") or 0.0 for p in parts)
         if volume <= 0:
             continue
         lo, hi = m["mass_kg"]

@@ -198,6 +198,118 @@ TEST(FitMassToKind, BadInputIsAnErrorNamingIt) {
   EXPECT_NE(s.message().find("mass range"), std::string::npos) << s.message();
 }
 
+// Votes for one face per part: part `part`'s face voted `share` for `other`,
+// the rest for its own class.
+FaceVotes votes_for(const Weighed& w, std::size_t part, int other, float share) {
+  FaceVotes v;
+  v.num_classes = table().size();
+  for (std::size_t i = 0; i < w.parts.size(); ++i) {
+    v.row.push_back(static_cast<int>(i));
+    std::vector<float> row(static_cast<std::size_t>(v.num_classes), 0.0f);
+    row[static_cast<std::size_t>(w.parts[i].label)] = i == part ? 100.0f * (1.0f - share) : 100.0f;
+    if (i == part) row[static_cast<std::size_t>(other)] = 100.0f * share;
+    v.histogram.insert(v.histogram.end(), row.begin(), row.end());
+    v.total.push_back(100.0f);
+  }
+  return v;
+}
+
+TEST(FitMassToBulkDensity, AnEstimateLikeEverydayObjectsStandsWithAnInterval) {
+  Weighed w;
+  w.add(cls("Wood"), 0.05, 1.2);  // a wooden cabinet's carcass, solid: 35 kg over 0.05 m^3
+  Result<MassPosterior> post = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report);
+  ASSERT_TRUE(post.ok()) << post.status().to_string();
+  EXPECT_TRUE(post->kind.empty());
+  EXPECT_FALSE(post->changed());
+  EXPECT_DOUBLE_EQ(post->mass_kg, w.report.object.mass_kg);
+  EXPECT_TRUE(post->in_range);
+  // The belief: everyday objects' bulk density over the closed volume, its central 90 %.
+  const PosteriorOptions d;
+  EXPECT_NEAR(std::sqrt(post->range_kg[0] * post->range_kg[1]), d.bulk_density_kg_m3 * 0.05, 1e-6);
+  EXPECT_NEAR(std::log(post->range_kg[1] / post->range_kg[0]), 2 * 1.6449 * d.bulk_density_log_sd, 1e-3);
+  EXPECT_NE(post->judged_by.find("everyday objects"), std::string::npos) << post->judged_by;
+  EXPECT_LE(post->p05_kg, post->median_kg);
+  EXPECT_LE(post->median_kg, post->p95_kg);
+  EXPECT_LT(post->p05_kg, post->p95_kg);  // the structures and densities the part may have
+  PropertiesReport report = w.report;
+  apply_intervals(*post, report);
+  EXPECT_EQ(report.mass_judged_by, post->judged_by);
+  EXPECT_DOUBLE_EQ(report.kind_range_kg[1], 0.0);  // no kind's range
+  EXPECT_DOUBLE_EQ(report.mass_median_kg, post->median_kg);
+}
+
+TEST(FitMassToBulkDensity, AFarTooLightEstimateIsNamedOrTakesAHeavierStructureWhenAllowed) {
+  Weighed w;
+  w.add(cls("Metal"), 0.5, 3.8, Structure::kHollow);  // a 0.5 m^3 closed volume as sheet metal
+  const PosteriorOptions d;                           // beyond the central 90 % of everyday objects' bulk density
+  ASSERT_LT(w.report.object.mass_kg / 0.5, d.bulk_density_kg_m3 * std::exp(-1.6449 * d.bulk_density_log_sd));
+  // By default the belief gives the interval only: the estimate stands and is named.
+  Result<MassPosterior> post = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report);
+  ASSERT_TRUE(post.ok()) << post.status().to_string();
+  EXPECT_FALSE(post->changed());
+  EXPECT_DOUBLE_EQ(post->mass_kg, w.report.object.mass_kg);
+  ASSERT_EQ(post->notes.size(), 1u);
+  EXPECT_NE(post->notes[0].find("the estimate stands"), std::string::npos) << post->notes[0];
+  EXPECT_NE(post->notes[0].find("short of what everyday objects"), std::string::npos) << post->notes[0];
+  EXPECT_GT(post->median_kg, post->estimated_kg);  // the interval leans to what such objects weigh
+  // Allowed to decide, it takes a heavier structure, in words.
+  PosteriorOptions deciding;
+  deciding.bulk_density_decides = true;
+  post = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, deciding);
+  ASSERT_TRUE(post.ok());
+  ASSERT_TRUE(post->changed());
+  EXPECT_GT(post->mass_kg, post->estimated_kg);
+  EXPECT_NE(post->parts[0].note.find("short of what everyday objects"), std::string::npos) << post->parts[0].note;
+}
+
+TEST(FitMassToBulkDensity, NoClosedPartIsAnError) {
+  Weighed w;
+  w.add(cls("Wood"), 0.05, 1.2);
+  w.completion.parts[0].checks.volume_m3 = 0.0;
+  const Status s = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report).status();
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("no part closed"), std::string::npos) << s.message();
+  PosteriorOptions bad;
+  bad.bulk_density_log_sd = 0.0;
+  w.completion.parts[0].checks.volume_m3 = 0.05;
+  const Status sd = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, bad).status();
+  EXPECT_NE(sd.message().find("bulk_density_log_sd"), std::string::npos) << sd.message();
+}
+
+TEST(ClassEvidence, APartsOtherProbableClassWidensTheIntervalNotTheChoice) {
+  Weighed w;
+  w.add(cls("Wood"), 1e-4, 0.015);  // a cabinet's knob, 70 g of wood; its faces 45 % Metal (a steel knob, 0.78 kg)
+  w.add(cls("Wood"), 0.05, 1.2);    // the cabinet, 35 kg: either knob is an everyday cabinet
+  const FaceVotes votes = votes_for(w, 0, cls("Metal"), 0.45f);
+  const std::vector<double> p = part_class_probabilities(votes, w.parts[0], table().size());
+  ASSERT_EQ(p.size(), static_cast<std::size_t>(table().size()));
+  EXPECT_NEAR(p[static_cast<std::size_t>(cls("Metal"))], 0.45, 1e-6);
+  Result<MassPosterior> certain = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report);
+  ClassEvidence evidence;
+  evidence.votes = &votes;
+  Result<MassPosterior> doubtful = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, {}, evidence);
+  ASSERT_TRUE(certain.ok() && doubtful.ok());
+  // The chosen assignment keeps the part's class and mass...
+  EXPECT_FALSE(doubtful->changed());
+  EXPECT_DOUBLE_EQ(doubtful->mass_kg, certain->mass_kg);
+  // ...the interval draws a steel knob too.
+  bool steel = false;
+  for (const PartHypothesis& h : doubtful->parts[0].hypotheses) steel |= h.label == cls("Metal");
+  EXPECT_TRUE(steel);
+  EXPECT_GT(doubtful->parts[0].p95_kg, 2.0 * certain->parts[0].p95_kg);
+  // A class a person gave is not in doubt; a vote share under class_min_probability is not drawn.
+  evidence.pinned = {true, false};
+  Result<MassPosterior> pinned = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, {}, evidence);
+  ASSERT_TRUE(pinned.ok());
+  EXPECT_EQ(pinned->parts[0].hypotheses.size(), certain->parts[0].hypotheses.size());
+  PosteriorOptions strict;
+  strict.class_min_probability = 0.5;
+  evidence.pinned.clear();
+  Result<MassPosterior> few = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, strict, evidence);
+  ASSERT_TRUE(few.ok());
+  EXPECT_EQ(few->parts[0].hypotheses.size(), certain->parts[0].hypotheses.size());
+}
+
 }  // namespace
 }  // namespace g2p
 

@@ -183,7 +183,7 @@ void add_identify_flags(CLI::App* cmd, IdentifyArgs& args) {
   cmd->add_option("--kind-mass", args.kind_mass,
                   "on: with a kind the run acts on, each class covers no more of the surface than the kind allows "
                   "and each part's structure is chosen against the kind's mass at the object's size "
-                  "(docs/properties.md); off: neither")
+                  "and, of an unknown kind, against everyday objects' bulk density (docs/properties.md); off: none")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
 }

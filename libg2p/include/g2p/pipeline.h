@@ -131,7 +131,9 @@ struct PipelineOptions {
   // show (posterior.h): a class covers no more of the surface than the kind
   // allows it (after refine), and each part's structure, wall and density are
   // chosen against the kind's mass at the object's size (after properties),
-  // with a median and 90 % interval in the report. false: neither.
+  // with a median and 90 % interval in the report. Of an unknown kind, the
+  // mass is judged the same way against everyday objects' bulk density (a
+  // weak belief: mostly an interval). false: none of these.
   bool kind_posterior = true;
   PosteriorOptions posterior;
   // The kind's materials by role (ObjectKind::materials) as evidence for the

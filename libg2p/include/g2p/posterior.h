@@ -15,6 +15,10 @@
 //    chosen and weighed physically (each part its volume times its density,
 //    never a scaled total); importance sampling gives the median and 90 %
 //    interval of the object and of each part.
+// Where the kind is unknown, fit_mass_to_bulk_density judges the mass the
+// same way against what everyday objects weigh per cubic metre of their
+// closed outline (a weak belief: mostly an interval). Both intervals count
+// the parts' other probable classes from the views' votes (ClassEvidence).
 // docs/properties.md#the-kinds-mass-posterior states the rules.
 #pragma once
 
@@ -61,8 +65,23 @@ struct PosteriorOptions {
   double other_structure_weight = 0.3;  // solid for hollow or hollow for solid
   double other_density_weight = 0.5;    // the class's lowest or highest density instead of its nominal
   double fill_weight = 0.5;             // foam or fabric over a frame, a share of its closed volume filled
-  int samples = 4000;                   // importance samples for the intervals; 0 = no intervals
-  std::uint32_t seed = 1;               // the sampler's, for reproducible intervals
+  // Where the kind is unknown: the object's mass over its parts' closed
+  // volume is log-normal about bulk_density_kg_m3 with bulk_density_log_sd
+  // (natural log), as measured on the 56 validation models
+  // (scripts/mass_set/bulk_density.py; docs/accuracy.md).
+  double bulk_density_kg_m3 = 474.0;
+  double bulk_density_log_sd = 1.26;
+  // Whether that belief may change a part's structure (as the kind's does),
+  // or gives the intervals only (the default: deciding took an unnamed
+  // hammer's steel head, 3,850 kg/m^3 with its handle, for too dense and
+  // weighed it 0.60 kg instead of 1.457; docs/accuracy.md).
+  bool bulk_density_decides = false;
+  // The intervals also draw each part's other classes that its faces' votes
+  // give at least this probability (and the kind allows at the part's share),
+  // weighed by their votes; the chosen assignment keeps the part's class.
+  double class_min_probability = 0.1;  // (0, 1]; 1 = the part's class only
+  int samples = 4000;                  // importance samples for the intervals; 0 = no intervals
+  std::uint32_t seed = 1;              // the sampler's, for reproducible intervals
 };
 
 // The most of the object's surface area each class of `table` may cover for
@@ -81,6 +100,16 @@ G2P_API std::vector<std::string> fit_classes_to_kind(Projection& projection, con
                                                      const MaterialTable& table, const std::vector<bool>& pinned = {},
                                                      const PosteriorOptions& options = {});
 
+// The part's class probabilities from its faces' votes (pixel counts, so a
+// face weighs as much as it was seen); empty when no view saw the part.
+G2P_API std::vector<double> part_class_probabilities(const FaceVotes& votes, const Part& part, int num_classes);
+
+// What the views said of each part's class, for the intervals (optional).
+struct ClassEvidence {
+  const FaceVotes* votes = nullptr;  // the project stage's votes; null: each part's class is certain
+  std::vector<bool> pinned;          // per part: a person gave its class (not in doubt); empty: none
+};
+
 // One way a part may be: its class, structure and density.
 struct PartHypothesis {
   Structure structure = Structure::kSolid;
@@ -92,6 +121,10 @@ struct PartHypothesis {
   double prior = 1.0;             // relative prior weight
   bool estimated = false;         // the estimator's own answer
   std::string words;              // "hollow, 2 mm walls", "solid, 60 % filled", "solid"
+  // Another class the votes give the part (its index in the table), drawn for
+  // the intervals only: the chosen assignment keeps the part's class. -1: the
+  // part's own class.
+  int label = -1;
 };
 
 struct PartPosterior {
@@ -104,9 +137,11 @@ struct PartPosterior {
 };
 
 struct MassPosterior {
-  std::string kind;                 // the kind's name
+  std::string kind;       // the kind's name; "" when judged by bulk density
+  std::string judged_by;  // in words: "a chair's 2.5-12 kg at 0.95 m", "everyday objects' ..."
+
   double longest_side_m = 0.0;      // the object's size it was judged at
-  double range_kg[2] = {0.0, 0.0};  // the kind's range scaled to that size
+  double range_kg[2] = {0.0, 0.0};  // the kind's range scaled to that size (the belief's central share)
   double hidden_fraction = 0.0;     // the kind's hidden mass, a share of the whole (added where the body is hollow)
   int body = -1;                    // the part that holds it
   std::vector<PartPosterior> parts;
@@ -132,7 +167,15 @@ struct MassPosterior {
 G2P_API Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
                                                const MaterialTable& table, const PropertiesReport& report,
                                                const ObjectKind& kind, double longest_side_m,
-                                               const PosteriorOptions& options = {});
+                                               const PosteriorOptions& options = {}, const ClassEvidence& classes = {});
+
+// The same for an object of unknown kind, against everyday objects' bulk
+// density (PosteriorOptions::bulk_density_kg_m3) times the parts' closed
+// volume. Fails when no part closed.
+G2P_API Result<MassPosterior> fit_mass_to_bulk_density(const std::vector<Part>& parts, const Completion& completion,
+                                                       const MaterialTable& table, const PropertiesReport& report,
+                                                       const PosteriorOptions& options = {},
+                                                       const ClassEvidence& classes = {});
 
 // An estimator that answers as `base` except where `posterior` chose another
 // hypothesis, which it gives with source "kind" and the posterior's note.
@@ -141,7 +184,8 @@ G2P_API std::unique_ptr<PropertyEstimator> make_posterior_estimator(const Proper
                                                                     const MassPosterior& posterior);
 
 // Writes the posterior's intervals into `report` (PartReport and
-// PropertiesReport mass_median_kg, mass_p05_kg, mass_p95_kg) and its notes.
+// PropertiesReport mass_median_kg, mass_p05_kg, mass_p95_kg, mass_judged_by;
+// kind_range_kg for a kind) and its notes.
 G2P_API void apply_intervals(const MassPosterior& posterior, PropertiesReport& report);
 
 }  // namespace g2p

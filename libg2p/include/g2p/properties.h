@@ -199,7 +199,7 @@ struct PartReport {
   MassProperties mass;      // nominal density; the walls and the contents together
   MassProperties contents;  // the contents alone (zero mass when empty)
   double mass_min_kg = 0.0, mass_max_kg = 0.0;
-  // The kind's mass posterior (posterior.h): median and 90 % interval; 0 where not judged.
+  // The mass posterior (posterior.h): median and 90 % interval; 0 where not judged.
   double mass_median_kg = 0.0, mass_p05_kg = 0.0, mass_p95_kg = 0.0;
   bool completed_ok = false;  // the complete stage's checks passed
 };
@@ -208,9 +208,11 @@ struct PropertiesReport {
   std::vector<PartReport> parts;
   MassProperties object;  // all parts combined, about the object's centre of mass
   double mass_min_kg = 0.0, mass_max_kg = 0.0;
-  // The kind's mass posterior (posterior.h): the object's median and 90 %
-  // interval, and the kind's mass range at the object's size; 0 where not judged.
+  // The mass posterior (posterior.h): the object's median and 90 % interval,
+  // what it was judged by in words, and the kind's mass range at the
+  // object's size; 0 and "" where not judged (kind_range_kg: no kind).
   double mass_median_kg = 0.0, mass_p05_kg = 0.0, mass_p95_kg = 0.0;
+  std::string mass_judged_by;
   double kind_range_kg[2] = {0.0, 0.0};
   // The object's size: estimate_properties sets the extent from the object's
   // mesh; callers that loaded a model set the rest (object_size(model)).

@@ -145,6 +145,7 @@ struct Pipeline::Impl {
   Status refine_labels(RunState& s);
   Status apply_corrections(RunState& s, bool apply_classes);
   void fit_classes(RunState& s) const;
+  std::vector<bool> class_pinned(const RunState& s) const;
   Status complete_parts(RunState& s);
   Status estimate(RunState& s);
   Status decompose_collision(RunState& s);
@@ -414,11 +415,9 @@ Status Pipeline::Impl::apply_corrections(RunState& s, bool apply_classes) {
   return Status::Ok();
 }
 
-// The kind's share of each class (posterior.h), after the corrections: the
-// parts a person gave a class keep it.
-void Pipeline::Impl::fit_classes(RunState& s) const {
-  PipelineResult& r = s.r;
-  if (!options.kind_posterior || r.kind.name.empty()) return;
+// Per part: a person gave its class (a correction), so it is not in doubt.
+std::vector<bool> Pipeline::Impl::class_pinned(const RunState& s) const {
+  const PipelineResult& r = s.r;
   std::vector<bool> pinned(r.projection.parts.size(), false);
   if (s.resolved)
     for (std::size_t i = 0; i < r.projection.parts.size(); ++i)
@@ -426,6 +425,15 @@ void Pipeline::Impl::fit_classes(RunState& s) const {
         if (f >= 0 && static_cast<std::size_t>(f) < s.resolved->class_entry.size() &&
             s.resolved->class_entry[static_cast<std::size_t>(f)] >= 0)
           pinned[i] = true;
+  return pinned;
+}
+
+// The kind's share of each class (posterior.h), after the corrections: the
+// parts a person gave a class keep it.
+void Pipeline::Impl::fit_classes(RunState& s) const {
+  PipelineResult& r = s.r;
+  if (!options.kind_posterior || r.kind.name.empty()) return;
+  const std::vector<bool> pinned = class_pinned(s);
   const std::vector<std::string> notes = fit_classes_to_kind(r.projection, r.kind, r.table, pinned, options.posterior);
   if (notes.empty()) return;
   for (StageReport& stage : r.stages)
@@ -496,19 +504,31 @@ Status Pipeline::Impl::estimate(RunState& s) {
                                         progress)
           : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views, progress);
   if (!report.ok()) return report.status().with_context("properties");
-  // The kind's mass: each part's structure chosen against it, weighed again
-  // where the choice differs from the estimator's.
-  if (o.kind_posterior && !r.kind.name.empty()) {
+  // The kind's mass (or, of an unknown kind, everyday objects' bulk density):
+  // each part's structure chosen against it, weighed again where the choice
+  // differs from the estimator's.
+  if (o.kind_posterior) {
+    const bool of_kind = !r.kind.name.empty();
+    ClassEvidence classes;
+    classes.votes = &r.projection.votes;
+    classes.pinned = class_pinned(s);
     const double longest = bounds(mesh).sizes().maxCoeff();
     Result<MassPosterior> posterior =
-        fit_mass_to_kind(r.projection.parts, r.completion, r.table, *report, r.kind, longest, o.posterior);
+        of_kind ? fit_mass_to_kind(r.projection.parts, r.completion, r.table, *report, r.kind, longest, o.posterior,
+                                   classes)
+                : fit_mass_to_bulk_density(r.projection.parts, r.completion, r.table, *report, o.posterior, classes);
     if (!posterior.ok()) {
-      r.warnings.push_back("properties: the kind's mass was not judged: " + posterior.status().message());
+      // A kind the user gave or the views named is worth a warning; the weak
+      // belief of an unknown kind a note.
+      if (of_kind)
+        r.warnings.push_back("properties: the kind's mass was not judged: " + posterior.status().message());
+      else
+        report->notes.push_back("everyday objects' mass: not judged: " + posterior.status().message());
     } else {
       if (posterior->changed()) {
         std::unique_ptr<PropertyEstimator> by_posterior = make_posterior_estimator(chosen, *posterior);
         Result<PropertiesReport> again =
-            o.kind_properties
+            o.kind_properties && of_kind
                 ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, *by_posterior, r.kind,
                                               views, progress)
                 : estimate_properties(mesh, r.projection.parts, r.completion, r.table, *by_posterior, views, progress);

@@ -91,11 +91,10 @@ std::string pipeline_summary_text(const PipelineResult& r) {
                   r.properties.object.mass_kg, r.properties.mass_min_kg, r.properties.mass_max_kg, c.x(), c.y(), c.z());
     out += line;
     if (r.properties.mass_median_kg > 0.0) {
-      std::snprintf(line, sizeof line,
-                    "  with its kind: median %.3g kg, 90 %% interval %.3g - %.3g kg (%s's %.3g-%.3g kg)\n",
-                    r.properties.mass_median_kg, r.properties.mass_p05_kg, r.properties.mass_p95_kg,
-                    r.kind.name.c_str(), r.properties.kind_range_kg[0], r.properties.kind_range_kg[1]);
-      out += line;
+      std::snprintf(line, sizeof line, "  %s: median %.3g kg, 90 %% interval %.3g - %.3g kg (",
+                    r.properties.kind_range_kg[1] > 0.0 ? "with its kind" : "as everyday objects weigh",
+                    r.properties.mass_median_kg, r.properties.mass_p05_kg, r.properties.mass_p95_kg);
+      out += line + r.properties.mass_judged_by + ")\n";
     }
   }
   return out;

@@ -294,8 +294,9 @@ std::string summary_html(const PipelineResult& r, const PipelineOptions& o) {
     << number(m.mass_kg) << " kg</b> (plausible range " << number(r.properties.mass_min_kg) << " to "
     << number(r.properties.mass_max_kg) << " kg"
     << (r.properties.mass_median_kg > 0
-            ? "; with its kind, median " + number(r.properties.mass_median_kg) + " kg, 90 % interval " +
-                  number(r.properties.mass_p05_kg) + " to " + number(r.properties.mass_p95_kg) + " kg"
+            ? "; judged by " + escape(r.properties.mass_judged_by) + ", median " + number(r.properties.mass_median_kg) +
+                  " kg, 90 % interval " + number(r.properties.mass_p05_kg) + " to " + number(r.properties.mass_p95_kg) +
+                  " kg"
             : std::string())
     << "), centre of mass (" << number(m.center_of_mass.x()) << ", " << number(m.center_of_mass.y()) << ", "
     << number(m.center_of_mass.z()) << ") m. Size " << number(r.properties.size.extent_m.x()) << " x "

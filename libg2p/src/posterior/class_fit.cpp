@@ -15,8 +15,8 @@ std::string percent(double share) {
   return text;
 }
 
-// The part's class probabilities from its faces' votes (pixel counts, so a
-// face weighs as much as it was seen); empty when no view saw it.
+}  // namespace
+
 std::vector<double> part_class_probabilities(const FaceVotes& votes, const Part& part, int num_classes) {
   std::vector<double> p(static_cast<std::size_t>(num_classes), 0.0);
   if (votes.num_classes != num_classes || votes.row.empty()) return {};
@@ -34,8 +34,6 @@ std::vector<double> part_class_probabilities(const FaceVotes& votes, const Part&
   for (double& x : p) x /= total;
   return p;
 }
-
-}  // namespace
 
 std::vector<double> kind_class_shares(const ObjectKind& kind, const MaterialTable& table,
                                       const PosteriorOptions& options) {

@@ -172,25 +172,97 @@ std::vector<PartHypothesis> hypotheses_of(const PartReport& r, const Part& part,
   return out;
 }
 
-}  // namespace
+// The part's other classes from its votes, drawn for the intervals only:
+// each as the estimator's structure in that class (its nominal density; a
+// shell of the class's wall), weighed by its votes against the part's own
+// class. `shares` (per class; empty: no limit) is the kind's.
+void add_other_classes(PartPosterior& pp, const PartReport& r, const CompletedPart& completed, double area_m2,
+                       double share, const MaterialTable& table, const std::vector<double>& probability,
+                       const std::vector<double>& shares) {
+  const int own_label = r.properties.label;
+  if (probability.size() != static_cast<std::size_t>(table.size()) || !table.valid_label(own_label)) return;
+  const double volume = completed.checks.volume_m3;
+  std::vector<int> others;
+  double most = probability[static_cast<std::size_t>(own_label)];
+  for (int c = 0; c < table.size(); ++c) {
+    const std::size_t k = static_cast<std::size_t>(c);
+    if (c == own_label || !(table[c].density_kg_m3 > 0.0) || probability[k] <= 0.0) continue;
+    if (!shares.empty() && share > shares[k] + 1e-9) continue;  // the kind does not allow it so large
+    others.push_back(c);
+    most = std::max(most, probability[k]);
+  }
+  // The part's own class is at least as probable as any other: it won the
+  // votes, or the kind or a neighbour chose it over the votes.
+  double own_prior = 0.0;
+  for (const PartHypothesis& h : pp.hypotheses) own_prior += h.prior;
+  const PartHypothesis& own = pp.hypotheses[0];
+  for (int c : others) {
+    const MaterialClass& mc = table[c];
+    PartHypothesis h;
+    h.label = c;
+    h.density_kg_m3 = mc.density_kg_m3;
+    h.prior = own_prior * probability[static_cast<std::size_t>(c)] / most;
+    const double t = mc.wall_thickness_m;
+    if (own.structure == Structure::kHollow && t > 0.0 && area_m2 * t < volume) {
+      h.structure = Structure::kHollow;
+      h.wall_thickness_m = t;
+      h.mass_kg = area_m2 * t * h.density_kg_m3;
+      h.words = mc.name + ", hollow, " + mm(t) + " walls";
+    } else if (volume > 0.0) {
+      h.mass_kg = volume * h.density_kg_m3;
+      h.words = mc.name + ", solid";
+    } else {
+      continue;
+    }
+    pp.hypotheses.push_back(h);
+  }
+}
 
-Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
-                                       const MaterialTable& table, const PropertiesReport& report,
-                                       const ObjectKind& kind, double longest_side_m, const PosteriorOptions& o) {
-  if (!(kind.mass_kg[0] > 0.0 && kind.mass_kg[1] >= kind.mass_kg[0]))
-    return Status::InvalidArgument("posterior: the kind '" + kind.name + "' has no mass range");
-  if (!(longest_side_m > 0.0) || !std::isfinite(longest_side_m))
-    return Status::InvalidArgument("posterior: the object's longest side must be positive");
+Status check_options(const PosteriorOptions& o) {
   if (!(o.range_share > 0.0 && o.range_share < 1.0))
     return Status::InvalidArgument("posterior: range_share must lie in (0, 1)");
   for (const auto& [name, weight] : {std::pair<const char*, double>{"other_wall_weight", o.other_wall_weight},
                                      {"other_structure_weight", o.other_structure_weight},
                                      {"other_density_weight", o.other_density_weight},
-                                     {"fill_weight", o.fill_weight}})
+                                     {"fill_weight", o.fill_weight},
+                                     {"class_min_probability", o.class_min_probability}})
     if (!(weight > 0.0 && weight <= 1.0))
       return Status::InvalidArgument(std::string("posterior: ") + name + " must lie in (0, 1]");
   if (!(std::isfinite(o.size_exponent) && o.size_exponent >= 0.0))
     return Status::InvalidArgument("posterior: size_exponent must be a number >= 0");
+  if (!(std::isfinite(o.bulk_density_kg_m3) && o.bulk_density_kg_m3 > 0.0))
+    return Status::InvalidArgument("posterior: bulk_density_kg_m3 must be a positive number");
+  if (!(std::isfinite(o.bulk_density_log_sd) && o.bulk_density_log_sd > 0.0))
+    return Status::InvalidArgument("posterior: bulk_density_log_sd must be a positive number");
+  return Status::Ok();
+}
+
+// What the object's total mass is believed to be: a log-normal about
+// `centre_kg`, `range_kg` its central range_share.
+struct Belief {
+  double centre_kg = 1.0, sigma = 1.0;
+  double range_kg[2] = {0.0, 0.0};
+  std::string words;             // "a chair's 2.5-12 kg at 0.95 m"
+  double hidden_fraction = 0.0;  // the kind's hidden mass, a share of the whole
+  std::vector<double> shares;    // per class: the kind's largest share of the surface; empty: no limit
+  bool decides = true;           // false: the estimate stands, the belief gives the intervals only
+};
+
+Result<MassPosterior> solve(const std::vector<Part>& parts, const Completion& completion, const MaterialTable& table,
+                            const PropertiesReport& report, const Belief& belief, MassPosterior post,
+                            const PosteriorOptions& o, const ClassEvidence& classes);
+
+}  // namespace
+
+Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Completion& completion,
+                                       const MaterialTable& table, const PropertiesReport& report,
+                                       const ObjectKind& kind, double longest_side_m, const PosteriorOptions& o,
+                                       const ClassEvidence& classes) {
+  if (!(kind.mass_kg[0] > 0.0 && kind.mass_kg[1] >= kind.mass_kg[0]))
+    return Status::InvalidArgument("posterior: the kind '" + kind.name + "' has no mass range");
+  if (!(longest_side_m > 0.0) || !std::isfinite(longest_side_m))
+    return Status::InvalidArgument("posterior: the object's longest side must be positive");
+  G2P_RETURN_IF_ERROR(check_options(o));
   MassPosterior post;
   post.kind = kind.name;
   post.longest_side_m = longest_side_m;
@@ -213,17 +285,63 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     judged_at = std::clamp(judged_at, usual[0], usual[1]);
   }
   const double scale = std::pow(judged_at / typical, o.size_exponent);
-  post.range_kg[0] = kind.mass_kg[0] * scale;
-  post.range_kg[1] = kind.mass_kg[1] * scale;
-  MassLikelihood likelihood;
-  const double width = std::log(post.range_kg[1] / post.range_kg[0]);
-  likelihood.centre = std::sqrt(post.range_kg[0] * post.range_kg[1]);
+  Belief belief;
+  belief.range_kg[0] = kind.mass_kg[0] * scale;
+  belief.range_kg[1] = kind.mass_kg[1] * scale;
+  const double width = std::log(belief.range_kg[1] / belief.range_kg[0]);
+  belief.centre_kg = std::sqrt(belief.range_kg[0] * belief.range_kg[1]);
   const double z = normal_quantile(0.5 + 0.5 * o.range_share);
-  likelihood.sigma = std::max(0.05, width / (2.0 * z));
+  belief.sigma = std::max(0.05, width / (2.0 * z));
+  char range[96];
+  std::snprintf(range, sizeof range, "%.3g-%.3g kg at %.3g m", belief.range_kg[0], belief.range_kg[1], longest_side_m);
+  belief.words = article(kind.name) + "'s " + range;
+  for (const HiddenContent& h : kind.hidden) belief.hidden_fraction += h.mass_fraction;
+  belief.shares = kind_class_shares(kind, table, o);
+  return solve(parts, completion, table, report, belief, std::move(post), o, classes);
+}
+
+Result<MassPosterior> fit_mass_to_bulk_density(const std::vector<Part>& parts, const Completion& completion,
+                                               const MaterialTable& table, const PropertiesReport& report,
+                                               const PosteriorOptions& o, const ClassEvidence& classes) {
+  G2P_RETURN_IF_ERROR(check_options(o));
+  // The closed volume as scripts/mass_set/bulk_density.py measured it: every
+  // part's that the complete stage closed, whether or not its checks passed
+  // (the volumes the estimator weighs).
+  double volume = 0.0;
+  for (const CompletedPart& c : completion.parts)
+    if (c.checks.volume_m3 > 0.0 && std::isfinite(c.checks.volume_m3)) volume += c.checks.volume_m3;
+  if (!(volume > 0.0))
+    return Status::InvalidArgument("posterior: no part closed, so the object has no volume to weigh by bulk density");
+  Belief belief;
+  belief.centre_kg = o.bulk_density_kg_m3 * volume;
+  belief.sigma = o.bulk_density_log_sd;
+  const double z = normal_quantile(0.5 + 0.5 * o.range_share);
+  belief.range_kg[0] = belief.centre_kg * std::exp(-z * belief.sigma);
+  belief.range_kg[1] = belief.centre_kg * std::exp(z * belief.sigma);
+  char words[160];
+  std::snprintf(words, sizeof words, "what everyday objects of its closed volume (%.3g m^3) weigh, %.3g-%.3g kg",
+                volume, belief.range_kg[0], belief.range_kg[1]);
+  belief.words = words;
+  belief.decides = o.bulk_density_decides;
+  MassPosterior post;
+  return solve(parts, completion, table, report, belief, std::move(post), o, classes);
+}
+
+namespace {
+
+Result<MassPosterior> solve(const std::vector<Part>& parts, const Completion& completion, const MaterialTable& table,
+                            const PropertiesReport& report, const Belief& belief, MassPosterior post,
+                            const PosteriorOptions& o, const ClassEvidence& classes) {
+  post.judged_by = belief.words;
+  post.range_kg[0] = belief.range_kg[0];
+  post.range_kg[1] = belief.range_kg[1];
+  MassLikelihood likelihood;
+  likelihood.centre = belief.centre_kg;
+  likelihood.sigma = belief.sigma;
+  post.hidden_fraction = belief.hidden_fraction;
 
   // The hidden mass rides on a hollow body (estimate_properties_of_kind): a
   // share F of the whole, the visible mass times 1 / (1 - F).
-  for (const HiddenContent& h : kind.hidden) post.hidden_fraction += h.mass_fraction;
   post.hidden_fraction = std::min(post.hidden_fraction, 0.9);
   double largest = 0.0;
   for (std::size_t i = 0; i < completion.parts.size(); ++i)
@@ -239,6 +357,8 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   // was not (solid body, no cavity), it stays out of every total here too.
   if (!hidden_added) post.hidden_fraction = 0.0;
 
+  double surface = 0.0;
+  for (const Part& p : parts) surface += p.area_m2;
   double fixed_kg = 0.0;  // contents other than the kind's hidden mass (a person's fill)
   for (const PartReport& r : report.parts) {
     if (r.mass.mass_kg <= 0.0 || r.part < 0 || static_cast<std::size_t>(r.part) >= parts.size() ||
@@ -250,6 +370,15 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     pp.hypotheses = hypotheses_of(r, parts[static_cast<std::size_t>(r.part)],
                                   completion.parts[static_cast<std::size_t>(r.part)], table[r.properties.label], o);
     pp.pinned = pp.hypotheses.size() == 1;
+    const std::size_t index = static_cast<std::size_t>(r.part);
+    const bool class_pinned = index < classes.pinned.size() && classes.pinned[index];
+    if (!pp.pinned && !class_pinned && classes.votes != nullptr && surface > 0.0 && o.class_min_probability < 1.0) {
+      std::vector<double> probability = part_class_probabilities(*classes.votes, parts[index], table.size());
+      for (double& x : probability)
+        if (x < o.class_min_probability) x = 0.0;
+      add_other_classes(pp, r, completion.parts[index], parts[index].area_m2, parts[index].area_m2 / surface, table,
+                        probability, belief.shares);
+    }
     post.parts.push_back(std::move(pp));
   }
   if (post.parts.empty()) return Status::InvalidArgument("posterior: no part has a mass");
@@ -298,7 +427,7 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   for (std::size_t i = 0; i < post.parts.size(); ++i) visible += hypothesis(i, 0).mass_kg;
   double best = prior + likelihood(with_hidden(visible, at));
   // An estimate the kind agrees with stands.
-  for (int sweep = 0; sweep < 50 && !in_range(post.estimated_kg); ++sweep) {
+  for (int sweep = 0; sweep < 50 && belief.decides && !in_range(post.estimated_kg); ++sweep) {
     bool moved = false;
     for (std::size_t i : order) {
       const int was = at[i];
@@ -306,6 +435,7 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
       const double rest_prior = prior - std::log(hypothesis(i, was).prior);
       int pick = was;
       for (std::size_t h = 0; h < post.parts[i].hypotheses.size(); ++h) {
+        if (post.parts[i].hypotheses[h].label >= 0) continue;  // another class: the intervals' only
         at[i] = static_cast<int>(h);
         const PartHypothesis& c = hypothesis(i, at[i]);
         const double score = rest_prior + std::log(c.prior) + likelihood(with_hidden(rest_kg + c.mass_kg, at));
@@ -324,9 +454,8 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   post.mass_kg = total(at);
   post.in_range = in_range(post.mass_kg);
 
-  char range[96];
-  std::snprintf(range, sizeof range, "%.3g-%.3g kg at %.3g m", post.range_kg[0], post.range_kg[1], longest_side_m);
-  const std::string whose = article(kind.name) + "'s " + range;
+  const std::string& whose = post.judged_by;
+  const std::string why = post.kind.empty() ? "" : " (the kind's mass)";
   for (std::size_t i = 0; i < post.parts.size(); ++i) {
     PartPosterior& pp = post.parts[i];
     pp.chosen = at[i];
@@ -347,10 +476,14 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
               (before > post.range_kg[1]   ? "beyond "
                : before < post.range_kg[0] ? "short of "
                                            : "within ") +
-              whose + " (the kind's mass)";
+              whose + why;
     post.notes.push_back("part " + std::to_string(pp.part) + " (" + cls + "): " + pp.note);
   }
-  if (!post.in_range) {
+  if (!post.in_range && !belief.decides) {
+    post.notes.push_back("the object weighs " + kg(post.mass_kg) +
+                         (post.mass_kg > post.range_kg[1] ? ", beyond " : ", short of ") + whose +
+                         "; the estimate stands (the belief gives the interval only)");
+  } else if (!post.in_range) {
     // The part that breaks it: the heaviest when too heavy, the one that could
     // gain most when too light.
     std::size_t worst = 0;
@@ -358,7 +491,8 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
     for (std::size_t i = 0; i < post.parts.size(); ++i) {
       double extreme = post.mass_kg > post.range_kg[1] ? 1e300 : 0.0;
       for (const PartHypothesis& h : post.parts[i].hypotheses)
-        extreme = post.mass_kg > post.range_kg[1] ? std::min(extreme, h.mass_kg) : std::max(extreme, h.mass_kg);
+        if (h.label < 0)
+          extreme = post.mass_kg > post.range_kg[1] ? std::min(extreme, h.mass_kg) : std::max(extreme, h.mass_kg);
       if (extreme > worst_kg) {
         worst_kg = extreme;
         worst = i;
@@ -422,11 +556,14 @@ Result<MassPosterior> fit_mass_to_kind(const std::vector<Part>& parts, const Com
   return post;
 }
 
+}  // namespace
+
 namespace {
 
 class PosteriorEstimator final : public PropertyEstimator {
  public:
-  PosteriorEstimator(const PropertyEstimator& base, const MassPosterior& posterior) : base_(base) {
+  PosteriorEstimator(const PropertyEstimator& base, const MassPosterior& posterior)
+      : base_(base), source_(posterior.kind.empty() ? "everyday objects' mass: " : "the kind's mass: ") {
     for (const PartPosterior& p : posterior.parts)
       if (p.chosen > 0) chosen_[p.part] = &p;
   }
@@ -454,12 +591,13 @@ class PosteriorEstimator final : public PropertyEstimator {
     p.density_kg_m3 = density;
     p.structure_source = ValueSource::kKind;
     if (h.structure == Structure::kHollow) p.thickness_source = ValueSource::kKind;
-    p.notes.push_back("the kind's mass: " + pp.note);
+    p.notes.push_back(source_ + pp.note);
     return r;
   }
 
  private:
   const PropertyEstimator& base_;
+  const std::string source_;
   std::map<int, const PartPosterior*> chosen_;
 };
 
@@ -483,9 +621,13 @@ void apply_intervals(const MassPosterior& posterior, PropertiesReport& report) {
     report.mass_p05_kg = posterior.p05_kg;
     report.mass_p95_kg = posterior.p95_kg;
   }
-  report.kind_range_kg[0] = posterior.range_kg[0];
-  report.kind_range_kg[1] = posterior.range_kg[1];
-  for (const std::string& n : posterior.notes) report.notes.push_back("kind's mass: " + n);
+  report.mass_judged_by = posterior.judged_by;
+  if (!posterior.kind.empty()) {
+    report.kind_range_kg[0] = posterior.range_kg[0];
+    report.kind_range_kg[1] = posterior.range_kg[1];
+  }
+  const std::string source = posterior.kind.empty() ? "everyday objects' mass: " : "kind's mass: ";
+  for (const std::string& n : posterior.notes) report.notes.push_back(source + n);
 }
 
 }  // namespace g2p

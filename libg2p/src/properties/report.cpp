@@ -185,6 +185,7 @@ std::string report_json(const PropertiesReport& report, const MaterialTable& tab
   object["mass_min_kg"] = report.mass_min_kg;
   object["mass_max_kg"] = report.mass_max_kg;
   object["mass_interval_kg"] = interval_json(report.mass_median_kg, report.mass_p05_kg, report.mass_p95_kg);
+  object["mass_judged_by"] = report.mass_judged_by.empty() ? json(nullptr) : json(report.mass_judged_by);
   object["kind_mass_range_kg"] =
       report.kind_range_kg[1] > 0.0 ? json::array({report.kind_range_kg[0], report.kind_range_kg[1]}) : json(nullptr);
   double contents_volume = 0.0;

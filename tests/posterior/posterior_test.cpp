@@ -3,11 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "g2p/export.h"
 #include "g2p/pipeline.h"
@@ -308,6 +310,36 @@ TEST(ClassEvidence, APartsOtherProbableClassWidensTheIntervalNotTheChoice) {
   Result<MassPosterior> few = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, strict, evidence);
   ASSERT_TRUE(few.ok());
   EXPECT_EQ(few->parts[0].hypotheses.size(), certain->parts[0].hypotheses.size());
+}
+
+TEST(ClassEvidence, EveryOtherProbableClassIsDrawnAfterThePartsOwn) {
+  // Votes spread over five classes: the part's hypotheses grow by four while
+  // its own stay first (a regression: growing them once read a moved element).
+  Weighed w;
+  w.add(cls("Wood"), 1e-3, 0.08);
+  FaceVotes votes = votes_for(w, 0, cls("Metal"), 0.15f);
+  const std::size_t n = static_cast<std::size_t>(votes.num_classes);
+  for (const char* name : {"Plastic", "Glass", "Fabric"}) {
+    votes.histogram[static_cast<std::size_t>(cls(name))] = 15.0f;
+    votes.histogram[static_cast<std::size_t>(cls("Wood"))] -= 15.0f;
+  }
+  ASSERT_EQ(votes.histogram.size(), n);
+  Result<MassPosterior> certain = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report);
+  ClassEvidence evidence;
+  evidence.votes = &votes;
+  Result<MassPosterior> spread = fit_mass_to_bulk_density(w.parts, w.completion, table(), w.report, {}, evidence);
+  ASSERT_TRUE(certain.ok() && spread.ok());
+  const std::vector<PartHypothesis>& own = certain->parts[0].hypotheses;
+  const std::vector<PartHypothesis>& all = spread->parts[0].hypotheses;
+  ASSERT_EQ(all.size(), own.size() + 4);
+  for (std::size_t i = 0; i < own.size(); ++i) EXPECT_DOUBLE_EQ(all[i].mass_kg, own[i].mass_kg);
+  std::vector<int> drawn;
+  for (std::size_t i = own.size(); i < all.size(); ++i) drawn.push_back(all[i].label);
+  std::sort(drawn.begin(), drawn.end());
+  std::vector<int> expected = {cls("Metal"), cls("Plastic"), cls("Glass"), cls("Fabric")};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(drawn, expected);
+  EXPECT_DOUBLE_EQ(spread->mass_kg, certain->mass_kg);
 }
 
 }  // namespace

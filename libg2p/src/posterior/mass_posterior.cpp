@@ -195,7 +195,8 @@ void add_other_classes(PartPosterior& pp, const PartReport& r, const CompletedPa
   // votes, or the kind or a neighbour chose it over the votes.
   double own_prior = 0.0;
   for (const PartHypothesis& h : pp.hypotheses) own_prior += h.prior;
-  const PartHypothesis& own = pp.hypotheses[0];
+  // A copy: the loop appends to pp.hypotheses, which may move its elements.
+  const Structure own_structure = pp.hypotheses[0].structure;
   for (int c : others) {
     const MaterialClass& mc = table[c];
     PartHypothesis h;
@@ -203,7 +204,7 @@ void add_other_classes(PartPosterior& pp, const PartReport& r, const CompletedPa
     h.density_kg_m3 = mc.density_kg_m3;
     h.prior = own_prior * probability[static_cast<std::size_t>(c)] / most;
     const double t = mc.wall_thickness_m;
-    if (own.structure == Structure::kHollow && t > 0.0 && area_m2 * t < volume) {
+    if (own_structure == Structure::kHollow && t > 0.0 && area_m2 * t < volume) {
       h.structure = Structure::kHollow;
       h.wall_thickness_m = t;
       h.mass_kg = area_m2 * t * h.density_kg_m3;

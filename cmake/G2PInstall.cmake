@@ -11,7 +11,7 @@ install(FILES ${PROJECT_BINARY_DIR}/libg2p/generated/include/g2p/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/g2p)
 install(FILES ${PROJECT_SOURCE_DIR}/libg2p/data/materials.json ${PROJECT_SOURCE_DIR}/libg2p/data/refine_prompt.txt
               ${PROJECT_SOURCE_DIR}/libg2p/data/objects.json ${PROJECT_SOURCE_DIR}/libg2p/data/objects.schema.json
-              ${PROJECT_SOURCE_DIR}/libg2p/data/objects.md
+              ${PROJECT_SOURCE_DIR}/libg2p/data/objects.md ${PROJECT_SOURCE_DIR}/libg2p/data/wordnet_kinds.json
         DESTINATION ${CMAKE_INSTALL_DATADIR}/g2p)
 if(EXISTS ${PROJECT_SOURCE_DIR}/libg2p/data/models)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/libg2p/data/models DESTINATION ${CMAKE_INSTALL_DATADIR}/g2p)

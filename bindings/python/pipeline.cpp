@@ -291,7 +291,7 @@ void bind_pipeline(py::module_& m) {
       .def_readwrite("views", &PipelineOptions::views)
       .def_readwrite("render", &PipelineOptions::render)
       .def_readwrite("identifier", &PipelineOptions::identifier,
-                     "identify backend: auto (default), object, names, detector, vlm, none")
+                     "identify backend: auto (default), object, names, detector, classifier, vlm, none")
       .def_readwrite("object", &PipelineOptions::object, "the object in your words ('exercise bike'); '' = none")
       .def_property(
           "size_from", [](const PipelineOptions& o) { return std::string(to_string(o.size_policy)); },

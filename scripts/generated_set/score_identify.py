@@ -2,7 +2,7 @@
 """Score identification, size and mass of `g2p run` on the generated test set (#48).
 
     /usr/bin/python3 scripts/generated_set/score_identify.py --out OUT [--g2p BIN] [--only ID ...]
-        [--json FILE] [--conditions nosize,size] [-- EXTRA g2p run FLAGS]
+        [--json FILE] [--conditions nosize,size | --identify-only] [-- EXTRA g2p run FLAGS]
 
 Each model of data/generated/manifest.json (read from ../shared/generated; missing ones are listed
 and left out) is copied under the file name its generator wrote
@@ -10,6 +10,8 @@ and left out) is copied under the file name its generator wrote
 are the generator's, not this set's ids. Then `g2p run` runs twice per model:
   - nosize: the file as it is (a normalised mesh may take its identified kind's size);
   - size:   with the annotated real size (--height or --longest-side).
+With --identify-only, `g2p identify --json` runs once instead (identification only, no mass; the
+EXTRA flags are g2p identify's).
 From each run.json it reads the identification and the mass, and prints per model and overall:
   - identification top-1 and top-3: the identified kind (and the first three candidates) against
     data/generated/objects.json's kind and its acceptable alternatives, over the models whose kind
@@ -54,6 +56,14 @@ def accepted(annotation, names):
     return {w for w in words if w in names}
 
 
+def identify(g2p, path, extra):
+    """`g2p identify --json` alone (--identify-only): the identification, no mass."""
+    done = subprocess.run([g2p, "identify", path, "--json"] + extra, capture_output=True, text=True)
+    if done.returncode != 0:
+        return None, done.stderr.strip().splitlines()[-1:] if done.stderr else ["exit %d" % done.returncode]
+    return {"identification": json.loads(done.stdout), "object": {"mass_kg": float("nan")}}, []
+
+
 def run(g2p, path, out, size, extra):
     cmd = [g2p, "run", path, "-o", out, "--overwrite", "-q"]
     if size:
@@ -74,9 +84,11 @@ def main(argv=None):
     ap.add_argument("--only", nargs="*")
     ap.add_argument("--json")
     ap.add_argument("--conditions", default="nosize,size")
+    ap.add_argument("--identify-only", action="store_true",
+                    help="run `g2p identify --json` once per model (top-1 and top-3 only, no mass)")
     ap.add_argument("extra", nargs="*")
     a = ap.parse_args(argv)
-    conditions = a.conditions.split(",")
+    conditions = ["nosize"] if a.identify_only else a.conditions.split(",")
     with open(os.path.join(SET, "manifest.json")) as f:
         manifest = json.load(f)["models"]
     with open(os.path.join(SET, "objects.json")) as f:
@@ -100,8 +112,11 @@ def main(argv=None):
         row = {"id": mid, "generator": entry["generator"], "kind": ann["kind"], "in_table": bool(right),
                "range": ann["mass_kg"], "file": os.path.basename(named)}
         for cond in conditions:
-            result, err = run(a.g2p, named, os.path.join(a.out, cond, mid),
-                              ann["real_size"] if cond == "size" else None, a.extra)
+            if a.identify_only:
+                result, err = identify(a.g2p, named, a.extra)
+            else:
+                result, err = run(a.g2p, named, os.path.join(a.out, cond, mid),
+                                  ann["real_size"] if cond == "size" else None, a.extra)
             if result is None:
                 row[cond] = {"error": " ".join(err)}
                 continue

@@ -14,11 +14,16 @@ hand-written `extra_terms`.  A term reached from several kinds goes to the most 
 (the kind whose synset is the nearer hypernym of the term's synset); a term that is exactly a
 lemma of a kind's own synset always belongs to that kind.
 
+Beside it, libg2p/data/wordnet_kinds.json maps WordNet 3.0 noun synsets (by offset, as ImageNet's
+ids "n03376595" write them) to kinds: every synset of a kind's closure (the same closure as its
+terms), a synset reached from several kinds going to the nearest. The `classifier` identifier maps
+a user's classifier's WordNet ids to kinds through it.
+
 Usage:
-  build_objects.py                 write libg2p/data/objects.json
-  build_objects.py --check         rebuild in memory; exit 1 if the committed file differs
+  build_objects.py                 write libg2p/data/objects.json and wordnet_kinds.json
+  build_objects.py --check         rebuild in memory; exit 1 if a committed file differs
   build_objects.py --wordnet DIR   read index.noun/data.noun from DIR instead
-  build_objects.py --output FILE   write (or check) FILE instead
+  build_objects.py --output FILE   write (or check) FILE instead, wordnet_kinds.json beside it
 
 Python 3 standard library only; the WordNet database format is parsed here (see wndb(5WN)).
 """
@@ -35,6 +40,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 KINDS = os.path.join(HERE, "kinds.json")
 OUTPUT = os.path.join(ROOT, "libg2p", "data", "objects.json")
+SYNSETS_OUTPUT = os.path.join(ROOT, "libg2p", "data", "wordnet_kinds.json")
 DEFAULT_WORDNET = "/usr/share/wordnet"
 PACKAGE = "wordnet-base"
 
@@ -244,6 +250,22 @@ def build_terms(kinds, wn):
     return {ki: sorted(set(ts)) for ki, ts in terms.items()}
 
 
+def build_synset_kinds(kinds, wn):
+    """{kind name: sorted offsets}: every synset of a kind's closure, each to its nearest kind."""
+    best = {}                                # offset -> (distance, kind idx)
+    for ki, kind in enumerate(kinds):
+        for name in kind["synsets"]:
+            root = wn.resolve(name)
+            closure = wn.closure(root) if kind.get("hyponyms", True) else {root: 0}
+            for off, d in closure.items():
+                if off not in best or (d, ki) < best[off]:
+                    best[off] = (d, ki)
+    out = collections.OrderedDict((k["name"], []) for k in kinds)
+    for off, (_, ki) in best.items():
+        out[kinds[ki]["name"]].append(off)
+    return collections.OrderedDict((name, sorted(offs)) for name, offs in out.items())
+
+
 # ---------------------------------------------------------------------------------------------
 # Validation (the same rules as libg2p/data/objects.schema.json, plus what a schema cannot say)
 # ---------------------------------------------------------------------------------------------
@@ -415,7 +437,14 @@ def build(wordnet_dir):
     errors = validate_table(table)
     if errors:
         raise BuildError("objects table is invalid:\n  " + "\n  ".join(errors))
-    return table
+    synsets = collections.OrderedDict()
+    synsets["format"] = "g2p-wordnet-kinds"
+    synsets["version"] = 1
+    synsets["about"] = ("WordNet 3.0 noun synsets by offset (ImageNet's n-ids without the 'n') under each "
+                        "kind of objects.json; built by scripts/objects/build_objects.py")
+    synsets["wordnet"] = table["wordnet"]
+    synsets["kinds"] = build_synset_kinds(kinds, wn)
+    return table, synsets
 
 
 def render(value, indent=0):
@@ -447,7 +476,7 @@ def main(argv=None):
     ap.add_argument("--output", default=OUTPUT, metavar="FILE", help="default %(default)s")
     args = ap.parse_args(argv)
     try:
-        table = build(args.wordnet)
+        table, synsets = build(args.wordnet)
     except BuildError as e:
         print("build_objects: error: %s" % e, file=sys.stderr)
         return 2
@@ -473,13 +502,33 @@ def main(argv=None):
                   "(kinds that differ: %s); run scripts/objects/build_objects.py and commit the result"
                   % (args.output, ", ".join(diffs[:20]) or "formatting/header only"), file=sys.stderr)
             return 1
-        print("build_objects: %s is up to date (%d kinds)" % (args.output, len(table["kinds"])))
+        synsets_output = os.path.join(os.path.dirname(args.output), os.path.basename(SYNSETS_OUTPUT))
+        try:
+            with open(synsets_output, encoding="utf-8") as f:
+                old_synsets = json.load(f)
+        except (OSError, ValueError) as e:
+            print("build_objects: %s cannot be read (%s); run scripts/objects/build_objects.py"
+                  % (synsets_output, e), file=sys.stderr)
+            return 1
+        synsets["wordnet"] = old_synsets.get("wordnet")
+        if old_synsets != json.loads(json.dumps(synsets)):
+            print("build_objects: %s is out of date with scripts/objects/kinds.json and WordNet; run "
+                  "scripts/objects/build_objects.py and commit the result" % synsets_output, file=sys.stderr)
+            return 1
+        print("build_objects: %s is up to date (%d kinds), %s too (%d synsets)"
+              % (args.output, len(table["kinds"]), synsets_output,
+                 sum(len(v) for v in synsets["kinds"].values())))
         return 0
     os.makedirs(os.path.dirname(args.output), exist_ok=True)
     with open(args.output, "w", encoding="utf-8") as f:
         f.write(render(table) + "\n")
+    synsets_output = os.path.join(os.path.dirname(args.output), os.path.basename(SYNSETS_OUTPUT))
+    with open(synsets_output, "w", encoding="utf-8") as f:
+        f.write(render(synsets) + "\n")
     n_terms = sum(len(k["terms"]) for k in table["kinds"])
-    print("build_objects: wrote %s (%d kinds, %d terms)" % (args.output, len(table["kinds"]), n_terms))
+    n_synsets = sum(len(v) for v in synsets["kinds"].values())
+    print("build_objects: wrote %s (%d kinds, %d terms) and %s (%d synsets)"
+          % (args.output, len(table["kinds"]), n_terms, synsets_output, n_synsets))
     return 0
 
 

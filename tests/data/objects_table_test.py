@@ -115,6 +115,24 @@ class ObjectsTable(unittest.TestCase):
         dup = {t: o for t, o in self.owner.items() if len(o) > 1}
         self.assertEqual(dup, {}, "every term belongs to one kind")
 
+    def test_wordnet_kinds(self):
+        """wordnet_kinds.json (the classifier identifier's map): every kind of the table, each synset
+        once, each kind's own synsets under it, and ImageNet's chairs under chair."""
+        with open(os.path.join(os.path.dirname(TABLE), "wordnet_kinds.json"), encoding="utf-8") as f:
+            synsets = json.load(f)
+        self.assertEqual(synsets["format"], "g2p-wordnet-kinds")
+        self.assertEqual(list(synsets["kinds"]), [k["name"] for k in self.kinds])
+        seen = {}
+        for name, offsets in synsets["kinds"].items():
+            self.assertEqual(offsets, sorted(offsets), name)
+            for o in offsets:
+                self.assertNotIn(o, seen, "synset %d under %s and %s" % (o, seen.get(o), name))
+                seen[o] = name
+        self.assertGreater(len(seen), 5000)
+        # n03376595 folding chair, n04099969 rocking chair, n02791124 barber chair; n04579145 whiskey jug.
+        for wnid, kind in [(3376595, "chair"), (4099969, "chair"), (2791124, "chair"), (4579145, "jug")]:
+            self.assertEqual(seen.get(wnid), kind, wnid)
+
     def test_spot_facts(self):
         expect = {
             "recliner": "armchair", "sedan": "car", "hatchback": "car", "minivan": "car",

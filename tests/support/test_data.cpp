@@ -17,6 +17,9 @@ std::string labels_json_path() { return std::string(G2P_TEST_SHARED_ASSETS) + "/
 std::string assimp_model(const std::string& relative) { return std::string(G2P_TEST_ASSIMP_MODELS) + "/" + relative; }
 std::string source_path(const std::string& relative) { return std::string(G2P_TEST_SOURCE_DIR) + "/" + relative; }
 std::string generated_path(const std::string& file) { return std::string(G2P_TEST_SHARED_GENERATED) + "/" + file; }
+std::string shared_model_path(const std::string& relative) {
+  return std::string(G2P_TEST_SHARED_MODELS) + "/" + relative;
+}
 
 std::string scratch_dir(const std::string& test_name) {
   // ctest runs tests in parallel, and several tests may ask for the same name

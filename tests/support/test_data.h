@@ -18,6 +18,11 @@ std::string source_path(const std::string& relative);
 // repositories and are never committed here; a test that needs one skips
 // without it (G2P_SKIP_WITHOUT).
 std::string generated_path(const std::string& file);
+// A network of ../shared/models, e.g.
+// shared_model_path("imagenet-mobilenet-v2/mobilenet_v2_1.0_224.onnx"): from a
+// public repository, never committed here; a test that needs one skips
+// without it (G2P_SKIP_WITHOUT).
+std::string shared_model_path(const std::string& relative);
 
 // A fresh, empty folder under the build tree, kept apart per running test
 // (build/tests/scratch/Suite.Test/NAME), so tests that share a name can run in parallel.
@@ -31,10 +36,10 @@ void write_file(const std::string& path, const std::string& bytes);
 }  // namespace g2p::test
 
 // Skips the running test, saying why, when `path` (a file the test reads from
-// ../shared) is absent.
-#define G2P_SKIP_WITHOUT(path)                                                                             \
-  do {                                                                                                     \
-    if (!std::filesystem::exists(path))                                                                    \
-      GTEST_SKIP() << (path) << " is absent: the generated set's files are read from ../shared/generated " \
-                   << "(cmake -DG2P_SHARED_GENERATED=DIR)";                                                \
+// ../shared/generated or ../shared/models) is absent.
+#define G2P_SKIP_WITHOUT(path)                                                                        \
+  do {                                                                                                \
+    if (!std::filesystem::exists(path))                                                               \
+      GTEST_SKIP() << (path) << " is absent: files from public repositories are read from ../shared " \
+                   << "(cmake -DG2P_SHARED_GENERATED=DIR -DG2P_SHARED_MODELS=DIR)";                   \
   } while (false)

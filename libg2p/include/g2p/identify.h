@@ -163,7 +163,8 @@ class G2P_API Identifier {
 
 // Backends by name. libg2p registers:
 //   "auto"     (the default) the user's words when given, which win; else the
-//              names and the detector together, conflicts noted;
+//              names and the detector together (and the classifier when
+//              given), conflicts noted;
 //   "object"   the user's words only (IdentifyInput::object_text);
 //   "names"    the file, node, mesh and material names, matched through the
 //              table's WordNet terms;
@@ -171,6 +172,11 @@ class G2P_API Identifier {
 //              g2p-objects-nanodet.onnx; settings model_card, min_score,
 //              min_iou, views = turntable (its own eye-level views, with a
 //              renderer) or given (IdentifyInput::views));
+//   "classifier" an ONNX image classifier the user supplies (settings model,
+//              labels: its classes as WordNet ids or words, mapped to kinds
+//              through WordNet; size, normalization, channels,
+//              min_probability); nothing ships for it, and `auto` takes its
+//              settings and joins its answer once model and labels are set;
 //   "vlm"      a vision-language model asked to name the object (docs/vlm.md);
 //   "none"     always unknown (the behaviour before identification).
 G2P_API Registry<Identifier>& identifier_registry();

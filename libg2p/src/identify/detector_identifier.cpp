@@ -162,7 +162,9 @@ class DetectorIdentifier final : public Identifier {
     const std::size_t k = card_.classes.size();
     std::vector<View> own;
     if (can_render) {
-      Result<std::vector<View>> rendered = turntable_views(*in.renderer, in.model->mesh);
+      Result<std::vector<View>> rendered =
+          detail::turntable_views(*in.renderer, in.model->mesh, card_.width, card_.height, card_.background,
+                                  kTurntableViews, kTurntableElevationDeg, "detector");
       if (!rendered.ok()) return rendered.status();
       own = std::move(*rendered);
     }
@@ -234,52 +236,17 @@ class DetectorIdentifier final : public Identifier {
     return load_status_;
   }
 
-  // Eye-level views around the object at the network's input size, on the
-  // card's grey: photographs of objects are taken from about there, and the
-  // detector reads views from straight above or below poorly.
-  Result<std::vector<View>> turntable_views(const Renderer& renderer, const Mesh& mesh) const {
-    ViewOptions o;
-    o.num_views = kTurntableViews;
-    o.layout = ViewLayout::kTurntable;
-    o.elevation_deg = kTurntableElevationDeg;
-    o.width = card_.width;
-    o.height = card_.height;
-    Result<std::vector<Camera>> cameras = make_views(mesh, o);
-    if (!cameras.ok()) return cameras.status().with_context("detector");
-    RenderOptions r;
-    r.material_buffers = r.geometry_buffers = false;
-    if (card_.background >= 0) r.background.fill(static_cast<std::uint8_t>(card_.background));
-    std::vector<View> views(cameras->size());
-    for (std::size_t i = 0; i < views.size(); ++i)
-      G2P_RETURN_IF_ERROR(renderer.render_into((*cameras)[i], r, views[i]).with_context("detector: view"));
-    return views;
-  }
-
   // Per class, the best score of a detection covering the object in this
   // view; empty when the view shows nothing of it.
   Result<std::vector<double>> view_scores(const View& view) const {
     if (view.rgb.empty() || view.rgb.channels() != 3) return Status::InvalidArgument("detector: the views need RGB");
     const int w = view.rgb.width(), h = view.rgb.height();
-    Box object{1e9, 1e9, -1e9, -1e9};
-    if (!view.face_id.empty()) {
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-          if (*view.face_id.pixel(x, y) >= 0) {
-            object.x1 = std::min(object.x1, double(x));
-            object.y1 = std::min(object.y1, double(y));
-            object.x2 = std::max(object.x2, double(x + 1));
-            object.y2 = std::max(object.y2, double(y + 1));
-          }
-      if (object.x2 <= object.x1) return std::vector<double>();
-    } else {
-      object = {0, 0, double(w), double(h)};
-    }
-    cv::Mat rgb = cv::Mat(h, w, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.data())).clone();
-    if (card_.background >= 0 && !view.face_id.empty())  // the grey the detector reads best (its card)
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-          if (*view.face_id.pixel(x, y) < 0)
-            rgb.at<cv::Vec3b>(y, x) = cv::Vec3b::all(static_cast<uchar>(card_.background));
+    const detail::PixelBox pixels = detail::object_box(view);
+    if (pixels.empty()) return std::vector<double>();
+    const Box object{double(pixels.x1), double(pixels.y1), double(pixels.x2), double(pixels.y2)};
+    // On the grey the detector reads best (its card).
+    std::vector<std::uint8_t> painted = detail::rgb_on_background(view, card_.background);
+    cv::Mat rgb(h, w, CV_8UC3, painted.data());
     cv::Mat resized, input;
     cv::resize(rgb, resized, cv::Size(card_.width, card_.height), 0, 0, cv::INTER_LINEAR);
     if (!card_.rgb) cv::cvtColor(resized, resized, cv::COLOR_RGB2BGR);

@@ -128,16 +128,21 @@ class NamesIdentifier final : public Identifier {
 };
 
 // "auto": the user's words win when given (the names are compared with them
-// and a disagreement is noted); else the names and the detector, each kind's
-// confidences joined as independent evidence, 1 - (1 - a)(1 - b).
+// and a disagreement is noted); else the names, the detector and, when the
+// user gave one, the classifier, each kind's confidences joined as
+// independent evidence, 1 - (1 - a)(1 - b).
 class AutoIdentifier final : public Identifier {
  public:
-  AutoIdentifier() : names_(std::make_unique<NamesIdentifier>()), detector_(detail::make_detector_identifier()) {}
+  AutoIdentifier()
+      : names_(std::make_unique<NamesIdentifier>()),
+        detector_(detail::make_detector_identifier()),
+        classifier_(detail::make_classifier_identifier()) {}
 
   SettingsSpec settings() override {
     return SettingsSpec("auto")
         .flag("detector", use_detector_, "join the detector's answer with the names'")
-        .include(detector_->settings());
+        .include(detector_->settings())
+        .include(classifier_->settings());
   }
 
   Result<Identification> identify(const IdentifyInput& in) const override {
@@ -178,6 +183,17 @@ class AutoIdentifier final : public Identifier {
         join(*seen);
       }
     }
+    if (classifier_->configured() && ((in.views != nullptr && !in.views->empty()) || in.renderer != nullptr)) {
+      Result<Identification> seen = classifier_->identify(in);
+      if (!seen.ok()) {
+        id.warnings.push_back("the classifier failed (" + seen.status().message() + "); identified without it");
+      } else {
+        if (seen->known() && by_names->known() && seen->kind() != by_names->kind())
+          id.notes.push_back("the names say " + by_names->kind() + " (" + percent(by_names->confidence()) +
+                             "), the classifier " + seen->kind() + " (" + percent(seen->confidence()) + ")");
+        join(*seen);
+      }
+    }
     for (auto& [kind, g] : joined) id.candidates.push_back(std::move(g));
     std::stable_sort(id.candidates.begin(), id.candidates.end(),
                      [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });
@@ -187,6 +203,7 @@ class AutoIdentifier final : public Identifier {
  private:
   std::unique_ptr<Identifier> names_;
   std::unique_ptr<Identifier> detector_;
+  std::unique_ptr<detail::OptionalIdentifier> classifier_;
   bool use_detector_ = true;
 };
 
@@ -199,6 +216,7 @@ Registry<Identifier>& identifier_registry() {
     (void)r->add("object", [] { return std::unique_ptr<Identifier>(std::make_unique<ObjectIdentifier>()); });
     (void)r->add("names", [] { return std::unique_ptr<Identifier>(std::make_unique<NamesIdentifier>()); });
     (void)r->add("detector", &detail::make_detector_identifier);
+    (void)r->add("classifier", [] { return std::unique_ptr<Identifier>(detail::make_classifier_identifier()); });
     (void)r->add("vlm", [] { return detail::make_vlm_identifier(); });
     (void)r->add("none", [] { return std::unique_ptr<Identifier>(std::make_unique<NoIdentifier>()); });
     return r;

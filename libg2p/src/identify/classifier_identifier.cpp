@@ -1,0 +1,382 @@
+// The "classifier" identifier: an image classifier the user supplies (an
+// ONNX file that OpenCV's dnn module reads: an ImageNet network, a domain
+// model), run on views of the object, its classes mapped to the object
+// table's kinds through WordNet. Nothing is shipped for it and nothing
+// defaults to it: with `auto` it votes beside the names and the detector once
+// `model` and `labels` are set (`g2p run --identify-set model=PATH labels=PATH`).
+//
+// The labels file names the network's classes in output order: a JSON array
+// of strings or one line each. A class is a WordNet 3.0 noun id ("n03376595",
+// as ImageNet writes them), words ("folding chair, folding stool": synonyms
+// split at commas), or both ("n03376595 folding chair"). An id maps through
+// the shipped synsets by kind (wordnet_kinds.json: every synset under a
+// kind's); words map where one of them is exactly a term of the object table
+// (the table's terms are the lemmas under each kind, so both ways follow
+// WordNet's hierarchy). A network with one score more than there are labels
+// has a leading background class (TensorFlow's ImageNet models), left out.
+//
+// Per view the scores become probabilities (a softmax, unless they already
+// are) and a kind's probability is the sum over its classes; a kind's
+// confidence is the mean over the views. The views are the detector's: eight
+// of its own at eye level with a renderer, else those given; each is cropped
+// to a square about the object's pixels (photographs are framed on the
+// object) on a plain grey, then scaled to the network's input.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/settings.h"
+#include "identify/backends.h"
+
+namespace g2p {
+namespace {
+
+// How a network expects its pixels.
+enum class Normalization {
+  kMinusOneToOne,  // (x - 127.5) / 127.5: TensorFlow and Keras MobileNets
+  kImageNet,       // (x / 255 - mean) / std with ImageNet's mean and std: torchvision
+  kZeroToOne,      // x / 255
+};
+
+std::string trim(const std::string& s) {
+  std::size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return s.substr(a, b - a);
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// One class of the network as its labels file names it.
+struct ClassLabel {
+  std::string text;  // as written, for notes ("folding chair")
+  long offset = -1;  // its WordNet 3.0 noun offset, -1 = none given
+  std::vector<std::string> words;
+};
+
+ClassLabel parse_label(const std::string& raw) {
+  ClassLabel l;
+  std::string rest = trim(raw);
+  // "n03376595", optionally followed by words.
+  if (rest.size() >= 9 && rest[0] == 'n' &&
+      std::all_of(rest.begin() + 1, rest.begin() + 9,
+                  [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }) &&
+      (rest.size() == 9 || !std::isalnum(static_cast<unsigned char>(rest[9])))) {
+    l.offset = std::stol(rest.substr(1, 8));
+    rest = trim(rest.substr(9));
+    while (!rest.empty() && (rest[0] == ',' || rest[0] == ':' || rest[0] == ';')) rest = trim(rest.substr(1));
+  }
+  std::stringstream ss(rest);
+  std::string word;
+  while (std::getline(ss, word, ','))
+    if (!trim(word).empty()) l.words.push_back(trim(word));
+  l.text = l.words.empty() ? trim(raw) : l.words.front();
+  return l;
+}
+
+Result<std::vector<ClassLabel>> read_labels(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound("labels=" + path + ": cannot open it");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  std::vector<std::string> raw;
+  if (!trim(text).empty() && trim(text)[0] == '[') {
+    const nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (doc.is_discarded() || !doc.is_array())
+      return Status::ParseError("labels=" + path + ": starts with '[' but is not a JSON array");
+    for (std::size_t i = 0; i < doc.size(); ++i) {
+      if (!doc[i].is_string())
+        return Status::ParseError("labels=" + path + ": entry " + std::to_string(i) + " is not a string");
+      raw.push_back(doc[i].get<std::string>());
+    }
+  } else {
+    std::stringstream lines(text);
+    std::string line;
+    while (std::getline(lines, line)) raw.push_back(line);
+    while (!raw.empty() && trim(raw.back()).empty()) raw.pop_back();
+  }
+  if (raw.empty()) return Status::ParseError("labels=" + path + ": names no class");
+  std::vector<ClassLabel> labels;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    if (trim(raw[i]).empty())
+      return Status::ParseError("labels=" + path + ": class " + std::to_string(i + 1) +
+                                " is blank (one class a line, in the network's output order)");
+    labels.push_back(parse_label(raw[i]));
+  }
+  return labels;
+}
+
+// The kind a class names in `table`, or -1.
+int kind_of(const ClassLabel& l, const ObjectTable& table) {
+  if (l.offset >= 0) {
+    const std::string& name = detail::shipped_wordnet_kind(l.offset);
+    if (!name.empty()) {
+      const int k = table.find(name);
+      if (k >= 0) return k;
+    }
+  }
+  for (const std::string& w : l.words) {
+    const std::string want = lower(w);
+    for (const TextMatch& m : table.match(w))
+      if (m.term == want) return m.kind;  // the whole label, not a word inside it ("tiger" of "tiger shark")
+  }
+  return -1;
+}
+
+std::string percent(double x) {
+  char b[16];
+  std::snprintf(b, sizeof b, "%.0f %%", 100.0 * x);
+  return b;
+}
+
+class ClassifierIdentifier final : public detail::OptionalIdentifier {
+ public:
+  SettingsSpec settings() override {
+    return SettingsSpec("classifier")
+        .file("model", model_path_, "an ONNX image classifier (OpenCV's dnn reads it); \"\" = none")
+        .file("labels", labels_path_,
+              "its classes in output order, one a line or a JSON array: WordNet ids (n03376595), words, or both")
+        .integer("size", size_, 32, 1024, "pixels", "the network's square input side")
+        .choice("normalization", normalization_,
+                {{"minus-one-to-one", Normalization::kMinusOneToOne},
+                 {"imagenet", Normalization::kImageNet},
+                 {"zero-to-one", Normalization::kZeroToOne}},
+                "its input's pixel values: (x-127.5)/127.5 (TensorFlow), ImageNet mean and std (torchvision), x/255")
+        .choice("channels", rgb_, {{"RGB", true}, {"BGR", false}}, "its input's channel order")
+        .number("min_probability", min_probability_, Range::closed(0, 1), "",
+                "the least mean probability over the views for a kind to be a candidate")
+        .check([this] {
+          if (model_path_.empty() != labels_path_.empty())
+            return Status::InvalidArgument(
+                "classifier: model and labels go together (--identify-set model=PATH "
+                "labels=PATH)");
+          loaded_ = false;  // read again, with these settings, at the next identify
+          return Status::Ok();
+        });
+  }
+
+  bool configured() const override { return !model_path_.empty(); }
+
+  Result<Identification> identify(const IdentifyInput& in) const override {
+    Identification id;
+    if (!configured()) {
+      id.notes.push_back("classifier: no network given (--identify-set model=PATH labels=PATH)");
+      return id;
+    }
+    const bool can_render = in.renderer != nullptr && in.model != nullptr;
+    if (!can_render && (in.views == nullptr || in.views->empty())) {
+      id.notes.push_back("classifier: no rendered views");
+      return id;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);  // the network is loaded once and is not reentrant
+    if (const Status s = load(); !s.ok()) {
+      id.warnings.push_back("the classifier is not available (" + s.message() + "); not identified by it");
+      return id;
+    }
+    const ObjectTable& table = in.table != nullptr ? *in.table : ObjectTable::shipped();
+    std::vector<View> own;
+    if (can_render) {
+      Result<std::vector<View>> rendered = detail::turntable_views(*in.renderer, in.model->mesh, 2 * size_, 2 * size_,
+                                                                   kBackground, kViews, kElevationDeg, "classifier");
+      if (!rendered.ok()) return rendered.status();
+      own = std::move(*rendered);
+    }
+    const std::vector<View>& views = own.empty() ? *in.views : own;
+    std::vector<int> kinds(labels_.size());
+    for (std::size_t c = 0; c < labels_.size(); ++c) kinds[c] = kind_of(labels_[c], table);
+    std::map<int, double> kind_sum;                   // kind -> summed probability over views
+    std::map<int, std::map<std::size_t, double>> by;  // kind -> class -> summed probability
+    std::map<std::size_t, double> unmapped;           // class -> summed probability, classes naming no kind
+    int seen = 0;
+    for (const View& view : views) {
+      Result<std::vector<double>> p = probabilities(view);
+      if (!p.ok()) return p.status();
+      if (p->empty()) continue;
+      ++seen;
+      for (std::size_t c = 0; c < labels_.size(); ++c) {
+        const double x = (*p)[c + offset_];
+        if (kinds[c] >= 0) {
+          kind_sum[kinds[c]] += x;
+          by[kinds[c]][c] += x;
+        } else {
+          unmapped[c] += x;
+        }
+      }
+    }
+    if (seen == 0) {
+      id.notes.push_back("classifier: no view shows the object");
+      return id;
+    }
+    for (const auto& [kind, sum] : kind_sum) {
+      const double confidence = sum / seen;
+      if (confidence < min_probability_ || confidence <= 0.0) continue;
+      std::vector<std::pair<double, std::size_t>> classes;
+      for (const auto& [c, x] : by[kind]) classes.emplace_back(x, c);
+      std::sort(classes.begin(), classes.end(), std::greater<>());
+      std::string evidence = "'" + labels_[classes.front().second].text + "'";
+      if (classes.size() > 1) evidence += " and " + std::to_string(classes.size() - 1) + " more of its classes";
+      evidence += ", " + percent(confidence) + " over " + std::to_string(seen) + " views";
+      id.candidates.push_back({table.kinds()[static_cast<std::size_t>(kind)].name, confidence, "classifier", evidence});
+    }
+    std::stable_sort(id.candidates.begin(), id.candidates.end(),
+                     [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });
+    std::pair<double, std::size_t> top{0.0, 0};
+    for (const auto& [c, x] : unmapped) top = std::max(top, {x, c});
+    if (top.first / seen >= min_probability_)
+      id.notes.push_back("classifier: '" + labels_[top.second].text + "' (" + percent(top.first / seen) +
+                         "), which no kind of the object table answers for");
+    if (id.candidates.empty())
+      id.notes.push_back("classifier: no class of a kind reached " + percent(min_probability_));
+    return id;
+  }
+
+ private:
+  Status load() const {
+    if (loaded_) return load_status_;
+    loaded_ = true;
+    Result<std::vector<ClassLabel>> labels = read_labels(labels_path_);
+    if (!labels.ok()) return load_status_ = labels.status();
+    labels_ = std::move(*labels);
+    try {
+      net_ = cv::dnn::readNet(model_path_);
+      net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+      net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    } catch (const cv::Exception& e) {
+      return load_status_ = Status::IoError("model=" + model_path_ + ": OpenCV could not load it (" + e.what() + ")");
+    }
+    if (net_.empty()) return load_status_ = Status::IoError("model=" + model_path_ + ": OpenCV could not load it");
+    // The number of scores, from a grey image: as many as labels, or one more
+    // (a leading background class).
+    Result<std::vector<float>> scores = forward(cv::Mat(size_, size_, CV_8UC3, cv::Scalar::all(kBackground)));
+    if (!scores.ok()) return load_status_ = scores.status();
+    if (scores->size() == labels_.size()) {
+      offset_ = 0;
+    } else if (scores->size() == labels_.size() + 1) {
+      offset_ = 1;
+    } else {
+      return load_status_ = Status::InvalidArgument(
+                 "model=" + model_path_ + " gives " + std::to_string(scores->size()) +
+                 " scores but labels=" + labels_path_ + " names " + std::to_string(labels_.size()) +
+                 " classes (as many are needed, or one fewer when the first score is a background class)");
+    }
+    return load_status_ = Status::Ok();
+  }
+
+  // The network's scores for an RGB image of size_ x size_.
+  Result<std::vector<float>> forward(const cv::Mat& rgb) const {
+    cv::Mat input;
+    if (!rgb_)
+      cv::cvtColor(rgb, input, cv::COLOR_RGB2BGR);
+    else
+      input = rgb;
+    cv::Mat blob;
+    switch (normalization_) {
+      case Normalization::kMinusOneToOne:
+        blob = cv::dnn::blobFromImage(input, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), false, false);
+        break;
+      case Normalization::kZeroToOne:
+        blob = cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), false, false);
+        break;
+      case Normalization::kImageNet: {
+        // (x / 255 - mean) / std per channel, in the input's channel order.
+        cv::Mat f;
+        input.convertTo(f, CV_32FC3, 1.0 / 255.0);
+        const double mean[3] = {0.485, 0.456, 0.406}, std[3] = {0.229, 0.224, 0.225};  // RGB
+        std::vector<cv::Mat> planes;
+        cv::split(f, planes);
+        for (int c = 0; c < 3; ++c) {
+          const int k = rgb_ ? c : 2 - c;
+          planes[static_cast<std::size_t>(c)] = (planes[static_cast<std::size_t>(c)] - mean[k]) / std[k];
+        }
+        cv::merge(planes, f);
+        blob = cv::dnn::blobFromImage(f);
+        break;
+      }
+    }
+    cv::Mat out;
+    try {
+      net_.setInput(blob);
+      out = net_.forward();
+    } catch (const cv::Exception& e) {
+      return Status::Internal(std::string("classifier: inference failed (is size=") + std::to_string(size_) +
+                              " its input side?): " + e.what());
+    }
+    const cv::Mat flat = out.reshape(1, 1);
+    std::vector<float> scores(flat.ptr<float>(), flat.ptr<float>() + flat.total());
+    return scores;
+  }
+
+  // The view's class probabilities (with the background score, if any, first);
+  // empty when the view shows nothing of the object.
+  Result<std::vector<double>> probabilities(const View& view) const {
+    if (view.rgb.empty() || view.rgb.channels() != 3) return Status::InvalidArgument("classifier: the views need RGB");
+    const detail::PixelBox box = detail::object_box(view);
+    if (box.empty()) return std::vector<double>();
+    const int w = view.rgb.width(), h = view.rgb.height();
+    std::vector<std::uint8_t> painted = detail::rgb_on_background(view, kBackground);
+    const cv::Mat rgb(h, w, CV_8UC3, painted.data());
+    // A square about the object, a margin of 8 % a side, grey beyond the view.
+    const int side = static_cast<int>(std::lround(std::max(box.x2 - box.x1, box.y2 - box.y1) * 1.16)) + 1;
+    const int cx = (box.x1 + box.x2) / 2, cy = (box.y1 + box.y2) / 2;
+    cv::Mat square(side, side, CV_8UC3, cv::Scalar::all(kBackground));
+    const cv::Rect want(cx - side / 2, cy - side / 2, side, side);
+    const cv::Rect have = want & cv::Rect(0, 0, w, h);
+    rgb(have).copyTo(square(cv::Rect(have.x - want.x, have.y - want.y, have.width, have.height)));
+    cv::Mat scaled;
+    cv::resize(square, scaled, cv::Size(size_, size_), 0, 0, cv::INTER_AREA);
+    Result<std::vector<float>> scores = forward(scaled);
+    if (!scores.ok()) return scores.status();
+    if (scores->size() != labels_.size() + offset_)
+      return Status::Internal("classifier: the network's output changed size between views");
+    std::vector<double> p(scores->begin(), scores->end());
+    double sum = 0.0;
+    bool probabilities = true;
+    for (double x : p) {
+      probabilities = probabilities && x >= 0.0 && x <= 1.0;
+      sum += x;
+    }
+    if (!probabilities || std::abs(sum - 1.0) > 0.01) {  // logits: a softmax
+      const double top = *std::max_element(p.begin(), p.end());
+      sum = 0.0;
+      for (double& x : p) sum += (x = std::exp(x - top));
+    }
+    for (double& x : p) x /= sum;
+    return p;
+  }
+
+  static constexpr int kViews = 8;
+  static constexpr double kElevationDeg = 15.0;
+  static constexpr int kBackground = 128;
+
+  std::string model_path_, labels_path_;
+  int size_ = 224;
+  Normalization normalization_ = Normalization::kMinusOneToOne;
+  bool rgb_ = true;
+  double min_probability_ = 0.05;
+  mutable bool loaded_ = false;
+  mutable Status load_status_;
+  mutable std::vector<ClassLabel> labels_;
+  mutable std::size_t offset_ = 0;  // 1: the first score is a background class
+  mutable cv::dnn::Net net_;
+  mutable std::mutex mutex_;
+};
+
+}  // namespace
+
+std::unique_ptr<detail::OptionalIdentifier> detail::make_classifier_identifier() {
+  return std::make_unique<ClassifierIdentifier>();
+}
+
+}  // namespace g2p

@@ -172,28 +172,22 @@ class AutoIdentifier final : public Identifier {
       id.warnings.insert(id.warnings.end(), part.warnings.begin(), part.warnings.end());
     };
     join(*by_names);
-    if (use_detector_ && ((in.views != nullptr && !in.views->empty()) || in.renderer != nullptr)) {
-      Result<Identification> seen = detector_->identify(in);
+    // A source that reads the views: its answer joined, a failure a warning.
+    const bool has_views = (in.views != nullptr && !in.views->empty()) || in.renderer != nullptr;
+    auto look = [&](const Identifier& source, const char* who) {
+      Result<Identification> seen = source.identify(in);
       if (!seen.ok()) {
-        id.warnings.push_back("the detector failed (" + seen.status().message() + "); identified from names only");
-      } else {
-        if (seen->known() && by_names->known() && seen->kind() != by_names->kind())
-          id.notes.push_back("the names say " + by_names->kind() + " (" + percent(by_names->confidence()) +
-                             "), the detector " + seen->kind() + " (" + percent(seen->confidence()) + ")");
-        join(*seen);
+        id.warnings.push_back(std::string("the ") + who + " failed (" + seen.status().message() +
+                              "); identified without it");
+        return;
       }
-    }
-    if (classifier_->configured() && ((in.views != nullptr && !in.views->empty()) || in.renderer != nullptr)) {
-      Result<Identification> seen = classifier_->identify(in);
-      if (!seen.ok()) {
-        id.warnings.push_back("the classifier failed (" + seen.status().message() + "); identified without it");
-      } else {
-        if (seen->known() && by_names->known() && seen->kind() != by_names->kind())
-          id.notes.push_back("the names say " + by_names->kind() + " (" + percent(by_names->confidence()) +
-                             "), the classifier " + seen->kind() + " (" + percent(seen->confidence()) + ")");
-        join(*seen);
-      }
-    }
+      if (seen->known() && by_names->known() && seen->kind() != by_names->kind())
+        id.notes.push_back("the names say " + by_names->kind() + " (" + percent(by_names->confidence()) + "), the " +
+                           who + " " + seen->kind() + " (" + percent(seen->confidence()) + ")");
+      join(*seen);
+    };
+    if (use_detector_ && has_views) look(*detector_, "detector");
+    if (classifier_->configured() && has_views) look(*classifier_, "classifier");
     for (auto& [kind, g] : joined) id.candidates.push_back(std::move(g));
     std::stable_sort(id.candidates.begin(), id.candidates.end(),
                      [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });

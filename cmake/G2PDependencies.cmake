@@ -16,8 +16,23 @@ g2p_require(Eigen3_FOUND libeigen3-dev)
 find_package(assimp QUIET)
 g2p_require(assimp_FOUND libassimp-dev)
 
-find_package(OpenCV 4.6 QUIET COMPONENTS core imgproc imgcodecs dnn ml)
+# OpenCV for image processing and ONNX inference only: its imgcodecs module
+# would load some 90 more shared libraries at start (Debian builds it with
+# GDAL, poppler, HDF5, ...); images are read and written with the libraries
+# made for each format (libg2p/src/io/image_codecs.h).
+find_package(OpenCV 4.6 QUIET COMPONENTS core imgproc dnn ml)
 g2p_require(OpenCV_FOUND libopencv-dev)
+
+find_package(PNG QUIET)
+g2p_require(PNG_FOUND libpng-dev)
+find_package(JPEG QUIET)
+g2p_require(JPEG_FOUND libjpeg-dev)
+find_package(TIFF QUIET)
+g2p_require(TIFF_FOUND libtiff-dev)
+find_path(G2P_WEBP_INCLUDE webp/decode.h)
+find_library(G2P_WEBP_LIBRARY webp)
+g2p_require(G2P_WEBP_INCLUDE libwebp-dev)
+g2p_require(G2P_WEBP_LIBRARY libwebp-dev)
 
 find_package(embree 3 QUIET)
 g2p_require(embree_FOUND libembree-dev)

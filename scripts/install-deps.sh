@@ -19,7 +19,8 @@ done
 core=(
   build-essential cmake pkg-config ccache git
   libeigen3-dev libassimp-dev libembree-dev libtbb-dev
-  libopencv-dev libcgal-dev libgmp-dev libmpfr-dev
+  libopencv-dev libpng-dev libjpeg-dev libwebp-dev libtiff-dev
+  libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libcurl4-openssl-dev
   liburdfdom-dev libqhull-dev
 )

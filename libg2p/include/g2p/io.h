@@ -76,11 +76,11 @@ G2P_API Status write_mesh(const std::string& path, const Mesh& mesh);
 // or a positive number of metres per unit ("0.001").
 G2P_API Result<double> parse_unit(const std::string& unit);
 
-// Reads an image file (PNG, JPEG, ...) as 8-bit RGBA.
+// Reads an image file (PNG, JPEG, WebP, BMP or TIFF, told by its bytes) as 8-bit RGBA.
 G2P_API Result<ImageU8> read_image(const std::string& path);
 
 // Writes an 8-bit image with 1 (grey), 3 (RGB) or 4 (RGBA) channels; the
-// format follows the extension. Written to a temporary name and renamed, so an
+// format follows the extension: .png, .jpg or .jpeg (quality 95, no alpha), .bmp. Written to a temporary name and renamed, so an
 // existing file is never left half-overwritten.
 G2P_API Status write_image(const std::string& path, const ImageU8& image);
 

@@ -1,88 +1,75 @@
-// Image reading and writing through OpenCV's codecs. Images are exchanged as
-// 8-bit with 1, 3 or 4 channels in RGB(A) order; OpenCV's BGR order stays here.
+// Image reading and writing (io.h's read_image and write_image, and the
+// texture decoder behind the importers): the format is told by the bytes'
+// signature, not the file name, and each goes to its codec (image_codecs.h).
+// Images are exchanged as 8-bit RGBA when read; written from 1, 3 or 4 channels.
 #include "image_io.h"
 
+#include <cctype>
 #include <cstring>
 #include <filesystem>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <fstream>
+#include <sstream>
 
 #include "core/file_util.h"
 #include "g2p/io.h"
+#include "io/image_codecs.h"
 
 namespace g2p {
 namespace detail {
 namespace {
 
-// Converts any decoded cv::Mat (1-4 channels, 8 or 16 bit) to RGBA8, writing
-// straight into the returned image's storage (no intermediate copy: decoded
-// textures are up to 4096^2 and fresh memory is costly on virtual machines).
-ImageU8 to_rgba8(const cv::Mat& decoded) {
-  cv::Mat m = decoded;
-  if (m.depth() == CV_16U)
-    m.convertTo(m, CV_8U, 1.0 / 257.0);
-  else if (m.depth() != CV_8U)
-    m.convertTo(m, CV_8U, 255.0);
-  if (m.channels() > 4 || m.channels() == 2) cv::extractChannel(m, m, 0);
-  ImageU8 out(m.cols, m.rows, 4);
-  cv::Mat rgba(m.rows, m.cols, CV_8UC4, out.data());  // a view of `out`
-  switch (m.channels()) {
-    case 1: cv::cvtColor(m, rgba, cv::COLOR_GRAY2RGBA); break;
-    case 3: cv::cvtColor(m, rgba, cv::COLOR_BGR2RGBA); break;
-    default: cv::cvtColor(m, rgba, cv::COLOR_BGRA2RGBA); break;
-  }
-  return out;
+bool starts_with(const std::uint8_t* b, std::size_t size, const char* magic, std::size_t n) {
+  return size >= n && std::memcmp(b, magic, n) == 0;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
 }
 
 }  // namespace
 
-Result<ImageU8> decode_image_rgba(const void* bytes, std::size_t size) {
-  if (bytes == nullptr || size == 0) return Status::ParseError("empty image data");
-  try {
-    const cv::Mat buffer(1, static_cast<int>(size), CV_8U, const_cast<void*>(bytes));
-    const cv::Mat decoded = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
-    if (decoded.empty())
-      return Status::ParseError("image data (" + std::to_string(size) + " bytes) could not be decoded");
-    return to_rgba8(decoded);
-  } catch (const cv::Exception& e) {
-    return Status::ParseError(std::string("image decoder: ") + e.what());
-  }
+Status check_image_size(const char* format, long long width, long long height) {
+  if (width < 1 || height < 1 || width > 32768 || height > 32768 || width * height > (1ll << 28))
+    return Status::ParseError(std::string(format) + ": an image of " + std::to_string(width) + " x " +
+                              std::to_string(height) + " pixels (at most 32768 a side and 2^28 pixels are read)");
+  return Status::Ok();
 }
 
-Result<std::string> encode_png(const ImageU8& image) {
-  const int c = image.channels();
-  if (image.empty() || (c != 1 && c != 3 && c != 4)) return Status::InvalidArgument("encode_png: bad image");
-  try {
-    // A read-only view of the caller's pixels; the colour conversion writes a
-    // new matrix (converting into `src` itself would swap the caller's red
-    // and blue).
-    const cv::Mat src(image.height(), image.width(), CV_8UC(c), const_cast<std::uint8_t*>(image.data()));
-    cv::Mat bgr;
-    if (c == 1)
-      bgr = src;
-    else if (c == 3)
-      cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
-    else if (c == 4)
-      cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGRA);
-    std::vector<std::uint8_t> bytes;
-    if (!cv::imencode(".png", bgr, bytes)) return Status::Internal("encode_png: the PNG encoder failed");
-    return std::string(bytes.begin(), bytes.end());
-  } catch (const cv::Exception& e) {
-    return Status::Internal(std::string("encode_png: ") + e.what());
-  }
+Result<ImageU8> decode_image_rgba(const void* data, std::size_t size) {
+  if (data == nullptr || size == 0) return Status::ParseError("empty image data");
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  if (starts_with(b, size, "\x89PNG\r\n\x1a\n", 8)) return decode_png(b, size);
+  if (starts_with(b, size, "\xFF\xD8\xFF", 3)) return decode_jpeg(b, size);
+  if (starts_with(b, size, "RIFF", 4) && size >= 12 && std::memcmp(b + 8, "WEBP", 4) == 0) return decode_webp(b, size);
+  if (starts_with(b, size, "BM", 2)) return decode_bmp(b, size);
+  if (starts_with(b, size, "II*\0", 4) || starts_with(b, size, "MM\0*", 4)) return decode_tiff(b, size);
+  const char* named = starts_with(b, size, "\xABKTX 20\xBB", 8)     ? "KTX2"
+                      : starts_with(b, size, "DDS ", 4)             ? "DDS"
+                      : starts_with(b, size, "GIF8", 4)             ? "GIF"
+                      : starts_with(b, size, "\x76\x2F\x31\x01", 4) ? "OpenEXR"
+                      : starts_with(b, size, "#?RADIANCE", 10)      ? "Radiance HDR"
+                                                                    : nullptr;
+  const std::string what = std::string("image data (") + std::to_string(size) + " bytes) ";
+  if (named != nullptr)
+    return Status::Unsupported(what + "is " + named +
+                               ", which libg2p does not read (it reads PNG, JPEG, WebP, BMP "
+                               "and TIFF)");
+  return Status::ParseError(what + "is not an image libg2p reads (PNG, JPEG, WebP, BMP or TIFF)");
 }
+
+Result<std::string> encode_png(const ImageU8& image) { return encode_png_bytes(image); }
 
 Result<ImageU8> read_image_rgba(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return Status::NotFound(path + ": no such image file");
-  try {
-    const cv::Mat decoded = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (decoded.empty()) return Status::ParseError(path + ": not a readable image");
-    return to_rgba8(decoded);
-  } catch (const cv::Exception& e) {
-    return Status::ParseError(path + ": " + e.what());
-  }
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream bytes;
+  if (!in || !(bytes << in.rdbuf())) return Status::IoError(path + ": cannot read it");
+  const std::string data = bytes.str();
+  Result<ImageU8> image = decode_image_rgba(data.data(), data.size());
+  if (!image.ok()) return image.status().with_context(path);
+  return image;
 }
 
 }  // namespace detail
@@ -94,27 +81,16 @@ Status write_image(const std::string& path, const ImageU8& image) {
   const int c = image.channels();
   if (c != 1 && c != 3 && c != 4)
     return Status::InvalidArgument(path + ": cannot write an image with " + std::to_string(c) + " channels");
-  try {
-    const cv::Mat src(image.height(), image.width(), CV_8UC(c), const_cast<std::uint8_t*>(image.data()));
-    cv::Mat bgr;
-    if (c == 3)
-      cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
-    else if (c == 4)
-      cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGRA);
-    else
-      bgr = src;
-    // Encoded in memory, then written beside the target and renamed, so a
-    // failure never leaves half a file and its message is the system's.
-    const std::string extension = std::filesystem::path(path).extension().string();
-    std::vector<std::uint8_t> bytes;
-    if (extension.empty() || !cv::haveImageWriter(path))
-      return Status::InvalidArgument(path + ": unknown image extension '" + extension + "' (png, jpg, bmp, tiff)");
-    if (!cv::imencode(extension, bgr, bytes)) return Status::Internal(path + ": the image encoder failed");
-    return detail::write_file_atomically(path, std::string(bytes.begin(), bytes.end()));
-  } catch (const cv::Exception& e) {
-    return Status::IoError(path + ": " + e.what());
-  }
-  return Status::Ok();
+  // Encoded in memory, then written beside the target and renamed, so a
+  // failure never leaves half a file and its message is the system's.
+  const std::string extension = detail::lower(std::filesystem::path(path).extension().string());
+  if (extension != ".png" && extension != ".jpg" && extension != ".jpeg" && extension != ".bmp")
+    return Status::InvalidArgument(path + ": unknown image extension '" + extension + "' (png, jpg, bmp)");
+  const Result<std::string> bytes = extension == ".png"   ? detail::encode_png_bytes(image)
+                                    : extension == ".bmp" ? detail::encode_bmp(image)
+                                                          : detail::encode_jpeg(image);
+  if (!bytes.ok()) return bytes.status().with_context(path);
+  return detail::write_file_atomically(path, *bytes);
 }
 
 }  // namespace g2p

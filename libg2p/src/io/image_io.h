@@ -1,4 +1,4 @@
-// Private: image decoding for textures (OpenCV stays inside the library).
+// Private: image decoding for textures and image writing (image_codecs.h has the codecs).
 #pragma once
 
 #include <cstddef>
@@ -9,7 +9,7 @@
 
 namespace g2p::detail {
 
-// Decodes PNG/JPEG/... bytes to 8-bit RGBA.
+// Decodes PNG, JPEG, WebP, BMP or TIFF bytes (told by their signature) to 8-bit RGBA.
 Result<ImageU8> decode_image_rgba(const void* bytes, std::size_t size);
 
 // PNG bytes of an 8-bit image with 1, 3 (RGB) or 4 (RGBA) channels.

@@ -20,8 +20,8 @@ std::uint8_t channel(std::uint32_t pixel, std::uint32_t mask, std::uint8_t none)
   if (mask == 0) return none;
   int shift = 0;
   while (((mask >> shift) & 1u) == 0) ++shift;
-  const std::uint32_t max = mask >> shift;
-  return static_cast<std::uint8_t>((((pixel & mask) >> shift) * 255 + max / 2) / max);
+  const std::uint64_t max = mask >> shift;  // 64 bits: a 32-bit field times 255 overflows 32
+  return static_cast<std::uint8_t>((static_cast<std::uint64_t>((pixel & mask) >> shift) * 255 + max / 2) / max);
 }
 
 void put_u32(std::string& s, std::uint32_t v) {

@@ -80,8 +80,8 @@ G2P_API Result<double> parse_unit(const std::string& unit);
 G2P_API Result<ImageU8> read_image(const std::string& path);
 
 // Writes an 8-bit image with 1 (grey), 3 (RGB) or 4 (RGBA) channels; the
-// format follows the extension: .png, .jpg or .jpeg (quality 95, no alpha), .bmp. Written to a temporary name and renamed, so an
-// existing file is never left half-overwritten.
+// format follows the extension: .png, .jpg or .jpeg (quality 95, no alpha), .bmp. Written to a temporary name and
+// renamed, so an existing file is never left half-overwritten.
 G2P_API Status write_image(const std::string& path, const ImageU8& image);
 
 // Writes a text (or any byte) file under a temporary name and renames it, so

@@ -63,11 +63,14 @@ TEST(ToolSegment, WritesLabelMapsForEachBackend) {
 
 TEST(ToolSegment, BadSegmenterArguments) {
   const std::string hammer = quote(test::source_path("examples/data/hammer.obj"));
-  test::ToolRun r = run_tool("segment " + hammer + " -o /tmp/x --segmenter segformer");
+  // A folder of this test's own that does not exist yet (a fixed /tmp path failed wherever it did).
+  const std::string out = test::scratch_dir("ToolSegment.BadSegmenterArguments") + "/out";
+  test::ToolRun r = run_tool("segment " + hammer + " -o " + quote(out) + " --segmenter segformer");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("known: pbr, onnx, oracle"), std::string::npos) << r.err;
-  EXPECT_EQ(run_tool("segment " + hammer + " -o /tmp/x --set nonsense").exit_code, 2);
-  EXPECT_EQ(run_tool("segment " + hammer + " -o /tmp/x --segmenter onnx").exit_code, 2);  // no model card
+  EXPECT_EQ(run_tool("segment " + hammer + " -o " + quote(out) + " --set nonsense").exit_code, 2);
+  EXPECT_EQ(run_tool("segment " + hammer + " -o " + quote(out) + " --segmenter onnx").exit_code, 2);  // no model card
+  EXPECT_FALSE(std::filesystem::exists(out));  // usage errors write nothing
 }
 
 // A backend that degrades (`hybrid` without its network) says so in both

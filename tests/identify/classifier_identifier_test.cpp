@@ -1,6 +1,7 @@
 // The "classifier" identifier: an ImageNet classifier the user supplies
 // (../shared/models/imagenet-mobilenet-v2, for tests only), its classes mapped
-// to kinds through WordNet, alone and voting in `auto`.
+// to kinds through WordNet, alone and voting in `auto`; the shipped kind
+// classifier is tested in kind_classifier_test.cpp.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -59,10 +60,10 @@ TEST(ClassifierIdentifier, AnImageNetNetworkRecognisesAGeneratedChairWithoutName
       << words->identification.candidates.front().evidence;
 }
 
-TEST(ClassifierIdentifier, AutoJoinsItsVoteWithTheDetectorsOnlyWhenGiven) {
+TEST(ClassifierIdentifier, AutoJoinsTheUsersNetworkWithTheDetector) {
   G2P_SKIP_WITHOUT(kModel);
   G2P_SKIP_WITHOUT(kChair);
-  Result<PipelineResult> plain = identify_run("auto", {}, kChair);
+  Result<PipelineResult> plain = identify_run("auto", {{"classifier", "off"}}, kChair);
   Result<PipelineResult> with = identify_run("auto", {{"model", kModel}, {"labels", kWnids}}, kChair);
   ASSERT_TRUE(plain.ok() && with.ok());
   for (const KindGuess& g : plain->identification.candidates)
@@ -127,17 +128,19 @@ TEST(ClassifierIdentifier, SettingsAreCheckedBeforeAnyWork) {
   EXPECT_FALSE(make_identifier("classifier", {{"size", "8"}}).ok());
   EXPECT_FALSE(make_identifier("classifier", {{"min_probability", "1.5"}}).ok());
   EXPECT_FALSE(make_identifier("classifier", {{"normalization", "caffe"}}).ok());
-  // Without a network it says so and names nothing.
-  Result<std::unique_ptr<Identifier>> none = make_identifier("classifier");
-  ASSERT_TRUE(none.ok());
+  // Without views it says so and names nothing.
+  Result<std::unique_ptr<Identifier>> shipped = make_identifier("classifier");
+  ASSERT_TRUE(shipped.ok());
   IdentifyInput in;
-  Result<Identification> id = (*none)->identify(in);
+  Result<Identification> id = (*shipped)->identify(in);
   ASSERT_TRUE(id.ok());
   EXPECT_FALSE(id->known());
   ASSERT_FALSE(id->notes.empty());
-  EXPECT_NE(id->notes.front().find("model=PATH labels=PATH"), std::string::npos);
-  // `auto` takes the classifier's settings beside the detector's.
+  EXPECT_NE(id->notes.front().find("no rendered views"), std::string::npos);
+  // `auto` takes the classifier's settings beside the detector's, and can
+  // leave either out.
   EXPECT_TRUE(make_identifier("auto", {{"min_probability", "0.2"}, {"min_score", "0.4"}}).ok());
+  EXPECT_TRUE(make_identifier("auto", {{"classifier", "off"}, {"detector", "off"}}).ok());
 }
 
 }  // namespace

@@ -213,7 +213,8 @@ TEST(Identify, ANormalisedMeshTakesItsKindsSizeOnlyWhenConfidentAndAllowed) {
 
   PipelineOptions strict = o;
   strict.object.clear();
-  strict.anonymize_names = true;  // nothing names it; the detector is off
+  strict.anonymize_names = true;  // nothing names it; the detector and the kind classifier are off
+  strict.identifier = {"auto", {{"detector", "off"}, {"classifier", "off"}}};
   r = identify_run(strict, kBicycle);
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r->identification.known());

@@ -603,8 +603,9 @@ class ModelsAndStagesTest(unittest.TestCase):
         renderer = Wrapped()
         pipeline.set_renderer(renderer)
         r = pipeline.run_file(HAMMER)
-        # The 6 views, then the detector's 8 eye-level views of its own (identify), through the same renderer.
-        self.assertEqual(renderer.rendered, 6 + 8)
+        # The 6 views, then the detector's 8 eye-level views of its own and the kind classifier's 8 (identify),
+        # through the same renderer.
+        self.assertEqual(renderer.rendered, 6 + 8 + 8)
         self.assertEqual(sorted(p["class"] for p in r.parts), ["Metal", "Wood"])
 
     def test_options(self):

@@ -8,7 +8,8 @@ Each step is a module with a main(), run from anywhere as a script or, from the 
 The steps: attribution (the models a dataset used), train, soup (weights of sibling runs averaged), ensemble (runs
 joined into one ONNX model), quantize (int8 weights), export_detector (NanoDet-g's whole detector as its own ONNX
 file) with its reference decoder detect_objects, and the checks colour_baseline and check_tfjs_graph. The
-training set itself is rendered by g2p_make_dataset (make_dataset.cpp, built with the C++ tools).
+training set itself is rendered by g2p_make_dataset (make_dataset.cpp, built with the C++ tools). train_kinds
+trains the kind classifier on g2p_make_kind_dataset's renders (docs/kind-classifier.md).
 
 Imports go one way: a module imports only modules listed before it in LAYERS (tests/tools/training_imports_test.py
 checks it), so there is no cycle. Writing an export and reading one back sit below train, since train does both (it
@@ -42,4 +43,6 @@ LAYERS = (
     # trained runs joined into the network that ships
     "soup",
     "ensemble",
+    # the kind classifier (docs/kind-classifier.md): a head on the npm MobileNetV2, its ONNX file and card
+    "train_kinds",
 )

@@ -4,7 +4,7 @@
     python3 tools/training/attribution.py DATASET SH3D_DIR OUT.md
 
 DATASET is a g2p_make_dataset folder (its manifest.csv lists every image with its library, model and
-split); SH3D_DIR holds the unpacked libraries of Debian's sweethome3d-furniture package, each with its
+split) or a g2p_make_kind_dataset folder (views.csv: the kind classifier's renders, splits train and val); SH3D_DIR holds the unpacked libraries of Debian's sweethome3d-furniture package, each with its
 PluginFurnitureCatalog.properties (name#N, model#N, creator#N). The licences are those of the package's
 debian/copyright: BlendSwap-CC-0 CC0, BlendSwap-CC-BY and Scopia CC-BY 3.0, KatorLegaz and Reallusion
 CC-BY 3.0 US.
@@ -40,16 +40,24 @@ def main():
         sys.exit(__doc__)
     dataset, sh3d, out = sys.argv[1:]
     used = {}
-    with open(os.path.join(dataset, "manifest.csv")) as f:
+    kinds = os.path.exists(os.path.join(dataset, "views.csv"))
+    with open(os.path.join(dataset, "views.csv" if kinds else "manifest.csv"), encoding="utf-8") as f:
         for row in csv.DictReader(f):
-            used.setdefault((row["split"], row["library"], row["model"]), 0)
-            used[(row["split"], row["library"], row["model"])] += 1
+            library = row["model"].split("/", 1)[0] if kinds else row["library"]
+            used.setdefault((row["split"], library, row["model"]), 0)
+            used[(row["split"], library, row["model"])] += 1
     catalogs = {}
-    lines = ["# Models the segmentation network saw", "",
-             "Rendered from Debian's `sweethome3d-furniture` package (1.8-1) by `g2p_make_dataset`",
-             "(docs/training.md). The network was trained on the `train` split only; the `test` split is the",
-             "held-out evaluation set. Licences per library as in the package's debian/copyright.", ""]
-    for split in ("train", "test"):
+    if kinds:
+        lines = ["# Models the kind classifier saw", "",
+                 "Rendered from Debian's `sweethome3d-furniture` package (1.8-1) by `g2p_make_kind_dataset`",
+                 "(docs/kind-classifier.md). The classifier's head was trained on the `train` split only; the `val`",
+                 "split chose among candidates. Licences per library as in the package's debian/copyright.", ""]
+    else:
+        lines = ["# Models the segmentation network saw", "",
+                 "Rendered from Debian's `sweethome3d-furniture` package (1.8-1) by `g2p_make_dataset`",
+                 "(docs/training.md). The network was trained on the `train` split only; the `test` split is the",
+                 "held-out evaluation set. Licences per library as in the package's debian/copyright.", ""]
+    for split in ("train", "val") if kinds else ("train", "test"):
         lines += [f"## {split}", "", "| library | licence | model | name | creator | images |", "|---|---|---|---|---|---|"]
         for (s, library, model), images in sorted(used.items()):
             if s != split:

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -37,6 +38,13 @@ inline Eigen::Vector3f mean_linear_colour(const Texture& texture) {
     }
   if (!(weight > 0)) return Eigen::Vector3f::Ones();
   return (sum / weight).cast<float>();
+}
+
+// The mesh turned by `yaw` radians about the up axis (+Z), normals with it.
+inline void turn(Mesh& mesh, double yaw) {
+  const Eigen::Matrix3f r = Eigen::AngleAxisf(static_cast<float>(yaw), Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  for (Eigen::Vector3f& p : mesh.positions) p = r * p;
+  for (Eigen::Vector3f& n : mesh.normals) n = r * n;
 }
 
 // SplitMix64 (Steele, Lea & Flood 2014): a well-mixed 64-bit hash step.

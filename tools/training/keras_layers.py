@@ -136,8 +136,9 @@ class LayersModel(nn.Module):
                 kernel = self.params[key + "__kernel"]
                 stride, dilation = tuple(cfg.get("strides", (1, 1))), tuple(cfg.get("dilation_rate", (1, 1)))
                 if cfg.get("padding", "valid") == "same":
-                    top, bottom = _same_padding(v.shape[2], kernel.shape[2], stride[0], dilation[0])
-                    left, right = _same_padding(v.shape[3], kernel.shape[3], stride[1], dilation[1])
+                    # Plain ints, so that an ONNX export pads by constants (OpenCV's importer needs them).
+                    top, bottom = _same_padding(int(v.shape[2]), kernel.shape[2], stride[0], dilation[0])
+                    left, right = _same_padding(int(v.shape[3]), kernel.shape[3], stride[1], dilation[1])
                     if top or bottom or left or right:
                         v = F.pad(v, (left, right, top, bottom))
                 bias = self.params[key + "__bias"] if key + "__bias" in self.params else None

@@ -93,12 +93,6 @@ int label_material(const g2p::SourceMaterial& m, const std::string& model_key, c
 }
 
 // Turns the model about +Z by `yaw` radians (positions and normals).
-void turn(g2p::Mesh& mesh, double yaw) {
-  const Eigen::Matrix3f r = Eigen::AngleAxisf(static_cast<float>(yaw), Eigen::Vector3f::UnitZ()).toRotationMatrix();
-  for (Eigen::Vector3f& p : mesh.positions) p = r * p;
-  for (Eigen::Vector3f& n : mesh.normals) n = r * n;
-}
-
 struct Args {
   std::string out;
   std::vector<std::string> libraries;
@@ -266,7 +260,7 @@ int run(const Args& a) {
       // Lights likewise: jittered studio lights per view on a share of models.
       std::mt19937_64 light_rng(g2p::training::splitmix64(a.seed + 1) ^ g2p::training::fnv1a(key));
       const bool relit = u(light_rng) < a.random_lights;
-      turn(model.mesh, 2 * M_PI * u(rng));
+      g2p::training::turn(model.mesh, 2 * M_PI * u(rng));
       g2p::ViewOptions vo;
       vo.layout = g2p::ViewLayout::kFibonacci;
       vo.num_views = 24;

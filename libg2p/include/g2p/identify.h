@@ -163,8 +163,8 @@ class G2P_API Identifier {
 
 // Backends by name. libg2p registers:
 //   "auto"     (the default) the user's words when given, which win; else the
-//              names and the detector together (and the classifier when
-//              given), conflicts noted;
+//              names, the detector and the classifier together (settings
+//              detector, classifier = on|off), conflicts noted;
 //   "object"   the user's words only (IdentifyInput::object_text);
 //   "names"    the file, node, mesh and material names, matched through the
 //              table's WordNet terms;
@@ -172,11 +172,12 @@ class G2P_API Identifier {
 //              g2p-objects-nanodet.onnx; settings model_card, min_score,
 //              min_iou, views = turntable (its own eye-level views, with a
 //              renderer) or given (IdentifyInput::views));
-//   "classifier" an ONNX image classifier the user supplies (settings model,
-//              labels: its classes as WordNet ids or words, mapped to kinds
-//              through WordNet; size, normalization, channels,
-//              min_probability); nothing ships for it, and `auto` takes its
-//              settings and joins its answer once model and labels are set;
+//   "classifier" the shipped kind classifier (g2p-kinds.onnx and its card,
+//              docs/kind-classifier.md; calibrated confidences), or an ONNX
+//              image classifier the user supplies (settings model, labels:
+//              its classes as WordNet ids or words, mapped to kinds through
+//              WordNet; size, normalization, channels, min_probability);
+//              `auto` takes its settings;
 //   "vlm"      a vision-language model asked to name the object (docs/vlm.md);
 //   "none"     always unknown (the behaviour before identification).
 G2P_API Registry<Identifier>& identifier_registry();
@@ -257,6 +258,29 @@ G2P_API std::vector<float> kind_class_prior(const ObjectKind& kind, const Materi
 // `size_assumed_m` > 0: the longest side the run gave the mesh.
 G2P_API std::string identification_json(const Identification& id, const ObjectTable& table,
                                         double size_assumed_m = 0.0);
+
+// How an image classifier sees an object: the views of the `classifier`
+// identifier, and the renders the shipped kind classifier was trained on
+// (tools/training/make_kind_dataset.cpp), so that both see alike.
+struct ClassifierViewOptions {
+  int size = 224;                   // pixels: the square side the network takes
+  int count = 8;                    // views around the object (a turntable)
+  double elevation_deg = 15.0;      // degrees above the object's middle: eye level, as photographs are taken
+  int background = 128;             // grey (0-255) wherever the object is not
+  std::vector<CameraLight> lights;  // the views' lights; empty = studio_lights()
+};
+
+// The classifier's inputs: `count` turntable views rendered at twice `size`,
+// each cropped by classifier_crop(). Views that do not show the object are
+// left out (the result may be empty).
+G2P_API Result<std::vector<ImageU8>> classifier_views(const Renderer& renderer, const Mesh& mesh,
+                                                      const ClassifierViewOptions& options = {});
+
+// One view as a classifier takes it: a square about the object's pixels (its
+// face IDs) with a margin of 8 % a side, grey `background` wherever the object
+// is not, scaled to size x size RGB by area averaging. An empty image when the
+// view does not show the object; the whole view when it has no face IDs.
+G2P_API ImageU8 classifier_crop(const View& view, int size, int background);
 
 // The table's kinds (`g2p identify --list --json`): [{"name", "group", "coco",
 // "typical_longest_side_m", "mass_kg": [lo, hi], "structure"}, ...], indented.

@@ -11,26 +11,20 @@
 
 namespace g2p::detail {
 
-// An identifier that has nothing to say until the user sets it up (the
-// classifier without a network): `auto` asks it only when configured().
-class OptionalIdentifier : public Identifier {
- public:
-  virtual bool configured() const = 0;
-};
-
-std::unique_ptr<Identifier> make_detector_identifier();            // detector_identifier.cpp
-std::unique_ptr<OptionalIdentifier> make_classifier_identifier();  // classifier_identifier.cpp
-std::unique_ptr<Identifier> make_vlm_identifier();                 // vlm_identifier.cpp
+std::unique_ptr<Identifier> make_detector_identifier();    // detector_identifier.cpp
+std::unique_ptr<Identifier> make_classifier_identifier();  // classifier_identifier.cpp
+std::unique_ptr<Identifier> make_vlm_identifier();         // vlm_identifier.cpp
 
 // identify_views.cpp: views for networks trained on photographs.
 //
 // `count` views around the object from `elevation_deg` above its middle (eye
 // level: photographs of objects are taken from about there, and views from
 // straight above or below are hard to read), width x height pixels, on a
-// background of grey `background` (0-255; -1 = the renderer's). `who` names
-// the backend in errors.
+// background of grey `background` (0-255; -1 = the renderer's), lit by
+// `lights` (empty = studio_lights()). `who` names the backend in errors.
 Result<std::vector<View>> turntable_views(const Renderer& renderer, const Mesh& mesh, int width, int height,
-                                          int background, int count, double elevation_deg, const char* who);
+                                          int background, int count, double elevation_deg, const char* who,
+                                          const std::vector<CameraLight>& lights = {});
 
 // The box of the object's pixels in a view (its face IDs), {x1, y1, x2, y2}
 // with x2, y2 one past the last pixel; the whole view when it has no face

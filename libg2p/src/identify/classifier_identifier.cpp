@@ -1,9 +1,11 @@
-// The "classifier" identifier: an image classifier the user supplies (an
-// ONNX file that OpenCV's dnn module reads: an ImageNet network, a domain
-// model), run on views of the object, its classes mapped to the object
-// table's kinds through WordNet. Nothing is shipped for it and nothing
-// defaults to it: with `auto` it votes beside the names and the detector once
-// `model` and `labels` are set (`g2p run --identify-set model=PATH labels=PATH`).
+// The "classifier" identifier: an image classifier run on views of the
+// object, its classes mapped to the object table's kinds. By default the
+// shipped kind classifier (g2p-kinds.json and the files it names: a network
+// trained here on rendered furniture libraries, docs/kind-classifier.md);
+// else any ONNX image classifier the user points it at (an ImageNet network,
+// a domain model: `--identify-set model=PATH labels=PATH`, classes mapped
+// through WordNet). With `auto` it votes beside the names and the detector
+// (`--identify-set classifier=off` leaves it out).
 //
 // The labels file names the network's classes in output order: a JSON array
 // of strings or one line each. A class is a WordNet 3.0 noun id ("n03376595",
@@ -17,7 +19,8 @@
 //
 // Per view the scores become probabilities (a softmax, unless they already
 // are) and a kind's probability is the sum over its classes; a kind's
-// confidence is the mean over the views. The views are the detector's: eight
+// confidence is the mean over the views, mapped by the shipped card's
+// calibration (Platt scaling fitted when it was trained) where it has one. The views are the detector's: eight
 // of its own at eye level with a renderer, else those given; each is cropped
 // to a square about the object's pixels (photographs are framed on the
 // object) on a plain grey, then scaled to the network's input.
@@ -33,6 +36,7 @@
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/model_files.h"
 #include "core/settings.h"
 #include "identify/backends.h"
 
@@ -135,17 +139,71 @@ int kind_of(const ClassLabel& l, const ObjectTable& table) {
   return -1;
 }
 
+constexpr const char* kShippedCard = "g2p-kinds.json";
+
+// What the shipped card says of its network (tools/training/train_kinds.py
+// writes it): the files, relative to the card, and the input.
+struct ClassifierCard {
+  std::string model, labels;
+  int size = 224;
+  Normalization normalization = Normalization::kMinusOneToOne;
+  bool rgb = true;
+  double platt_a = 1.0, platt_b = 0.0;  // confidence = sigmoid(a logit(p) + b); 1, 0 = p itself
+};
+
+Result<ClassifierCard> read_card(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path + ": cannot open the kind classifier's card");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const nlohmann::json doc = nlohmann::json::parse(ss.str(), nullptr, /*allow_exceptions=*/false);
+  auto bad = [&](const std::string& what) { return Status::ParseError(path + ": " + what); };
+  if (doc.is_discarded() || !doc.is_object()) return bad("not valid JSON");
+  ClassifierCard c;
+  try {
+    if (doc.value("format", std::string()) != "g2p-kind-classifier-card" || doc.value("version", 0) != 1)
+      return bad("'format' must be \"g2p-kind-classifier-card\", 'version' 1");
+    const std::string dir = path.substr(0, path.find_last_of('/') + 1);
+    c.model = dir + doc.at("model").get<std::string>();
+    c.labels = dir + doc.at("labels").get<std::string>();
+    const nlohmann::json& input = doc.at("input");
+    c.size = input.at("shape").at(2).get<int>();
+    if (input.at("shape").at(3).get<int>() != c.size) return bad("input.shape must be square");
+    const std::string norm = input.at("normalization").get<std::string>();
+    if (norm == "minus-one-to-one") {
+      c.normalization = Normalization::kMinusOneToOne;
+    } else if (norm == "imagenet") {
+      c.normalization = Normalization::kImageNet;
+    } else if (norm == "zero-to-one") {
+      c.normalization = Normalization::kZeroToOne;
+    } else {
+      return bad("input.normalization '" + norm + "' is not minus-one-to-one, imagenet or zero-to-one");
+    }
+    c.rgb = input.value("channel_order", std::string("RGB")) == "RGB";
+    if (doc.contains("calibration")) {
+      const nlohmann::json& platt = doc.at("calibration").at("platt");
+      c.platt_a = platt.at(0).get<double>(), c.platt_b = platt.at(1).get<double>();
+      if (!std::isfinite(c.platt_a) || !std::isfinite(c.platt_b) || c.platt_a <= 0.0)
+        return bad("calibration.platt must be two finite numbers, the first > 0");
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return bad(std::string("missing or wrong field (") + e.what() + ")");
+  }
+  return c;
+}
+
 std::string percent(double x) {
   char b[16];
   std::snprintf(b, sizeof b, "%.0f %%", 100.0 * x);
   return b;
 }
 
-class ClassifierIdentifier final : public detail::OptionalIdentifier {
+class ClassifierIdentifier final : public Identifier {
  public:
   SettingsSpec settings() override {
     return SettingsSpec("classifier")
-        .file("model", model_path_, "an ONNX image classifier (OpenCV's dnn reads it); \"\" = none")
+        .file("model", model_path_,
+              "an ONNX image classifier (OpenCV's dnn reads it); \"\" = the shipped kind classifier")
         .file("labels", labels_path_,
               "its classes in output order, one a line or a JSON array: WordNet ids (n03376595), words, or both")
         .integer("size", size_, 32, 1024, "pixels", "the network's square input side")
@@ -158,23 +216,17 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
         .number("min_probability", min_probability_, Range::closed(0, 1), "",
                 "the least mean probability over the views for a kind to be a candidate")
         .check([this] {
-          if (model_path_.empty() != labels_path_.empty())
+          if (user_model() != !labels_path_.empty())
             return Status::InvalidArgument(
                 "classifier: model and labels go together (--identify-set model=PATH "
-                "labels=PATH)");
+                "labels=PATH); without them the shipped kind classifier runs");
           loaded_ = false;  // read again, with these settings, at the next identify
           return Status::Ok();
         });
   }
 
-  bool configured() const override { return !model_path_.empty(); }
-
   Result<Identification> identify(const IdentifyInput& in) const override {
     Identification id;
-    if (!configured()) {
-      id.notes.push_back("classifier: no network given (--identify-set model=PATH labels=PATH)");
-      return id;
-    }
     const bool can_render = in.renderer != nullptr && in.model != nullptr;
     if (!can_render && (in.views == nullptr || in.views->empty())) {
       id.notes.push_back("classifier: no rendered views");
@@ -186,24 +238,33 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
       return id;
     }
     const ObjectTable& table = in.table != nullptr ? *in.table : ObjectTable::shipped();
-    std::vector<View> own;
+    std::vector<ImageU8> inputs;  // the network's inputs, one a view that shows the object
     if (can_render) {
-      Result<std::vector<View>> rendered = detail::turntable_views(*in.renderer, in.model->mesh, 2 * size_, 2 * size_,
-                                                                   kBackground, kViews, kElevationDeg, "classifier");
-      if (!rendered.ok()) return rendered.status();
-      own = std::move(*rendered);
+      ClassifierViewOptions o;
+      o.size = input_size_;
+      o.count = kViews;
+      o.elevation_deg = kElevationDeg;
+      o.background = kBackground;
+      Result<std::vector<ImageU8>> rendered = classifier_views(*in.renderer, in.model->mesh, o);
+      if (!rendered.ok()) return rendered.status().with_context("classifier");
+      inputs = std::move(*rendered);
+    } else {
+      for (const View& view : *in.views) {
+        if (view.rgb.empty() || view.rgb.channels() != 3)
+          return Status::InvalidArgument("classifier: the views need RGB");
+        ImageU8 crop = classifier_crop(view, input_size_, kBackground);
+        if (!crop.empty()) inputs.push_back(std::move(crop));
+      }
     }
-    const std::vector<View>& views = own.empty() ? *in.views : own;
     std::vector<int> kinds(labels_.size());
     for (std::size_t c = 0; c < labels_.size(); ++c) kinds[c] = kind_of(labels_[c], table);
     std::map<int, double> kind_sum;                   // kind -> summed probability over views
     std::map<int, std::map<std::size_t, double>> by;  // kind -> class -> summed probability
     std::map<std::size_t, double> unmapped;           // class -> summed probability, classes naming no kind
     int seen = 0;
-    for (const View& view : views) {
-      Result<std::vector<double>> p = probabilities(view);
+    for (const ImageU8& input : inputs) {
+      Result<std::vector<double>> p = probabilities(input);
       if (!p.ok()) return p.status();
-      if (p->empty()) continue;
       ++seen;
       for (std::size_t c = 0; c < labels_.size(); ++c) {
         const double x = (*p)[c + offset_];
@@ -220,14 +281,14 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
       return id;
     }
     for (const auto& [kind, sum] : kind_sum) {
-      const double confidence = sum / seen;
+      const double confidence = calibrated(sum / seen);
       if (confidence < min_probability_ || confidence <= 0.0) continue;
       std::vector<std::pair<double, std::size_t>> classes;
       for (const auto& [c, x] : by[kind]) classes.emplace_back(x, c);
       std::sort(classes.begin(), classes.end(), std::greater<>());
       std::string evidence = "'" + labels_[classes.front().second].text + "'";
       if (classes.size() > 1) evidence += " and " + std::to_string(classes.size() - 1) + " more of its classes";
-      evidence += ", " + percent(confidence) + " over " + std::to_string(seen) + " views";
+      evidence += ", " + percent(sum / seen) + " over " + std::to_string(seen) + " views";
       id.candidates.push_back({table.kinds()[static_cast<std::size_t>(kind)].name, confidence, "classifier", evidence});
     }
     std::stable_sort(id.candidates.begin(), id.candidates.end(),
@@ -246,20 +307,36 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
   Status load() const {
     if (loaded_) return load_status_;
     loaded_ = true;
-    Result<std::vector<ClassLabel>> labels = read_labels(labels_path_);
+    model_file_ = model_path_, labels_file_ = labels_path_;
+    input_size_ = size_, input_normalization_ = normalization_, input_rgb_ = rgb_;
+    platt_a_ = 1.0, platt_b_ = 0.0;
+    if (!user_model()) {
+      const std::string card = detail::shipped_model_file(kShippedCard);
+      if (card.empty())
+        return load_status_ = Status::NotFound(std::string(kShippedCard) +
+                                               " was not found in $G2P_MODEL_DIR, libg2p/data/models or "
+                                               "share/g2p/models");
+      Result<ClassifierCard> c = read_card(card);
+      if (!c.ok()) return load_status_ = c.status();
+      model_file_ = c->model, labels_file_ = c->labels;
+      input_size_ = c->size, input_normalization_ = c->normalization, input_rgb_ = c->rgb;
+      platt_a_ = c->platt_a, platt_b_ = c->platt_b;
+    }
+    Result<std::vector<ClassLabel>> labels = read_labels(labels_file_);
     if (!labels.ok()) return load_status_ = labels.status();
     labels_ = std::move(*labels);
     try {
-      net_ = cv::dnn::readNet(model_path_);
+      net_ = cv::dnn::readNet(model_file_);
       net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
       net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
     } catch (const cv::Exception& e) {
-      return load_status_ = Status::IoError("model=" + model_path_ + ": OpenCV could not load it (" + e.what() + ")");
+      return load_status_ = Status::IoError(model_name() + ": OpenCV could not load it (" + e.what() + ")");
     }
-    if (net_.empty()) return load_status_ = Status::IoError("model=" + model_path_ + ": OpenCV could not load it");
+    if (net_.empty()) return load_status_ = Status::IoError(model_name() + ": OpenCV could not load it");
     // The number of scores, from a grey image: as many as labels, or one more
     // (a leading background class).
-    Result<std::vector<float>> scores = forward(cv::Mat(size_, size_, CV_8UC3, cv::Scalar::all(kBackground)));
+    Result<std::vector<float>> scores =
+        forward(cv::Mat(input_size_, input_size_, CV_8UC3, cv::Scalar::all(kBackground)));
     if (!scores.ok()) return load_status_ = scores.status();
     if (scores->size() == labels_.size()) {
       offset_ = 0;
@@ -267,22 +344,22 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
       offset_ = 1;
     } else {
       return load_status_ = Status::InvalidArgument(
-                 "model=" + model_path_ + " gives " + std::to_string(scores->size()) +
-                 " scores but labels=" + labels_path_ + " names " + std::to_string(labels_.size()) +
+                 model_name() + " gives " + std::to_string(scores->size()) + " scores but " + labels_name() +
+                 " names " + std::to_string(labels_.size()) +
                  " classes (as many are needed, or one fewer when the first score is a background class)");
     }
     return load_status_ = Status::Ok();
   }
 
-  // The network's scores for an RGB image of size_ x size_.
+  // The network's scores for an RGB image of input_size_ x input_size_.
   Result<std::vector<float>> forward(const cv::Mat& rgb) const {
     cv::Mat input;
-    if (!rgb_)
+    if (!input_rgb_)
       cv::cvtColor(rgb, input, cv::COLOR_RGB2BGR);
     else
       input = rgb;
     cv::Mat blob;
-    switch (normalization_) {
+    switch (input_normalization_) {
       case Normalization::kMinusOneToOne:
         blob = cv::dnn::blobFromImage(input, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), false, false);
         break;
@@ -297,7 +374,7 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
         std::vector<cv::Mat> planes;
         cv::split(f, planes);
         for (int c = 0; c < 3; ++c) {
-          const int k = rgb_ ? c : 2 - c;
+          const int k = input_rgb_ ? c : 2 - c;
           planes[static_cast<std::size_t>(c)] = (planes[static_cast<std::size_t>(c)] - mean[k]) / std[k];
         }
         cv::merge(planes, f);
@@ -310,7 +387,7 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
       net_.setInput(blob);
       out = net_.forward();
     } catch (const cv::Exception& e) {
-      return Status::Internal(std::string("classifier: inference failed (is size=") + std::to_string(size_) +
+      return Status::Internal(std::string("classifier: inference failed (is size=") + std::to_string(input_size_) +
                               " its input side?): " + e.what());
     }
     const cv::Mat flat = out.reshape(1, 1);
@@ -318,24 +395,10 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
     return scores;
   }
 
-  // The view's class probabilities (with the background score, if any, first);
-  // empty when the view shows nothing of the object.
-  Result<std::vector<double>> probabilities(const View& view) const {
-    if (view.rgb.empty() || view.rgb.channels() != 3) return Status::InvalidArgument("classifier: the views need RGB");
-    const detail::PixelBox box = detail::object_box(view);
-    if (box.empty()) return std::vector<double>();
-    const int w = view.rgb.width(), h = view.rgb.height();
-    std::vector<std::uint8_t> painted = detail::rgb_on_background(view, kBackground);
-    const cv::Mat rgb(h, w, CV_8UC3, painted.data());
-    // A square about the object, a margin of 8 % a side, grey beyond the view.
-    const int side = static_cast<int>(std::lround(std::max(box.x2 - box.x1, box.y2 - box.y1) * 1.16)) + 1;
-    const int cx = (box.x1 + box.x2) / 2, cy = (box.y1 + box.y2) / 2;
-    cv::Mat square(side, side, CV_8UC3, cv::Scalar::all(kBackground));
-    const cv::Rect want(cx - side / 2, cy - side / 2, side, side);
-    const cv::Rect have = want & cv::Rect(0, 0, w, h);
-    rgb(have).copyTo(square(cv::Rect(have.x - want.x, have.y - want.y, have.width, have.height)));
-    cv::Mat scaled;
-    cv::resize(square, scaled, cv::Size(size_, size_), 0, 0, cv::INTER_AREA);
+  // The network's class probabilities for one input (classifier_crop()),
+  // with the background score, if any, first.
+  Result<std::vector<double>> probabilities(const ImageU8& input) const {
+    const cv::Mat scaled(input.height(), input.width(), CV_8UC3, const_cast<std::uint8_t*>(input.data()));
     Result<std::vector<float>> scores = forward(scaled);
     if (!scores.ok()) return scores.status();
     if (scores->size() != labels_.size() + offset_)
@@ -360,11 +423,29 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
   static constexpr double kElevationDeg = 15.0;
   static constexpr int kBackground = 128;
 
+  bool user_model() const { return !model_path_.empty(); }
+  std::string model_name() const { return user_model() ? "model=" + model_file_ : model_file_; }
+  std::string labels_name() const { return user_model() ? "labels=" + labels_file_ : labels_file_; }
+
   std::string model_path_, labels_path_;
   int size_ = 224;
   Normalization normalization_ = Normalization::kMinusOneToOne;
   bool rgb_ = true;
   double min_probability_ = 0.05;
+  // What load() read: the user's files and settings, or the shipped card's.
+  mutable std::string model_file_, labels_file_;
+  mutable int input_size_ = 224;
+  mutable Normalization input_normalization_ = Normalization::kMinusOneToOne;
+  mutable bool input_rgb_ = true;
+  mutable double platt_a_ = 1.0, platt_b_ = 0.0;
+
+  // A kind's mean probability over the views as the confidence the card's
+  // calibration makes of it (how often a top kind that sure was right).
+  double calibrated(double p) const {
+    if (platt_a_ == 1.0 && platt_b_ == 0.0) return p;
+    const double q = std::clamp(p, 1e-6, 1.0 - 1e-6);
+    return 1.0 / (1.0 + std::exp(-(platt_a_ * std::log(q / (1.0 - q)) + platt_b_)));
+  }
   mutable bool loaded_ = false;
   mutable Status load_status_;
   mutable std::vector<ClassLabel> labels_;
@@ -375,8 +456,6 @@ class ClassifierIdentifier final : public detail::OptionalIdentifier {
 
 }  // namespace
 
-std::unique_ptr<detail::OptionalIdentifier> detail::make_classifier_identifier() {
-  return std::make_unique<ClassifierIdentifier>();
-}
+std::unique_ptr<Identifier> detail::make_classifier_identifier() { return std::make_unique<ClassifierIdentifier>(); }
 
 }  // namespace g2p

@@ -128,9 +128,9 @@ class NamesIdentifier final : public Identifier {
 };
 
 // "auto": the user's words win when given (the names are compared with them
-// and a disagreement is noted); else the names, the detector and, when the
-// user gave one, the classifier, each kind's confidences joined as
-// independent evidence, 1 - (1 - a)(1 - b).
+// and a disagreement is noted); else the names, the detector and the kind
+// classifier (the shipped one, or the user's), each kind's confidences joined
+// as independent evidence, 1 - (1 - a)(1 - b).
 class AutoIdentifier final : public Identifier {
  public:
   AutoIdentifier()
@@ -141,6 +141,7 @@ class AutoIdentifier final : public Identifier {
   SettingsSpec settings() override {
     return SettingsSpec("auto")
         .flag("detector", use_detector_, "join the detector's answer with the names'")
+        .flag("classifier", use_classifier_, "join the kind classifier's answer (the shipped one, or model=PATH)")
         .include(detector_->settings())
         .include(classifier_->settings());
   }
@@ -187,7 +188,7 @@ class AutoIdentifier final : public Identifier {
       join(*seen);
     };
     if (use_detector_ && has_views) look(*detector_, "detector");
-    if (classifier_->configured() && has_views) look(*classifier_, "classifier");
+    if (use_classifier_ && has_views) look(*classifier_, "classifier");
     for (auto& [kind, g] : joined) id.candidates.push_back(std::move(g));
     std::stable_sort(id.candidates.begin(), id.candidates.end(),
                      [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });
@@ -197,8 +198,9 @@ class AutoIdentifier final : public Identifier {
  private:
   std::unique_ptr<Identifier> names_;
   std::unique_ptr<Identifier> detector_;
-  std::unique_ptr<detail::OptionalIdentifier> classifier_;
+  std::unique_ptr<Identifier> classifier_;
   bool use_detector_ = true;
+  bool use_classifier_ = true;
 };
 
 }  // namespace
@@ -210,7 +212,7 @@ Registry<Identifier>& identifier_registry() {
     (void)r->add("object", [] { return std::unique_ptr<Identifier>(std::make_unique<ObjectIdentifier>()); });
     (void)r->add("names", [] { return std::unique_ptr<Identifier>(std::make_unique<NamesIdentifier>()); });
     (void)r->add("detector", &detail::make_detector_identifier);
-    (void)r->add("classifier", [] { return std::unique_ptr<Identifier>(detail::make_classifier_identifier()); });
+    (void)r->add("classifier", &detail::make_classifier_identifier);
     (void)r->add("vlm", [] { return detail::make_vlm_identifier(); });
     (void)r->add("none", [] { return std::unique_ptr<Identifier>(std::make_unique<NoIdentifier>()); });
     return r;

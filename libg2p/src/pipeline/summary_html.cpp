@@ -140,12 +140,23 @@ std::string article(const std::string& noun) {
 void object_line(std::ostringstream& h, const PipelineResult& r, double kind_confidence) {
   const Identification& id = r.identification;
   h << "<p id=\"g2p-object\">What it is: ";
+  // The runners-up, as `g2p identify` lists them: "chair (40 %), bench (12 %)".
+  auto others = [&](std::size_t from, std::size_t count) {
+    std::string list;
+    for (std::size_t i = from; i < id.candidates.size() && i < from + count; ++i)
+      list += (list.empty() ? "" : ", ") + escape(id.candidates[i].kind) + " (" +
+              number(100.0 * id.candidates[i].confidence, "%.0f") + " %)";
+    return list;
+  };
   if (!id.known()) {
-    h << "<b>unknown</b> (give it with <code>g2p run --object</code> to check its mass against its kind)</p>\n";
+    h << "<b>unknown</b>";
+    if (!id.candidates.empty()) h << "; the likeliest kinds were " << others(0, 3);
+    h << " (give it with <code>g2p run --object</code> to check its mass against its kind)</p>\n";
     return;
   }
   h << "<b>" << escape(id.kind()) << "</b> (from " << escape(id.source()) << ", "
     << number(100.0 * id.confidence(), "%.0f") << " % confident: " << escape(id.candidates.front().evidence) << ")";
+  if (id.candidates.size() > 1) h << "; else perhaps " << others(1, 2);
   if (!r.kind.name.empty())
     h << "; " << escape(article(r.kind.name)) << " usually weighs " << number(r.kind.mass_kg[0]) << " to "
       << number(r.kind.mass_kg[1]) << " kg";

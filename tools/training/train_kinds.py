@@ -1,0 +1,352 @@
+"""Trains the kind classifier (docs/kind-classifier.md): a linear head over an ImageNet MobileNetV2's pooled
+features, on the renders of g2p_make_kind_dataset, then writes it as one ONNX network with its labels and card.
+
+    /usr/bin/python3 -m tools.training.train_kinds DATASET MNV2_DIR OUT [--features LAYER,...]
+        [--min-models 2] [--weight-decay 1e-3] [--epochs 300] [--folds 5]
+
+DATASET: g2p_make_kind_dataset's folder (models.csv, views.csv, images/). MNV2_DIR: the MobileNetV2 of the npm
+package nsfwjs 4.4.0 unpacked by unpack_nsfwjs.js (mobilenet_v2.json, .bin). The backbone stays frozen; its
+features are computed once and cached in DATASET/features-LAYERS.npy.
+
+The head is multinomial logistic regression over the kinds with at least --min-models training models, plus a
+leading "other" class for the models of the kinds below that (the classifier identifier reads a network with one score more
+than labels as having a leading background class). Views are fused as the identifier fuses them: the mean of the
+per-view probabilities. A model's loss weight is 1 / (its kind's model count)^--balance (0.5), so that the 21 chairs do not
+drown the single kinds. The temperature that calibrates the fused confidence is fitted on out-of-fold
+predictions of the training models (--folds 3, split by model), and divides the head's weights in the export, so
+the shipped network's probabilities are the calibrated ones. Validation (the split g2p_make_kind_dataset marked
+from data/mass-ranges/val.json) is scored and reported, never trained or calibrated on.
+
+OUT gets g2p-kinds.onnx, g2p-kinds.txt (the kinds in output order after "other"), g2p-kinds.json (the card:
+input, normalisation, data, per-kind counts, scores) and report.json (reliability diagram, per-model results).
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import sys
+from collections import Counter, defaultdict
+
+import numpy as np
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+if __name__ == "__main__" and not __package__:  # run as a script: import the package as python3 -m does
+    sys.path[0] = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    __package__ = "tools.training"
+
+from .keras_layers import LayersModel  # noqa: E402
+
+OTHER = "other"
+
+
+class Backbone(nn.Module):
+    """The MobileNetV2's feature maps at LAYERS, each averaged over the image and joined."""
+
+    def __init__(self, folder, layers):
+        super().__init__()
+        self.net = LayersModel(folder, "mobilenet_v2.json", layers)
+
+    def forward(self, x):
+        # Global average pooling and flatten, as ONNX GlobalAveragePool (OpenCV 4.6 misreads a ReduceMean here).
+        return torch.cat([torch.flatten(F.adaptive_avg_pool2d(f, 1), 1) for f in self.net(x)], dim=1)
+
+
+class KindClassifier(nn.Module):
+    """The shipped network: pixels normalised to [-1, 1] (NCHW, RGB) in, per-kind probabilities out."""
+
+    def __init__(self, backbone, head, temperature):
+        super().__init__()
+        self.backbone, self.head, self.temperature = backbone, head, temperature
+
+    def forward(self, x):
+        return F.softmax(self.head(self.backbone(x)) / self.temperature, dim=1)
+
+
+def read_csv(path):
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
+
+
+def export_onnx(net, path):
+    # Opset 10: Pad takes its pads as an attribute, which OpenCV 4.6's importer reads (opset 11's input it does not).
+    torch.onnx.export(net, torch.zeros(1, 3, 224, 224), path, input_names=["pixels"], output_names=["output"],
+                      opset_version=10, do_constant_folding=True)
+
+
+def features(dataset, views, backbone, tag):
+    """The backbone's features of every view, computed by OpenCV's dnn on the exported backbone: the same
+    inference the classifier identifier runs, and ten times as fast as torch here. Cached."""
+    import cv2  # python3-opencv
+
+    cache = os.path.join(dataset, f"features-{tag}.npy")
+    if os.path.exists(cache):
+        x = np.load(cache)
+        if len(x) == len(views):
+            return x
+    onnx_path = os.path.join(dataset, f"backbone-{tag}.onnx")
+    export_onnx(backbone, onnx_path)
+    net = cv2.dnn.readNetFromONNX(onnx_path)
+    out, batch = [], 32
+    for i in range(0, len(views), batch):
+        images = [cv2.cvtColor(cv2.imread(os.path.join(dataset, "images", v["image"])), cv2.COLOR_BGR2RGB)
+                  for v in views[i:i + batch]]
+        # (pixel - 127.5) / 127.5, RGB: the classifier identifier's normalization=minus-one-to-one.
+        net.setInput(cv2.dnn.blobFromImages(images, 1 / 127.5, (224, 224), (127.5, 127.5, 127.5), False, False))
+        out.append(net.forward().reshape(len(images), -1))
+        if (i // batch) % 100 == 0:
+            print(f"features: {i + len(images)}/{len(views)}", file=sys.stderr, flush=True)
+    x = np.concatenate(out).astype(np.float32)
+    np.save(cache, x)
+    return x
+
+
+def train_head(x, y, w, classes, weight_decay, epochs, seed=0):
+    """Weighted multinomial logistic regression with an L2 penalty on the weights, by full-batch L-BFGS (the
+    problem is convex: `epochs` iterations reach its optimum to plotting accuracy)."""
+    torch.manual_seed(seed)
+    head = nn.Linear(x.shape[1], classes)
+    xt, yt, wt = torch.from_numpy(x), torch.from_numpy(y), torch.from_numpy(w / w.sum())
+    opt = torch.optim.LBFGS(head.parameters(), lr=1, max_iter=epochs, history_size=20,
+                            line_search_fn="strong_wolfe", tolerance_grad=1e-6, tolerance_change=1e-9)
+
+    def closure():
+        opt.zero_grad()
+        loss = (F.cross_entropy(head(xt), yt, reduction="none") * wt).sum() + weight_decay * head.weight.pow(2).sum()
+        loss.backward()
+        return loss
+
+    opt.step(closure)
+    return head
+
+
+def fused(head, x, groups, temperature=1.0):
+    """{model: mean per-view probabilities} for the views of each model (groups: model -> view rows)."""
+    with torch.no_grad():
+        p = F.softmax(head(torch.from_numpy(x)) / temperature, dim=1).numpy()
+    return {m: p[rows].mean(axis=0) for m, rows in groups.items()}
+
+
+def fuse(z, temperature, fusion):
+    """A model's class probabilities from its views' logits z (views x classes): the mean of the per-view
+    softmaxes ("mean"), or the softmax of the mean logits ("geometric": the renormalised geometric mean of the
+    per-view probabilities), at `temperature`."""
+    if fusion == "geometric":
+        m = z.mean(axis=0) / temperature
+        p = np.exp(m - m.max())
+        return p / p.sum()
+    p = np.exp((z - z.max(axis=1, keepdims=True)) / temperature)
+    return (p / p.sum(axis=1, keepdims=True)).mean(axis=0)
+
+
+def fit_temperature(logits_by_model, truth, fusion):
+    """The temperature that minimises the negative log-likelihood of each model's true class under the fusion,
+    by golden-section search on log T."""
+    def nll(t):
+        return -sum(math.log(max(fuse(z, t, fusion)[truth[m]], 1e-12)) for m, z in logits_by_model.items())
+    a, b = math.log(0.05), math.log(20.0)
+    g = (math.sqrt(5) - 1) / 2
+    c, d = b - g * (b - a), a + g * (b - a)
+    for _ in range(60):
+        if nll(math.exp(c)) < nll(math.exp(d)):
+            b = d
+        else:
+            a = c
+        c, d = b - g * (b - a), a + g * (b - a)
+    return math.exp((a + b) / 2)
+
+
+def logit(c):
+    c = min(max(c, 1e-6), 1 - 1e-6)
+    return math.log(c / (1 - c))
+
+
+def fit_platt(confidence, right):
+    """(a, b) of calibrated = sigmoid(a * logit(c) + b), fitted by logistic regression of whether the top kind
+    was right on its fused confidence (Platt 1999)."""
+    x = torch.tensor([logit(c) for c in confidence], dtype=torch.float64)
+    y = torch.tensor([float(r) for r in right], dtype=torch.float64)
+    ab = torch.tensor([1.0, 0.0], dtype=torch.float64, requires_grad=True)
+    opt = torch.optim.LBFGS([ab], lr=1, max_iter=200, line_search_fn="strong_wolfe")
+
+    def closure():
+        opt.zero_grad()
+        loss = F.binary_cross_entropy_with_logits(ab[0] * x + ab[1], y)
+        loss.backward()
+        return loss
+
+    opt.step(closure)
+    return float(ab[0]), float(ab[1])
+
+
+def platt(c, ab):
+    return 1 / (1 + math.exp(-(ab[0] * logit(c) + ab[1])))
+
+
+def reliability(confidence, right, bins=10):
+    rows = []
+    for i in range(bins):
+        lo, hi = i / bins, (i + 1) / bins
+        idx = [k for k, c in enumerate(confidence) if lo <= c < hi or (i == bins - 1 and c == 1.0)]
+        if idx:
+            rows.append({"bin": [lo, hi], "models": len(idx), "mean_confidence": float(np.mean([confidence[k] for k in idx])),
+                         "right": float(np.mean([right[k] for k in idx]))})
+    n = len(confidence)
+    ece = sum(r["models"] / n * abs(r["mean_confidence"] - r["right"]) for r in rows) if n else 0.0
+    return rows, ece
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dataset")
+    ap.add_argument("mnv2")
+    ap.add_argument("out")
+    ap.add_argument("--features", default="out_relu", help="MobileNetV2 layers pooled into features (default out_relu)")
+    ap.add_argument("--min-models", type=int, default=2, help="least training models for a kind to be a class")
+    ap.add_argument("--weight-decay", type=float, default=1e-3)
+    ap.add_argument("--epochs", type=int, default=100, help="L-BFGS iterations")
+    ap.add_argument("--folds", type=int, default=3)
+    ap.add_argument("--fusion", choices=["mean", "geometric"], default="geometric",
+                    help="how views are joined: mean of probabilities, or their geometric mean (default)")
+    ap.add_argument("--balance", type=float, default=0.5,
+                    help="a model's loss weight is 1 / (its kind's model count)^BALANCE (default 0.5)")
+    ap.add_argument("--no-export", action="store_true", help="score only (for choosing)")
+    a = ap.parse_args(argv)
+    torch.set_num_threads(max(1, os.cpu_count() or 1))
+
+    models = {m["model"]: m for m in read_csv(os.path.join(a.dataset, "models.csv"))}
+    views = read_csv(os.path.join(a.dataset, "views.csv"))
+    layers = a.features.split(",")
+    backbone = Backbone(a.mnv2, layers).eval()
+    x = features(a.dataset, views, backbone, "+".join(layers))
+
+    train_models = [m for m in sorted({v["model"] for v in views}) if models[m]["split"] == "train"]
+    counts = Counter(models[m]["kind"] or OTHER for m in train_models)
+    kinds = sorted(k for k, n in counts.items() if k != OTHER and n >= a.min_models)
+    classes = [OTHER] + kinds
+    index = {k: i for i, k in enumerate(classes)}
+
+    def label(m):
+        return index.get(models[m]["kind"] or OTHER, 0)
+
+    rows_of = defaultdict(list)
+    for i, v in enumerate(views):
+        rows_of[v["model"]].append(i)
+    weight_of = {k: 1.0 / n ** a.balance for k, n in counts.items()}
+
+    def arrays(ms):
+        rows = [r for m in ms for r in rows_of[m]]
+        y = np.array([label(views[r]["model"]) for r in rows], dtype=np.int64)
+        w = np.array([weight_of[models[views[r]["model"]]["kind"] or OTHER] / len(rows_of[views[r]["model"]])
+                      for r in rows], dtype=np.float32)
+        return x[rows], y, w
+
+    # Out-of-fold logits of the training models (split by model) for the temperature.
+    rng = np.random.default_rng(0)
+    order = list(rng.permutation(len(train_models)))
+    oof_logits, oof_right = {}, []
+    for f in range(a.folds):
+        held = {train_models[i] for i in order[f::a.folds]}
+        head = train_head(*arrays([m for m in train_models if m not in held]), len(classes), a.weight_decay, a.epochs)
+        with torch.no_grad():
+            for m in held:
+                oof_logits[m] = head(torch.from_numpy(x[rows_of[m]])).numpy()
+    truth = {m: label(m) for m in train_models}
+    temperature = fit_temperature(oof_logits, truth, a.fusion)
+    head = train_head(*arrays(train_models), len(classes), a.weight_decay, a.epochs)
+
+    def score(ms, logits_of):
+        results = []
+        for m in ms:
+            p = fuse(logits_of(m), temperature, a.fusion)
+            # As the identifier reads it: the kinds only ("other" is a background class, left out).
+            top = [classes[i] for i in np.argsort(-p) if i != 0][:3]
+            results.append({"model": m, "truth": models[m]["kind"], "top3": top,
+                            "confidence": float(p[1:].max()), "p_truth": float(p[index[models[m]["kind"]]])
+                            if models[m]["kind"] in index else 0.0})
+        return results
+
+    oof = score(train_models, lambda m: oof_logits[m])
+    with torch.no_grad():
+        val_models = sorted({v["model"] for v in views} - set(train_models))
+        val = score(val_models, lambda m: head(torch.from_numpy(x[rows_of[m]])).numpy())
+
+    # The fused confidence of the top kind, mapped so that it says how often the top kind is right: fitted on the
+    # out-of-fold predictions of the training models, checked on validation.
+    known_oof = [r for r in oof if r["truth"]]
+    calibration = fit_platt([r["confidence"] for r in known_oof], [r["top3"][0] == r["truth"] for r in known_oof])
+    for r in oof + val:
+        r["raw_confidence"] = r["confidence"]
+        r["confidence"] = platt(r["confidence"], calibration)
+
+    def summary(results):
+        known = [r for r in results if r["truth"]]
+        top1 = sum(r["top3"][0] == r["truth"] for r in known)
+        top3 = sum(r["truth"] in r["top3"] for r in known)
+        covered = sum(r["truth"] in index for r in known)
+        conf = [r["confidence"] for r in known]
+        right = [r["top3"][0] == r["truth"] for r in known]
+        diagram, ece = reliability(conf, right)
+        confident = [r for r in known if r["confidence"] >= 0.6]
+        return {"models": len(known), "kind_covered": covered, "top1": top1, "top3": top3,
+                "confident_0.6": len(confident), "confident_right": sum(r["top3"][0] == r["truth"] for r in confident),
+                "ece": ece, "reliability": diagram}
+
+    report = {"features": layers, "fusion": a.fusion, "balance": a.balance, "calibration": calibration, "min_models": a.min_models, "weight_decay": a.weight_decay, "epochs": a.epochs,
+              "temperature": temperature, "classes": len(classes),
+              "training_models": len(train_models), "training_views": sum(len(rows_of[m]) for m in train_models),
+              "out_of_fold": summary(oof), "validation": summary(val), "validation_models": val}
+    s = report["validation"]
+    print(f"{a.features} {a.fusion} balance={a.balance} wd={a.weight_decay} T={temperature:.2f} classes={len(classes)}: "
+          f"oof top1 {report['out_of_fold']['top1']}/{report['out_of_fold']['models']}, "
+          f"val top1 {s['top1']}/{s['models']} top3 {s['top3']} (kind covered {s['kind_covered']}), "
+          f"confident {s['confident_right']}/{s['confident_0.6']}, ECE {s['ece']:.3f} "
+          f"(out of fold {report['out_of_fold']['ece']:.3f}), Platt {calibration[0]:.2f} {calibration[1]:.2f}")
+    os.makedirs(a.out, exist_ok=True)
+    with open(os.path.join(a.out, "report.json"), "w") as f:
+        json.dump(report, f, indent=1)
+    if a.no_export:
+        return 0
+
+    net = KindClassifier(backbone, head, temperature).eval()
+    onnx_path = os.path.join(a.out, "g2p-kinds.onnx")
+    export_onnx(net, onnx_path)
+    with open(os.path.join(a.out, "g2p-kinds.txt"), "w") as f:
+        f.write("".join(k + "\n" for k in kinds))
+    libraries = Counter(models[m]["library"] for m in train_models)
+    card = {
+        "format": "g2p-kind-classifier-card", "version": 1,
+        "model": "g2p-kinds.onnx", "labels": "g2p-kinds.txt",
+        "architecture": "MobileNetV2 (Sandler et al. 2018; the ImageNet backbone of npm nsfwjs 4.4.0, frozen) to "
+                        f"{'+'.join(layers)}, averaged over the image; a linear head over {len(classes)} classes "
+                        "(a leading 'other', then the kinds of g2p-kinds.txt); softmax of the logits divided by "
+                        "the calibration temperature",
+        "input": {"name": "pixels", "layout": "NCHW", "shape": [1, 3, 224, 224], "channel_order": "RGB",
+                  "normalization": "minus-one-to-one", "formula": "(pixel - 127.5) / 127.5", "views": "classifier_views(): 8 turntable views at "
+                  "15 degrees, each cropped to the object on grey 128"},
+        "notice": "MobileNetV2 of the npm package nsfwjs 4.4.0, Copyright (c) 2019 Infinite Red, Inc., MIT licence "
+                  "(NOTICE.md); head trained on the models of ATTRIBUTION-kinds.md",
+        "fusion": a.fusion, "temperature": temperature,
+        "calibration": {"platt": list(calibration),
+                        "about": "a kind's confidence = sigmoid(a * logit(fused probability) + b): how often a top "
+                                 "kind of that confidence was right, out of fold"},
+        "data": {"libraries": dict(libraries), "training_models": len(train_models),
+                 "views": report["training_views"],
+                 "source": "Debian's sweethome3d-furniture 1.8-1 (BlendSwap-CC-0: CC0; BlendSwap-CC-BY, Scopia, "
+                           "Reallusion: CC BY 3.0); data/mass-ranges/val.json's models and KatorLegaz held out"},
+        "kinds": {k: counts[k] for k in kinds},
+        "other_models": sum(1 for m in train_models if label(m) == 0),
+        "kinds_below_min_models": {k: n for k, n in counts.items() if k != OTHER and n < a.min_models},
+        "scores": {"out_of_fold": {k: v for k, v in report["out_of_fold"].items() if k != "reliability"},
+                   "validation": {k: v for k, v in report["validation"].items() if k != "reliability"}},
+    }
+    with open(os.path.join(a.out, "g2p-kinds.json"), "w") as f:
+        json.dump(card, f, indent=1)
+        f.write("\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

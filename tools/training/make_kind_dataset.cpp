@@ -11,11 +11,14 @@
 // surfaces, jittered lights, a random turn and elevation.
 //
 //   g2p_make_kind_dataset OUT LIBRARY... [--val data/mass-ranges/val.json]
-//       [--hold-out KatorLegaz] [--labels tools/training/kind_labels.json] [--copies 3] [--labels-only]
+//       [--hold-out KatorLegaz] [--labels tools/training/kind_labels.json] [--copies 3]
+//       [--labels-only | --cues-only]
 //
 // OUT/images/NNNNNN.png (size x size RGB), OUT/views.csv (image, model, split,
 // copy, view), OUT/models.csv (model, library, split, name, category, kind,
-// rule). Models of --val are the validation split; --hold-out libraries are
+// rule), OUT/cues.csv (model, copy, then shape_cues() of that copy's mesh by
+// shape_cue_names()). --cues-only writes models.csv and cues.csv, the same
+// copies without their renders. Models of --val are the validation split; --hold-out libraries are
 // not read at all.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -43,7 +46,7 @@ struct Args {
   std::vector<std::string> libraries;
   std::string val, labels, hold_out = "KatorLegaz";
   int copies = 3, size = 224;
-  bool labels_only = false;
+  bool labels_only = false, cues_only = false;
   unsigned seed = 1;
 };
 
@@ -142,9 +145,14 @@ int run(const Args& a) {
     std::cerr << "g2p_make_kind_dataset: " << a.out << " exists; choose a new folder\n";
     return 2;
   }
-  fs::create_directories(a.out + "/images");
-  std::ofstream views_csv(a.out + "/views.csv"), models_csv(a.out + "/models.csv");
+  fs::create_directories(a.cues_only ? a.out : a.out + "/images");
+  std::ofstream models_csv(a.out + "/models.csv"), cues_csv(a.out + "/cues.csv");
+  std::ofstream views_csv;
+  if (!a.cues_only) views_csv.open(a.out + "/views.csv");
   views_csv << "image,model,split,copy,view\n";
+  cues_csv << "model,copy";
+  for (const std::string& name : g2p::shape_cue_names()) cues_csv << "," << name;
+  cues_csv << "\n";
   models_csv << "model,library,split,name,category,kind,rule\n";
   const g2p::ObjectTable& table = g2p::ObjectTable::shipped();
   int images = 0, models = 0, skipped = 0;
@@ -209,6 +217,13 @@ int run(const Args& a) {
           o.elevation_deg = 5 + 25 * u(rng);
           o.lights = g2p::training::jittered_studio_lights(rng);
         }
+        const std::vector<double> cues = g2p::shape_cues(model.mesh);
+        if (!cues.empty()) {
+          cues_csv << csv(key) << "," << copy;
+          for (double c : cues) cues_csv << "," << c;
+          cues_csv << "\n";
+        }
+        if (a.cues_only) continue;
         g2p::Result<std::unique_ptr<g2p::Renderer>> renderer = g2p::renderer_registry().create("embree");
         if (!renderer.ok() || !(*renderer)->set_model(model).ok()) break;
         g2p::Result<std::vector<g2p::ImageU8>> views = g2p::classifier_views(**renderer, model.mesh, o);
@@ -248,6 +263,7 @@ int main(int argc, char** argv) {
   app.add_option("--size", a.size, "Image side, pixels (default 224, the classifier's)")->check(CLI::Range(32, 1024));
   app.add_option("--seed", a.seed, "Random seed (default 1)");
   app.add_flag("--labels-only", a.labels_only, "Write OUT/models.csv only (to review the labels)");
+  app.add_flag("--cues-only", a.cues_only, "Write OUT/models.csv and OUT/cues.csv, without renders");
   CLI11_PARSE(app, argc, argv);
   return run(a);
 }

@@ -17,6 +17,12 @@ predictions of the training models (--folds 3, split by model), and divides the 
 the shipped network's probabilities are the calibrated ones. Validation (the split g2p_make_kind_dataset marked
 from data/mass-ranges/val.json) is scored and reported, never trained or calibrated on.
 
+With shape cues (DATASET/cues.csv, g2p::shape_cues() of each copy's mesh; --shape-hidden 0 leaves them out), a
+second head, a small MLP over the standardised cues, gives each class a log-probability from the shape alone;
+the two join as log p(views) + w log p(shape), renormalised, with w fitted like the temperature on out-of-fold
+predictions. The shape head ships in the card (its weights as JSON), for the classifier identifier to run on
+the mesh.
+
 OUT gets g2p-kinds.onnx, g2p-kinds.txt (the kinds in output order after "other"), g2p-kinds.json (the card:
 input, normalisation, data, per-kind counts, scores) and report.json (reliability diagram, per-model results).
 """
@@ -25,6 +31,7 @@ import csv
 import json
 import math
 import os
+import re
 import sys
 from collections import Counter, defaultdict
 
@@ -158,6 +165,81 @@ def fit_temperature(logits_by_model, truth, fusion):
     return math.exp((a + b) / 2)
 
 
+def read_cues(path):
+    """{model: {copy: cue vector}} and the cue names, from g2p_make_kind_dataset's cues.csv."""
+    rows = read_csv(path)
+    names = [k for k in rows[0] if k not in ("model", "copy")] if rows else []
+    out = defaultdict(dict)
+    for r in rows:
+        out[r["model"]][int(r["copy"])] = np.array([float(r[k]) for k in names], dtype=np.float32)
+    return out, names
+
+
+class ShapeHead(nn.Module):
+    """Class logits from standardised shape cues: one tanh layer of `hidden` units (0: linear)."""
+
+    def __init__(self, cues, hidden, classes):
+        super().__init__()
+        self.layers = nn.ModuleList([nn.Linear(cues, hidden), nn.Linear(hidden, classes)] if hidden
+                                    else [nn.Linear(cues, classes)])
+
+    def forward(self, z):
+        for i, layer in enumerate(self.layers):
+            z = layer(z)
+            if i + 1 < len(self.layers):
+                z = torch.tanh(z)
+        return z
+
+
+def train_shape_head(z, y, w, classes, hidden, weight_decay, iterations=300, seed=0):
+    """The shape head by full-batch L-BFGS on the weighted cross-entropy with an L2 penalty on the weights."""
+    torch.manual_seed(seed)
+    head = ShapeHead(z.shape[1], hidden, classes)
+    zt, yt, wt = torch.from_numpy(z), torch.from_numpy(y), torch.from_numpy(w / w.sum())
+    opt = torch.optim.LBFGS(head.parameters(), lr=1, max_iter=iterations, history_size=20,
+                            line_search_fn="strong_wolfe", tolerance_grad=1e-6, tolerance_change=1e-9)
+
+    def closure():
+        opt.zero_grad()
+        loss = (F.cross_entropy(head(zt), yt, reduction="none") * wt).sum() + \
+            weight_decay * sum(layer.weight.pow(2).sum() for layer in head.layers)
+        loss.backward()
+        return loss
+
+    opt.step(closure)
+    return head
+
+
+def shape_logp(head, z):
+    with torch.no_grad():
+        return F.log_softmax(head(torch.from_numpy(z[None].astype(np.float32))), dim=1).numpy()[0]
+
+
+def join(p_views, logp_shape, w):
+    """Views' probabilities and the shape's log-probabilities joined: p(views) * p(shape)^w, renormalised."""
+    if logp_shape is None or w == 0:
+        return p_views
+    lp = np.log(np.maximum(p_views, 1e-12)) + w * logp_shape
+    q = np.exp(lp - lp.max())
+    return q / q.sum()
+
+
+def fit_shape_weight(p_views, logp_shape, truth):
+    """The w in [0, 2] that minimises the out-of-fold negative log-likelihood of the joined probabilities."""
+    def nll(w):
+        return -sum(math.log(max(join(p_views[m], logp_shape[m], w)[truth[m]], 1e-12)) for m in truth)
+    a, b = 0.0, 2.0
+    g = (math.sqrt(5) - 1) / 2
+    c, d = b - g * (b - a), a + g * (b - a)
+    for _ in range(40):
+        if nll(c) < nll(d):
+            b = d
+        else:
+            a = c
+        c, d = b - g * (b - a), a + g * (b - a)
+    return (a + b) / 2
+
+
 def logit(c):
     c = min(max(c, 1e-6), 1 - 1e-6)
     return math.log(c / (1 - c))
@@ -198,6 +280,35 @@ def reliability(confidence, right, bins=10):
     return rows, ece
 
 
+def card_text(card):
+    """The card as indented JSON with each list of numbers on one line, the shape head's float32 weights written
+    to 9 significant digits (exactly)."""
+    def tidy(v):
+        if isinstance(v, dict):
+            return {k: tidy(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [tidy(x) for x in v]
+        return float(f"{v:.9g}") if isinstance(v, float) else v
+    text = json.dumps(tidy(card), indent=1)
+    return re.sub(r"\[\s*(-?[0-9][-0-9.e+,\s]*?)\s*\]",
+                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text) + "\n"
+
+
+def shape_card(head, names, mean, scale, weight):
+    """The shape head as the classifier identifier reads it (classifier_identifier.cpp)."""
+    return {
+        "cues": names, "mean": [float(v) for v in mean], "scale": [float(v) for v in scale],
+        "layers": [{"weights": layer.weight.detach().double().numpy().tolist(),
+                    "bias": layer.bias.detach().double().numpy().tolist(),
+                    "activation": "tanh" if i + 1 < len(head.layers) else "none"}
+                   for i, layer in enumerate(head.layers)],
+        "weight": weight,
+        "about": "g2p::shape_cues() of the mesh, standardised ((cue - mean) / scale), through the layers (weights: "
+                 "outputs x inputs) give a log-probability per class (softmax); the kind's probability is "
+                 "p(views) * p(shape)^weight, renormalised, before the calibration",
+    }
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dataset")
@@ -205,13 +316,18 @@ def main(argv=None):
     ap.add_argument("out")
     ap.add_argument("--features", default="out_relu", help="MobileNetV2 layers pooled into features (default out_relu)")
     ap.add_argument("--min-models", type=int, default=2, help="least training models for a kind to be a class")
-    ap.add_argument("--weight-decay", type=float, default=1e-3)
+    ap.add_argument("--weight-decay", type=float, default=1e-4)
     ap.add_argument("--epochs", type=int, default=100, help="L-BFGS iterations")
     ap.add_argument("--folds", type=int, default=3)
-    ap.add_argument("--fusion", choices=["mean", "geometric"], default="geometric",
-                    help="how views are joined: mean of probabilities, or their geometric mean (default)")
+    ap.add_argument("--fusion", choices=["mean", "geometric"], default="mean",
+                    help="how views are joined: the mean of their probabilities (default, as the classifier "
+                         "identifier joins them), or their geometric mean")
     ap.add_argument("--balance", type=float, default=0.5,
                     help="a model's loss weight is 1 / (its kind's model count)^BALANCE (default 0.5)")
+    ap.add_argument("--cues", default=None, help="shape cues (default DATASET/cues.csv)")
+    ap.add_argument("--shape-hidden", type=int, default=32,
+                    help="tanh units of the shape head (default 32; 0 = linear; -1 = no shape head)")
+    ap.add_argument("--shape-weight-decay", type=float, default=1e-3)
     ap.add_argument("--no-export", action="store_true", help="score only (for choosing)")
     a = ap.parse_args(argv)
     torch.set_num_threads(max(1, os.cpu_count() or 1))
@@ -244,23 +360,55 @@ def main(argv=None):
         return x[rows], y, w
 
     # Out-of-fold logits of the training models (split by model) for the temperature.
+    # Shape cues, standardised by the training copies' mean and deviation; each model's copy 0 (as it is) is
+    # the one scored.
+    use_shape = a.shape_hidden >= 0
+    cues, cue_names = read_cues(a.cues or os.path.join(a.dataset, "cues.csv")) if use_shape else ({}, [])
+    if use_shape:
+        missing = [m for m in sorted({v["model"] for v in views}) if 0 not in cues.get(m, {})]
+        if missing:
+            sys.exit(f"train_kinds: no shape cues of {len(missing)} models (first {missing[0]}); "
+                     "rerun g2p_make_kind_dataset --cues-only, or --shape-hidden -1")
+        every = np.stack([c for m in train_models for c in cues[m].values()])
+        cue_mean, cue_scale = every.mean(axis=0), every.std(axis=0) + 1e-6
+
+    def shape_arrays(ms):
+        z, y, w = [], [], []
+        for m in ms:
+            for c in cues[m].values():
+                z.append((c - cue_mean) / cue_scale)
+                y.append(label(m))
+                w.append(weight_of[models[m]["kind"] or OTHER] / len(cues[m]))
+        return np.array(z, np.float32), np.array(y, np.int64), np.array(w, np.float32)
+
+    def shape_of(shape_head, m):
+        return shape_logp(shape_head, (cues[m][0] - cue_mean) / cue_scale) if use_shape else None
+
     rng = np.random.default_rng(0)
     order = list(rng.permutation(len(train_models)))
-    oof_logits, oof_right = {}, []
+    oof_logits, oof_shape = {}, {}
     for f in range(a.folds):
         held = {train_models[i] for i in order[f::a.folds]}
-        head = train_head(*arrays([m for m in train_models if m not in held]), len(classes), a.weight_decay, a.epochs)
+        kept = [m for m in train_models if m not in held]
+        head = train_head(*arrays(kept), len(classes), a.weight_decay, a.epochs)
+        shape_head = train_shape_head(*shape_arrays(kept), len(classes), a.shape_hidden,
+                                      a.shape_weight_decay) if use_shape else None
         with torch.no_grad():
             for m in held:
                 oof_logits[m] = head(torch.from_numpy(x[rows_of[m]])).numpy()
+                oof_shape[m] = shape_of(shape_head, m)
     truth = {m: label(m) for m in train_models}
     temperature = fit_temperature(oof_logits, truth, a.fusion)
+    shape_weight = fit_shape_weight({m: fuse(oof_logits[m], temperature, a.fusion) for m in train_models},
+                                    oof_shape, truth) if use_shape else 0.0
     head = train_head(*arrays(train_models), len(classes), a.weight_decay, a.epochs)
+    shape_head = train_shape_head(*shape_arrays(train_models), len(classes), a.shape_hidden,
+                                  a.shape_weight_decay) if use_shape else None
 
-    def score(ms, logits_of):
+    def score(ms, logits_of, shape_logp_of):
         results = []
         for m in ms:
-            p = fuse(logits_of(m), temperature, a.fusion)
+            p = join(fuse(logits_of(m), temperature, a.fusion), shape_logp_of(m), shape_weight)
             # As the identifier reads it: the kinds only ("other" is a background class, left out).
             top = [classes[i] for i in np.argsort(-p) if i != 0][:3]
             results.append({"model": m, "truth": models[m]["kind"], "top3": top,
@@ -268,10 +416,11 @@ def main(argv=None):
                             if models[m]["kind"] in index else 0.0})
         return results
 
-    oof = score(train_models, lambda m: oof_logits[m])
+    oof = score(train_models, lambda m: oof_logits[m], lambda m: oof_shape[m])
     with torch.no_grad():
         val_models = sorted({v["model"] for v in views} - set(train_models))
-        val = score(val_models, lambda m: head(torch.from_numpy(x[rows_of[m]])).numpy())
+        val = score(val_models, lambda m: head(torch.from_numpy(x[rows_of[m]])).numpy(),
+                    lambda m: shape_of(shape_head, m))
 
     # The fused confidence of the top kind, mapped so that it says how often the top kind is right: fitted on the
     # out-of-fold predictions of the training models, checked on validation.
@@ -294,12 +443,14 @@ def main(argv=None):
                 "confident_0.6": len(confident), "confident_right": sum(r["top3"][0] == r["truth"] for r in confident),
                 "ece": ece, "reliability": diagram}
 
-    report = {"features": layers, "fusion": a.fusion, "balance": a.balance, "calibration": calibration, "min_models": a.min_models, "weight_decay": a.weight_decay, "epochs": a.epochs,
+    report = {"features": layers, "fusion": a.fusion, "shape_hidden": a.shape_hidden,
+              "shape_weight_decay": a.shape_weight_decay, "shape_weight": shape_weight, "balance": a.balance, "calibration": calibration, "min_models": a.min_models, "weight_decay": a.weight_decay, "epochs": a.epochs,
               "temperature": temperature, "classes": len(classes),
               "training_models": len(train_models), "training_views": sum(len(rows_of[m]) for m in train_models),
               "out_of_fold": summary(oof), "validation": summary(val), "validation_models": val}
     s = report["validation"]
-    print(f"{a.features} {a.fusion} balance={a.balance} wd={a.weight_decay} T={temperature:.2f} classes={len(classes)}: "
+    print(f"{a.features} {a.fusion} balance={a.balance} wd={a.weight_decay} T={temperature:.2f} "
+          f"shape={a.shape_hidden} swd={a.shape_weight_decay} w={shape_weight:.2f} classes={len(classes)}: "
           f"oof top1 {report['out_of_fold']['top1']}/{report['out_of_fold']['models']}, "
           f"val top1 {s['top1']}/{s['models']} top3 {s['top3']} (kind covered {s['kind_covered']}), "
           f"confident {s['confident_right']}/{s['confident_0.6']}, ECE {s['ece']:.3f} "
@@ -322,7 +473,8 @@ def main(argv=None):
         "architecture": "MobileNetV2 (Sandler et al. 2018; the ImageNet backbone of npm nsfwjs 4.4.0, frozen) to "
                         f"{'+'.join(layers)}, averaged over the image; a linear head over {len(classes)} classes "
                         "(a leading 'other', then the kinds of g2p-kinds.txt); softmax of the logits divided by "
-                        "the calibration temperature",
+                        "the calibration temperature" + ("; joined with a shape head over g2p::shape_cues() (\"shape\")"
+                                                          if use_shape else ""),
         "input": {"name": "pixels", "layout": "NCHW", "shape": [1, 3, 224, 224], "channel_order": "RGB",
                   "normalization": "minus-one-to-one", "formula": "(pixel - 127.5) / 127.5", "views": "classifier_views(): 8 turntable views at "
                   "15 degrees, each cropped to the object on grey 128"},
@@ -330,8 +482,9 @@ def main(argv=None):
                   "(NOTICE.md); head trained on the models of ATTRIBUTION-kinds.md",
         "fusion": a.fusion, "temperature": temperature,
         "calibration": {"platt": list(calibration),
-                        "about": "a kind's confidence = sigmoid(a * logit(fused probability) + b): how often a top "
-                                 "kind of that confidence was right, out of fold"},
+                        "about": "a kind's confidence = sigmoid(a * logit(p) + b), p its probability from the views "
+                                 "(joined with the shape head's where the card has one): how often a top kind of "
+                                 "that confidence was right, out of fold"},
         "data": {"libraries": dict(libraries), "training_models": len(train_models),
                  "views": report["training_views"],
                  "source": "Debian's sweethome3d-furniture 1.8-1 (BlendSwap-CC-0: CC0; BlendSwap-CC-BY, Scopia, "
@@ -339,12 +492,12 @@ def main(argv=None):
         "kinds": {k: counts[k] for k in kinds},
         "other_models": sum(1 for m in train_models if label(m) == 0),
         "kinds_below_min_models": {k: n for k, n in counts.items() if k != OTHER and n < a.min_models},
+        "shape": shape_card(shape_head, cue_names, cue_mean, cue_scale, shape_weight) if use_shape else None,
         "scores": {"out_of_fold": {k: v for k, v in report["out_of_fold"].items() if k != "reliability"},
                    "validation": {k: v for k, v in report["validation"].items() if k != "reliability"}},
     }
     with open(os.path.join(a.out, "g2p-kinds.json"), "w") as f:
-        json.dump(card, f, indent=1)
-        f.write("\n")
+        f.write(card_text(card))
     return 0
 
 

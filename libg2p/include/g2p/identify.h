@@ -282,6 +282,32 @@ G2P_API Result<std::vector<ImageU8>> classifier_views(const Renderer& renderer, 
 // view does not show the object; the whole view when it has no face IDs.
 G2P_API ImageU8 classifier_crop(const View& view, int size, int background);
 
+// Shape cues (docs/kind-classifier.md): numbers that say how an object is
+// shaped whatever its size, position and turn about the vertical (+Z), for
+// the kind classifier to weigh beside its views. In the frame of the
+// object's horizontal principal axes (long, short) and its height:
+//   height_over_long, short_over_long   log of the extents' ratios
+//   mirror_long, mirror_short           how alike the surface is to its
+//                                       mirror image across the middle, along
+//                                       each horizontal axis (IoU of a 24^3
+//                                       surface grid with its mirror, 0-1)
+//   surface_fill                        share of that grid's cells the surface
+//                                       meets
+//   area_height                         height of the surface's centre of area
+//                                       over the object's height (0-1)
+//   area_bottom, area_top               share of the surface area in the lowest
+//                                       and highest quarter of the height
+//   footprint_low, _middle, _high       share of the horizontal grid that the
+//                                       lowest, middle and highest third of
+//                                       the height covers, seen from above
+//   area_level, area_upright            share of the area facing within 25
+//                                       degrees of vertical (|n_z| > 0.9:
+//                                       seats, tops, shelves) and within 17
+//                                       degrees of horizontal (|n_z| < 0.3: sides)
+// Empty when the mesh has no area or no extent along an axis.
+G2P_API const std::vector<std::string>& shape_cue_names();
+G2P_API std::vector<double> shape_cues(const Mesh& mesh);
+
 // The table's kinds (`g2p identify --list --json`): [{"name", "group", "coco",
 // "typical_longest_side_m", "mass_kg": [lo, hi], "structure"}, ...], indented.
 G2P_API std::string object_kinds_json(const ObjectTable& table);

@@ -20,7 +20,10 @@
 // Per view the scores become probabilities (a softmax, unless they already
 // are) and a kind's probability is the sum over its classes; a kind's
 // confidence is the mean over the views, mapped by the shipped card's
-// calibration (Platt scaling fitted when it was trained) where it has one. The views are the detector's: eight
+// calibration (Platt scaling fitted when it was trained) where it has one.
+// The shipped card may also carry a shape head: a small network over the
+// mesh's shape_cues() whose class probabilities join the views' ones as
+// p(views) * p(shape)^weight, renormalised, before the calibration. The views are the detector's: eight
 // of its own at eye level with a renderer, else those given; each is cropped
 // to a square about the object's pixels (photographs are framed on the
 // object) on a plain grey, then scaled to the network's input.
@@ -141,6 +144,84 @@ int kind_of(const ClassLabel& l, const ObjectTable& table) {
 
 constexpr const char* kShippedCard = "g2p-kinds.json";
 
+// The card's shape head (train_kinds.py's ShapeHead): standardised
+// shape_cues() through dense layers to one logit per class, the network's
+// classes in its output order.
+struct ShapeHead {
+  struct Layer {
+    int inputs = 0, outputs = 0;
+    std::vector<double> weights, bias;  // weights: outputs x inputs, row-major
+    bool tanh = false;
+  };
+  std::vector<double> mean, scale;
+  std::vector<Layer> layers;
+  double weight = 0.0;  // the exponent of p(shape) in the join
+
+  bool empty() const { return layers.empty(); }
+  int classes() const { return layers.empty() ? 0 : layers.back().outputs; }
+
+  // log p(class | shape) for cues of shape_cue_names().
+  std::vector<double> log_probabilities(const std::vector<double>& cues) const {
+    std::vector<double> z(cues.size());
+    for (std::size_t i = 0; i < cues.size(); ++i) z[i] = (cues[i] - mean[i]) / scale[i];
+    for (const Layer& l : layers) {
+      std::vector<double> out(l.bias);
+      for (int o = 0; o < l.outputs; ++o)
+        for (int i = 0; i < l.inputs; ++i) out[o] += l.weights[static_cast<std::size_t>(o) * l.inputs + i] * z[i];
+      if (l.tanh)
+        for (double& v : out) v = std::tanh(v);
+      z = std::move(out);
+    }
+    const double top = *std::max_element(z.begin(), z.end());
+    double sum = 0.0;
+    for (double v : z) sum += std::exp(v - top);
+    for (double& v : z) v -= top + std::log(sum);
+    return z;
+  }
+};
+
+// The card's "shape" (null or absent: none), checked against this build's cues.
+Status read_shape_head(const nlohmann::json& j, ShapeHead& head) {
+  if (j.is_null()) return Status::Ok();
+  const std::vector<std::string>& names = shape_cue_names();
+  if (j.at("cues").get<std::vector<std::string>>() != names)
+    return Status::InvalidArgument("shape.cues are not this libg2p's shape_cue_names()");
+  head.mean = j.at("mean").get<std::vector<double>>();
+  head.scale = j.at("scale").get<std::vector<double>>();
+  head.weight = j.at("weight").get<double>();
+  if (head.mean.size() != names.size() || head.scale.size() != names.size())
+    return Status::InvalidArgument("shape.mean and shape.scale need one number per cue");
+  for (double v : head.scale)
+    if (!(v > 0) || !std::isfinite(v)) return Status::InvalidArgument("shape.scale must be positive");
+  if (!(head.weight >= 0) || !std::isfinite(head.weight))
+    return Status::InvalidArgument("shape.weight must be a finite number >= 0");
+  int inputs = static_cast<int>(names.size());
+  for (const nlohmann::json& lj : j.at("layers")) {
+    ShapeHead::Layer l;
+    const auto rows = lj.at("weights").get<std::vector<std::vector<double>>>();
+    l.bias = lj.at("bias").get<std::vector<double>>();
+    l.inputs = inputs, l.outputs = static_cast<int>(rows.size());
+    const std::string activation = lj.at("activation").get<std::string>();
+    if (activation != "tanh" && activation != "none")
+      return Status::InvalidArgument("shape.layers: activation '" + activation + "' is not tanh or none");
+    l.tanh = activation == "tanh";
+    if (l.outputs == 0 || l.bias.size() != rows.size())
+      return Status::InvalidArgument("shape.layers: bias and weights disagree on the outputs");
+    for (const std::vector<double>& row : rows) {
+      if (static_cast<int>(row.size()) != inputs)
+        return Status::InvalidArgument("shape.layers: a layer's weights do not take the previous layer's outputs");
+      l.weights.insert(l.weights.end(), row.begin(), row.end());
+    }
+    for (double v : l.weights)
+      if (!std::isfinite(v)) return Status::InvalidArgument("shape.layers: weights must be finite");
+    inputs = l.outputs;
+    head.layers.push_back(std::move(l));
+  }
+  if (head.layers.empty()) return Status::InvalidArgument("shape.layers is empty");
+  if (head.layers.back().tanh) return Status::InvalidArgument("shape.layers: the last layer gives logits (none)");
+  return Status::Ok();
+}
+
 // What the shipped card says of its network (tools/training/train_kinds.py
 // writes it): the files, relative to the card, and the input.
 struct ClassifierCard {
@@ -149,6 +230,7 @@ struct ClassifierCard {
   Normalization normalization = Normalization::kMinusOneToOne;
   bool rgb = true;
   double platt_a = 1.0, platt_b = 0.0;  // confidence = sigmoid(a logit(p) + b); 1, 0 = p itself
+  ShapeHead shape;                      // empty: the views alone
 };
 
 Result<ClassifierCard> read_card(const std::string& path) {
@@ -185,6 +267,9 @@ Result<ClassifierCard> read_card(const std::string& path) {
       c.platt_a = platt.at(0).get<double>(), c.platt_b = platt.at(1).get<double>();
       if (!std::isfinite(c.platt_a) || !std::isfinite(c.platt_b) || c.platt_a <= 0.0)
         return bad("calibration.platt must be two finite numbers, the first > 0");
+    }
+    if (doc.contains("shape")) {
+      if (const Status s = read_shape_head(doc.at("shape"), c.shape); !s.ok()) return bad(s.message());
     }
   } catch (const nlohmann::json::exception& e) {
     return bad(std::string("missing or wrong field (") + e.what() + ")");
@@ -256,47 +341,70 @@ class ClassifierIdentifier final : public Identifier {
         if (!crop.empty()) inputs.push_back(std::move(crop));
       }
     }
-    std::vector<int> kinds(labels_.size());
-    for (std::size_t c = 0; c < labels_.size(); ++c) kinds[c] = kind_of(labels_[c], table);
-    std::map<int, double> kind_sum;                   // kind -> summed probability over views
-    std::map<int, std::map<std::size_t, double>> by;  // kind -> class -> summed probability
-    std::map<std::size_t, double> unmapped;           // class -> summed probability, classes naming no kind
+    // The mean of the views' probabilities per class (background first, if any).
+    std::vector<double> mean(labels_.size() + offset_, 0.0);
     int seen = 0;
     for (const ImageU8& input : inputs) {
       Result<std::vector<double>> p = probabilities(input);
       if (!p.ok()) return p.status();
       ++seen;
-      for (std::size_t c = 0; c < labels_.size(); ++c) {
-        const double x = (*p)[c + offset_];
-        if (kinds[c] >= 0) {
-          kind_sum[kinds[c]] += x;
-          by[kinds[c]][c] += x;
-        } else {
-          unmapped[c] += x;
-        }
-      }
+      for (std::size_t c = 0; c < mean.size(); ++c) mean[c] += (*p)[c];
     }
     if (seen == 0) {
       id.notes.push_back("classifier: no view shows the object");
       return id;
     }
-    for (const auto& [kind, sum] : kind_sum) {
-      const double confidence = calibrated(sum / seen);
+    for (double& x : mean) x /= seen;
+    // Joined with the shape head's probabilities, where the card has one.
+    std::vector<double> joined = mean;
+    bool shaped = false;
+    if (!shape_.empty()) {
+      const std::vector<double> cues = in.model != nullptr ? shape_cues(in.model->mesh) : std::vector<double>();
+      if (cues.empty()) {
+        id.notes.push_back(
+            "classifier: " + std::string(in.model != nullptr ? "the mesh has no extent to measure" : "no mesh") +
+            "; named from its views alone, without its shape");
+      } else {
+        const std::vector<double> logp = shape_.log_probabilities(cues);
+        double top = -INFINITY, sum = 0.0;
+        for (std::size_t c = 0; c < joined.size(); ++c)
+          top = std::max(top, joined[c] = std::log(std::max(mean[c], 1e-12)) + shape_.weight * logp[c]);
+        for (double& x : joined) sum += (x = std::exp(x - top));
+        for (double& x : joined) x /= sum;
+        shaped = true;
+      }
+    }
+    std::vector<int> kinds(labels_.size());
+    for (std::size_t c = 0; c < labels_.size(); ++c) kinds[c] = kind_of(labels_[c], table);
+    std::map<int, std::pair<double, double>> kind_p;      // kind -> probability (joined, views alone)
+    std::map<int, std::map<std::size_t, double>> by;      // kind -> class -> probability
+    std::pair<double, std::size_t> top_unmapped{0.0, 0};  // the likeliest class that names no kind
+    for (std::size_t c = 0; c < labels_.size(); ++c) {
+      const double x = joined[c + offset_];
+      if (kinds[c] >= 0) {
+        kind_p[kinds[c]].first += x;
+        kind_p[kinds[c]].second += mean[c + offset_];
+        by[kinds[c]][c] += x;
+      } else {
+        top_unmapped = std::max(top_unmapped, {x, c});
+      }
+    }
+    for (const auto& [kind, p] : kind_p) {
+      const double confidence = calibrated(p.first);
       if (confidence < min_probability_ || confidence <= 0.0) continue;
       std::vector<std::pair<double, std::size_t>> classes;
       for (const auto& [c, x] : by[kind]) classes.emplace_back(x, c);
       std::sort(classes.begin(), classes.end(), std::greater<>());
       std::string evidence = "'" + labels_[classes.front().second].text + "'";
       if (classes.size() > 1) evidence += " and " + std::to_string(classes.size() - 1) + " more of its classes";
-      evidence += ", " + percent(sum / seen) + " over " + std::to_string(seen) + " views";
+      evidence += ", " + percent(p.second) + " over " + std::to_string(seen) + " views";
+      if (shaped) evidence += ", " + percent(p.first) + " with its shape";
       id.candidates.push_back({table.kinds()[static_cast<std::size_t>(kind)].name, confidence, "classifier", evidence});
     }
     std::stable_sort(id.candidates.begin(), id.candidates.end(),
                      [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });
-    std::pair<double, std::size_t> top{0.0, 0};
-    for (const auto& [c, x] : unmapped) top = std::max(top, {x, c});
-    if (top.first / seen >= min_probability_)
-      id.notes.push_back("classifier: '" + labels_[top.second].text + "' (" + percent(top.first / seen) +
+    if (top_unmapped.first >= min_probability_)
+      id.notes.push_back("classifier: '" + labels_[top_unmapped.second].text + "' (" + percent(top_unmapped.first) +
                          "), which no kind of the object table answers for");
     if (id.candidates.empty())
       id.notes.push_back("classifier: no class of a kind reached " + percent(min_probability_));
@@ -310,6 +418,7 @@ class ClassifierIdentifier final : public Identifier {
     model_file_ = model_path_, labels_file_ = labels_path_;
     input_size_ = size_, input_normalization_ = normalization_, input_rgb_ = rgb_;
     platt_a_ = 1.0, platt_b_ = 0.0;
+    shape_ = ShapeHead();
     if (!user_model()) {
       const std::string card = detail::shipped_model_file(kShippedCard);
       if (card.empty())
@@ -321,6 +430,7 @@ class ClassifierIdentifier final : public Identifier {
       model_file_ = c->model, labels_file_ = c->labels;
       input_size_ = c->size, input_normalization_ = c->normalization, input_rgb_ = c->rgb;
       platt_a_ = c->platt_a, platt_b_ = c->platt_b;
+      shape_ = std::move(c->shape);
     }
     Result<std::vector<ClassLabel>> labels = read_labels(labels_file_);
     if (!labels.ok()) return load_status_ = labels.status();
@@ -348,6 +458,10 @@ class ClassifierIdentifier final : public Identifier {
                  " names " + std::to_string(labels_.size()) +
                  " classes (as many are needed, or one fewer when the first score is a background class)");
     }
+    if (!shape_.empty() && static_cast<std::size_t>(shape_.classes()) != scores->size())
+      return load_status_ = Status::InvalidArgument(std::string(kShippedCard) + ": the shape head gives " +
+                                                    std::to_string(shape_.classes()) + " classes, the network " +
+                                                    std::to_string(scores->size()));
     return load_status_ = Status::Ok();
   }
 
@@ -438,6 +552,7 @@ class ClassifierIdentifier final : public Identifier {
   mutable Normalization input_normalization_ = Normalization::kMinusOneToOne;
   mutable bool input_rgb_ = true;
   mutable double platt_a_ = 1.0, platt_b_ = 0.0;
+  mutable ShapeHead shape_;
 
   // A kind's mean probability over the views as the confidence the card's
   // calibration makes of it (how often a top kind that sure was right).

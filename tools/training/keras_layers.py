@@ -123,9 +123,36 @@ class LayersModel(nn.Module):
         return [entry[0] for entry in nodes[0]] if nodes else []
 
     def forward(self, x):
-        values = {self.input_name: x}
+        return self._run({self.input_name: x}, self.order)
+
+    def _below(self, start):
+        """The layers that `start` feeds, directly or not, in evaluation order (start itself left out)."""
+        below = {start}
         for name in self.order:
-            if name == self.input_name:
+            if any(source in below for source in self._inbound(name)):
+                below.add(name)
+        return [n for n in self.order if n in below and n != start]
+
+    def forward_from(self, start, value):
+        """The outputs from `start`'s value (NCHW) alone: only the layers downstream of `start` run (fine-tuning
+        the last blocks on cached values). Every output must follow from `start`, and the layers after it may not
+        read a layer before it."""
+        if getattr(self, "_downstream", (None,))[0] != start:
+            below = self._below(start)
+            missing = [n for n in self.outputs if n not in below]
+            if missing:
+                raise ValueError(f"outputs {missing} do not follow from layer {start}")
+            self._downstream = (start, below)
+        return self._run({start: value}, self._downstream[1])
+
+    def downstream_parameters(self, start):
+        """{name: parameter} of the layers forward_from(start, ...) runs."""
+        keys = {n.replace("/", "__").replace(".", "_") for n in self._below(start)}
+        return {k: p for k, p in self.params.items() if k.rsplit("__", 1)[0] in keys}
+
+    def _run(self, values, order):
+        for name in order:
+            if name in values:
                 continue
             layer = self.layers[name]
             kind, cfg = layer["class_name"], layer["config"]

@@ -240,6 +240,88 @@ def fit_shape_weight(p_views, logp_shape, truth):
     return (a + b) / 2
 
 
+class Part(nn.Module):
+    """The backbone up to one layer, unpooled (its values are cached for fine-tuning the layers after it)."""
+
+    def __init__(self, folder, layer):
+        super().__init__()
+        self.net = LayersModel(folder, "mobilenet_v2.json", [layer])
+
+    def forward(self, x):
+        return self.net(x)[0]
+
+
+def layer_values(dataset, views, folder, layer):
+    """Every view's value at `layer` (NCHW, float16), computed by OpenCV's dnn on the backbone exported up to it.
+    Cached in DATASET/values-LAYER.npy."""
+    import cv2  # python3-opencv
+
+    cache = os.path.join(dataset, f"values-{layer}.npy")
+    if os.path.exists(cache):
+        v = np.load(cache, mmap_mode="r")
+        if len(v) == len(views):
+            return v
+    onnx_path = os.path.join(dataset, f"part-{layer}.onnx")
+    export_onnx(Part(folder, layer).eval(), onnx_path)
+    net = cv2.dnn.readNetFromONNX(onnx_path)
+    out, batch = None, 32
+    for i in range(0, len(views), batch):
+        images = [cv2.cvtColor(cv2.imread(os.path.join(dataset, "images", v["image"])), cv2.COLOR_BGR2RGB)
+                  for v in views[i:i + batch]]
+        net.setInput(cv2.dnn.blobFromImages(images, 1 / 127.5, (224, 224), (127.5, 127.5, 127.5), False, False))
+        y = net.forward()
+        if out is None:
+            out = np.zeros((len(views),) + y.shape[1:], np.float16)
+        out[i:i + len(images)] = y
+        if (i // batch) % 100 == 0:
+            print(f"{layer}: {i + len(images)}/{len(views)}", file=sys.stderr, flush=True)
+    np.save(cache, out)
+    return np.load(cache, mmap_mode="r")
+
+
+def tuned_features(net, start, values, rows, batch=256):
+    """The pooled out_relu features of the views `rows` from their cached values at `start`."""
+    out = []
+    with torch.no_grad():
+        for i in range(0, len(rows), batch):
+            v = torch.from_numpy(np.asarray(values[np.sort(rows[i:i + batch])], dtype=np.float32))
+            order = np.argsort(np.argsort(rows[i:i + batch]))  # back to the rows' order
+            out.append(torch.flatten(F.adaptive_avg_pool2d(net.forward_from(start, v)[0], 1), 1)[order].numpy())
+    return np.concatenate(out) if out else np.zeros((0, 1280), np.float32)
+
+
+def fine_tune(net, start, values, rows, y, w, head, epochs, lr, anchor, weight_decay, seed=0):
+    """Fine-tunes the layers after `start` and the head together: Adam on minibatches of 64 views, the weighted
+    cross-entropy, the head's L2 penalty, and an L2 pull of the tuned layers towards their pretrained weights
+    (`anchor`; L2-SP, Li et al. 2018), batch normalisation kept at its moving statistics. The views' values at
+    `start` are cached: the layers before it never run."""
+    tuned = net.downstream_parameters(start)
+    pretrained = {k: p.detach().clone() for k, p in tuned.items()}
+    for p in tuned.values():
+        p.requires_grad_(True)
+    opt = torch.optim.Adam([{"params": list(tuned.values()), "lr": lr}, {"params": head.parameters(), "lr": 3 * lr}])
+    rng = np.random.default_rng(seed)
+    total = float(w.sum())
+    for epoch in range(epochs):
+        order = rng.permutation(len(rows))
+        for i in range(0, len(order), 64):
+            b = order[i:i + 64]
+            b = b[np.argsort(rows[b])]  # the cache read in file order
+            v = torch.from_numpy(np.asarray(values[rows[b]], dtype=np.float32))
+            logits = head(torch.flatten(F.adaptive_avg_pool2d(net.forward_from(start, v)[0], 1), 1))
+            loss = (F.cross_entropy(logits, torch.from_numpy(y[b]), reduction="none") *
+                    torch.from_numpy(w[b])).sum() * (len(order) / len(b) / total)
+            loss = loss + weight_decay * head.weight.pow(2).sum() + \
+                anchor * sum((p - pretrained[k]).pow(2).sum() for k, p in tuned.items())
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+        print(f"fine-tune: epoch {epoch + 1}/{epochs}, loss {float(loss):.3f}", file=sys.stderr, flush=True)
+    for p in tuned.values():
+        p.requires_grad_(False)
+    return head
+
+
 def logit(c):
     c = min(max(c, 1e-6), 1 - 1e-6)
     return math.log(c / (1 - c))
@@ -328,6 +410,13 @@ def main(argv=None):
     ap.add_argument("--shape-hidden", type=int, default=32,
                     help="tanh units of the shape head (default 32; 0 = linear; -1 = no shape head)")
     ap.add_argument("--shape-weight-decay", type=float, default=1e-3)
+    ap.add_argument("--fine-tune", default="", metavar="LAYER",
+                    help="also train the backbone's layers after LAYER (e.g. block_15_add: block_16 and Conv_1), "
+                         "from each view's cached value at LAYER; default: the backbone stays frozen")
+    ap.add_argument("--fine-tune-epochs", type=int, default=4)
+    ap.add_argument("--fine-tune-lr", type=float, default=1e-4)
+    ap.add_argument("--fine-tune-anchor", type=float, default=1e-3,
+                    help="L2 pull of the tuned layers towards their pretrained weights")
     ap.add_argument("--no-export", action="store_true", help="score only (for choosing)")
     a = ap.parse_args(argv)
     torch.set_num_threads(max(1, os.cpu_count() or 1))
@@ -351,6 +440,26 @@ def main(argv=None):
     for i, v in enumerate(views):
         rows_of[v["model"]].append(i)
     weight_of = {k: 1.0 / n ** a.balance for k, n in counts.items()}
+
+    if a.fine_tune and layers != ["out_relu"]:
+        sys.exit("train_kinds: --fine-tune needs --features out_relu")
+    values = layer_values(a.dataset, views, a.mnv2, a.fine_tune) if a.fine_tune else None
+    pretrained = {k: p.detach().clone() for k, p in backbone.net.params.items()}
+
+    def trained(ms):
+        """The head (and with --fine-tune the backbone's last layers, from their pretrained weights) trained on
+        the views of models `ms`; and the pooled features of any views under it."""
+        head = train_head(*arrays(ms), len(classes), a.weight_decay, a.epochs)
+        if not a.fine_tune:
+            return head, lambda rows: x[rows]
+        with torch.no_grad():
+            for k, p in backbone.net.params.items():
+                p.copy_(pretrained[k])
+        rows = np.array([r for m in ms for r in rows_of[m]])
+        _, y, w = arrays(ms)
+        head = fine_tune(backbone.net, a.fine_tune, values, rows, y, w, head, a.fine_tune_epochs, a.fine_tune_lr,
+                         a.fine_tune_anchor, a.weight_decay)
+        return head, lambda rows: tuned_features(backbone.net, a.fine_tune, values, np.asarray(rows))
 
     def arrays(ms):
         rows = [r for m in ms for r in rows_of[m]]
@@ -390,18 +499,18 @@ def main(argv=None):
     for f in range(a.folds):
         held = {train_models[i] for i in order[f::a.folds]}
         kept = [m for m in train_models if m not in held]
-        head = train_head(*arrays(kept), len(classes), a.weight_decay, a.epochs)
+        head, feats = trained(kept)
         shape_head = train_shape_head(*shape_arrays(kept), len(classes), a.shape_hidden,
                                       a.shape_weight_decay) if use_shape else None
         with torch.no_grad():
             for m in held:
-                oof_logits[m] = head(torch.from_numpy(x[rows_of[m]])).numpy()
+                oof_logits[m] = head(torch.from_numpy(feats(rows_of[m]))).numpy()
                 oof_shape[m] = shape_of(shape_head, m)
     truth = {m: label(m) for m in train_models}
     temperature = fit_temperature(oof_logits, truth, a.fusion)
     shape_weight = fit_shape_weight({m: fuse(oof_logits[m], temperature, a.fusion) for m in train_models},
                                     oof_shape, truth) if use_shape else 0.0
-    head = train_head(*arrays(train_models), len(classes), a.weight_decay, a.epochs)
+    head, feats = trained(train_models)
     shape_head = train_shape_head(*shape_arrays(train_models), len(classes), a.shape_hidden,
                                   a.shape_weight_decay) if use_shape else None
 
@@ -419,7 +528,7 @@ def main(argv=None):
     oof = score(train_models, lambda m: oof_logits[m], lambda m: oof_shape[m])
     with torch.no_grad():
         val_models = sorted({v["model"] for v in views} - set(train_models))
-        val = score(val_models, lambda m: head(torch.from_numpy(x[rows_of[m]])).numpy(),
+        val = score(val_models, lambda m: head(torch.from_numpy(feats(rows_of[m]))).numpy(),
                     lambda m: shape_of(shape_head, m))
 
     # The fused confidence of the top kind, mapped so that it says how often the top kind is right: fitted on the
@@ -443,13 +552,15 @@ def main(argv=None):
                 "confident_0.6": len(confident), "confident_right": sum(r["top3"][0] == r["truth"] for r in confident),
                 "ece": ece, "reliability": diagram}
 
-    report = {"features": layers, "fusion": a.fusion, "shape_hidden": a.shape_hidden,
+    report = {"features": layers, "fusion": a.fusion, "fine_tune": a.fine_tune or None,
+              "fine_tune_epochs": a.fine_tune_epochs, "fine_tune_lr": a.fine_tune_lr,
+              "fine_tune_anchor": a.fine_tune_anchor, "shape_hidden": a.shape_hidden,
               "shape_weight_decay": a.shape_weight_decay, "shape_weight": shape_weight, "balance": a.balance, "calibration": calibration, "min_models": a.min_models, "weight_decay": a.weight_decay, "epochs": a.epochs,
               "temperature": temperature, "classes": len(classes),
               "training_models": len(train_models), "training_views": sum(len(rows_of[m]) for m in train_models),
               "out_of_fold": summary(oof), "validation": summary(val), "validation_models": val}
     s = report["validation"]
-    print(f"{a.features} {a.fusion} balance={a.balance} wd={a.weight_decay} T={temperature:.2f} "
+    print(f"{a.features} fine-tune={a.fine_tune or '-'}/{a.fine_tune_epochs}/{a.fine_tune_lr} {a.fusion} balance={a.balance} wd={a.weight_decay} T={temperature:.2f} "
           f"shape={a.shape_hidden} swd={a.shape_weight_decay} w={shape_weight:.2f} classes={len(classes)}: "
           f"oof top1 {report['out_of_fold']['top1']}/{report['out_of_fold']['models']}, "
           f"val top1 {s['top1']}/{s['models']} top3 {s['top3']} (kind covered {s['kind_covered']}), "
@@ -470,8 +581,9 @@ def main(argv=None):
     card = {
         "format": "g2p-kind-classifier-card", "version": 1,
         "model": "g2p-kinds.onnx", "labels": "g2p-kinds.txt",
-        "architecture": "MobileNetV2 (Sandler et al. 2018; the ImageNet backbone of npm nsfwjs 4.4.0, frozen) to "
-                        f"{'+'.join(layers)}, averaged over the image; a linear head over {len(classes)} classes "
+        "architecture": "MobileNetV2 (Sandler et al. 2018; the ImageNet backbone of npm nsfwjs 4.4.0, "
+                        + (f"frozen to {a.fine_tune}, its later layers fine-tuned here ({a.fine_tune_epochs} epochs)"
+                           if a.fine_tune else "frozen") + f") to {'+'.join(layers)}, averaged over the image; a linear head over {len(classes)} classes "
                         "(a leading 'other', then the kinds of g2p-kinds.txt); softmax of the logits divided by "
                         "the calibration temperature" + ("; joined with a shape head over g2p::shape_cues() (\"shape\")"
                                                           if use_shape else ""),

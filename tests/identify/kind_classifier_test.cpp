@@ -83,10 +83,12 @@ TEST(KindClassifier, TheCardNamesKindsOfTheTableAndTheirTrainingCounts) {
 }
 
 TEST(KindClassifier, NamesABottleAndAChairFromTheirViewsAlone) {
-  // Names removed: the views are all it has. Its confidences are calibrated
-  // and low on their own; what it ranks first is what counts here.
-  for (const auto& [asset, kind] : {std::pair<std::string, std::string>{"WaterBottle", "bottle"},
-                                    std::pair<std::string, std::string>{"SheenChair", "chair"}}) {
+  // Names removed: the views and the shape are all it has. Its confidences
+  // are calibrated and low on their own; what it ranks first is what counts
+  // here. SheenChair is a lounge chair with arms: chair or armchair.
+  const std::vector<std::pair<std::string, std::set<std::string>>> cases = {{"WaterBottle", {"bottle"}},
+                                                                            {"SheenChair", {"chair", "armchair"}}};
+  for (const auto& [asset, kinds] : cases) {
     const std::string file = test::asset_path(asset);
     G2P_SKIP_WITHOUT(file);
     Result<PipelineResult> r = identify_run("classifier", file);
@@ -94,7 +96,7 @@ TEST(KindClassifier, NamesABottleAndAChairFromTheirViewsAlone) {
     const Identification& id = r->identification;
     EXPECT_TRUE(id.warnings.empty()) << id.warnings.front();
     ASSERT_FALSE(id.candidates.empty()) << asset;
-    EXPECT_EQ(id.candidates.front().kind, kind) << asset;
+    EXPECT_EQ(kinds.count(id.candidates.front().kind), 1u) << asset << ": " << id.candidates.front().kind;
     EXPECT_EQ(id.candidates.front().source, "classifier");
     EXPECT_NE(id.candidates.front().evidence.find("over 8 views"), std::string::npos);
     EXPECT_NE(id.candidates.front().evidence.find("with its shape"), std::string::npos)

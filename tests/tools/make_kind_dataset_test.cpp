@@ -12,6 +12,7 @@
 #include <sstream>
 #include <vector>
 
+#include "g2p/identify.h"
 #include "g2p/io.h"
 #include "support/test_data.h"
 #include "support/tool_run.h"
@@ -130,6 +131,28 @@ TEST(ToolMakeKindDataset, LabelsSplitsAndRendersAsTheClassifierSees) {
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) differ += plain->at(x, y, 0) != generated->at(x, y, 0);
   EXPECT_GT(differ, 64 * 64 / 10);
+
+  // Each rendered copy's shape cues, after its lumps and turn; --cues-only
+  // measures the same copies without rendering them.
+  const auto c = rows(out + "/cues.csv");
+  std::vector<std::string> header = {"model", "copy"};
+  for (const std::string& name : shape_cue_names()) header.push_back(name);
+  ASSERT_EQ(c.front(), header);
+  std::map<std::string, int> copies;
+  for (std::size_t i = 1; i < c.size(); ++i) {
+    ASSERT_EQ(c[i].size(), header.size());
+    ++copies[c[i][0]];
+  }
+  EXPECT_EQ(copies["Lib/lib/chair/chair.obj"], 2);
+  EXPECT_EQ(copies["Lib/lib/stool/stool.obj"], 1);
+  EXPECT_EQ(copies.count("Lib/lib/gadget/gadget.obj"), 0u);
+  const std::string measured = dir + "/measured";
+  ASSERT_EQ(run_tool(quote(measured) + " " + quote(lib) + " --labels " + quote(dir + "/labels.json") + " --val " +
+                     quote(dir + "/val.json") + " --copies 2 --cues-only"),
+            0);
+  EXPECT_EQ(rows(measured + "/cues.csv"), c);
+  EXPECT_FALSE(std::filesystem::exists(measured + "/images"));
+  EXPECT_FALSE(std::filesystem::exists(measured + "/views.csv"));
 
   // An existing folder is refused, nothing written into it.
   EXPECT_EQ(run_tool(quote(out) + " " + quote(lib)), 2);

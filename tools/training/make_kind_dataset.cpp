@@ -244,7 +244,8 @@ int run(const Args& a) {
       if (++done % 50 == 0) std::cerr << library << ": " << done << "/" << catalogue.size() << " models\n";
     }
   }
-  std::cout << "models rendered " << models << ", skipped " << skipped << ", images " << images << "\n";
+  std::cout << (a.cues_only ? "models measured " : "models rendered ") << models << ", skipped " << skipped
+            << ", images " << images << "\n";
   return 0;
 }
 

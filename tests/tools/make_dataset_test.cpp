@@ -278,6 +278,80 @@ TEST(FlatTexture, MeanLinearColourWeighsByAlpha) {
   EXPECT_TRUE(training::mean_linear_colour(Texture{}).isApprox(Eigen::Vector3f::Ones()));
 }
 
+// Vertex colours: each vertex takes the texel at its UV (nearest, linear),
+// times any colour it had; vertices of an untextured material stay white.
+TEST(VertexColours, EachVertexTakesTheTexelAtItsUv) {
+  auto image = std::make_shared<ImageU8>(2, 1, 4, 255);
+  image->at(0, 0, 1) = 0, image->at(0, 0, 2) = 0;  // red | white
+  Model model;
+  model.materials.resize(2);
+  model.materials[0].base_color_texture.image = image;
+  Mesh& mesh = model.mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}, {3, 0, 0}, {2, 1, 0}};
+  mesh.uvs = {{0.25f, 0.5f}, {0.75f, 0.5f}, {1.25f, 0.5f}, {0.25f, 0.5f}, {0.25f, 0.5f}, {0.25f, 0.5f}};
+  mesh.triangles = {{0, 1, 2}, {3, 4, 5}};
+  mesh.face_source = {{0, 0, 0}, {0, 1, 1}};
+  training::texture_to_vertex_colours(model, mesh);
+  ASSERT_EQ(mesh.colors.size(), 6u);
+  EXPECT_TRUE(mesh.colors[0].isApprox(Eigen::Vector4f(1, 0, 0, 1)));
+  EXPECT_TRUE(mesh.colors[1].isApprox(Eigen::Vector4f(1, 1, 1, 1)));
+  EXPECT_TRUE(mesh.colors[2].isApprox(Eigen::Vector4f(1, 0, 0, 1))) << "u 1.25 repeats to 0.25";
+  for (int v = 3; v < 6; ++v) EXPECT_TRUE(mesh.colors[v].isApprox(Eigen::Vector4f::Ones())) << "untextured " << v;
+}
+
+// Baked light: under a roof a floor gets less light than the roof's top,
+// and a box is brighter on the side of the key light than on the far side.
+TEST(BakedLighting, ShadowsDarkenWhatIsCoveredAndTheKeySideIsBrightest) {
+  const auto quad = [](Mesh& m, double half, double z, int n) {  // an n x n grid facing +Z
+    const int base = m.num_vertices();
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        m.positions.emplace_back(-half + 2 * half * i / n, -half + 2 * half * j / n, z);
+        m.normals.emplace_back(0.f, 0.f, 1.f);
+      }
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int a = base + j * (n + 1) + i;
+        m.triangles.emplace_back(a, a + 1, a + n + 2);
+        m.triangles.emplace_back(a, a + n + 2, a + n + 1);
+      }
+  };
+  Model covered;
+  quad(covered.mesh, 1.0, 1.0, 4);  // the roof: 25 vertices
+  quad(covered.mesh, 0.3, 0.0, 4);  // the floor under it
+  Mesh lit = covered.mesh;
+  ASSERT_TRUE(training::bake_lighting(covered, lit, Eigen::Vector3f::UnitZ()).ok());
+  ASSERT_EQ(lit.colors.size(), lit.positions.size());
+  double roof = 0, floor = 0;
+  for (int v = 0; v < 25; ++v) roof += lit.colors[v].x() / 25;
+  for (int v = 25; v < 50; ++v) floor += lit.colors[v].x() / 25;
+  EXPECT_GT(roof, 0.9) << "the roof's top sees the whole sky";
+  EXPECT_LT(floor, 0.5 * roof) << "the roof hides the sky above 45 degrees from the floor";
+  EXPECT_GE(floor, 0.12 - 1e-6) << "the floor of the baked light";
+  for (const Eigen::Vector4f& c : lit.colors) EXPECT_EQ(c.w(), 1.f) << "alpha untouched";
+
+  Model box;  // a unit cube, four vertices per face with its normal
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign : {-1, 1}) {
+      const int base = box.mesh.num_vertices();
+      Eigen::Vector3f n = Eigen::Vector3f::Zero();
+      n[axis] = static_cast<float>(sign);
+      const Eigen::Vector3f u = Eigen::Vector3f::Unit((axis + 1) % 3), w = Eigen::Vector3f::Unit((axis + 2) % 3);
+      for (int k = 0; k < 4; ++k) {
+        box.mesh.positions.push_back(0.5f * n + 0.5f * ((k & 1) ? u : -u) + 0.5f * ((k & 2) ? w : -w));
+        box.mesh.normals.push_back(n);
+      }
+      box.mesh.triangles.emplace_back(base, base + 1, base + 3);
+      box.mesh.triangles.emplace_back(base, base + 3, base + 2);
+    }
+  Mesh boxed = box.mesh;
+  ASSERT_TRUE(training::bake_lighting(box, boxed, Eigen::Vector3f::UnitX(), 0.3f, 0.f).ok());
+  const float plus_x = boxed.colors[4].x(), minus_x = boxed.colors[0].x(), plus_y = boxed.colors[12].x();
+  EXPECT_GT(plus_x, minus_x + 0.3f) << "the key's side against the far side";
+  EXPECT_GT(plus_x, plus_y) << "the key's side against a side it grazes";
+  EXPECT_NEAR(boxed.colors[5].x(), plus_x, 1e-6f) << "one face, one light";
+}
+
 // --flat-textures: a striped red and blue texture becomes its mean colour
 // (purple, no stripes left; dropping the texture would leave the white of
 // Kd); without it both stripes show.

@@ -4,9 +4,12 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#include <memory>
 #include <random>
 #include <string_view>
 #include <vector>
@@ -97,6 +100,113 @@ inline void add_geometry_noise(Mesh& mesh, double sigma, double tilt, std::uint6
     mesh.positions[v] += static_cast<float>(sigma * diagonal) * offset;
     if (v < mesh.normals.size()) mesh.normals[v] = (mesh.normals[v] + static_cast<float>(tilt) * turn).normalized();
   }
+}
+
+// sRGB byte to linear, as the renderer reads colour textures.
+inline float srgb_to_linear(std::uint8_t byte) {
+  const float c = byte / 255.f;
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+// Vertex colours from the colour textures, as generators that write no atlas
+// store colour per vertex: each vertex takes the texel (nearest, linear RGB)
+// at its UV in the base colour texture of the first triangle that uses it;
+// vertices of untextured materials, or without UVs, take white. The textures
+// stay (the caller drops them); the material factors are not folded in (the
+// renderer multiplies them, as glTF COLOR_0 is multiplied).
+inline void texture_to_vertex_colours(const Model& model, Mesh& mesh) {
+  const std::size_t n = mesh.positions.size();
+  std::vector<int> material(n, -1);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const int m = f < mesh.face_source.size() ? mesh.face_source[f].material : -1;
+    for (int i = 0; i < 3; ++i) {
+      int& slot = material[static_cast<std::size_t>(mesh.triangles[f][i])];
+      if (slot < 0) slot = m;
+    }
+  }
+  std::vector<Eigen::Vector4f> colours(n, Eigen::Vector4f::Ones());
+  for (std::size_t v = 0; v < n; ++v) {
+    if (material[v] < 0 || material[v] >= static_cast<int>(model.materials.size()) || v >= mesh.uvs.size()) continue;
+    const Texture& t = model.materials[static_cast<std::size_t>(material[v])].base_color_texture;
+    if (t.empty() || t.image->channels() < 3 || t.image->width() < 1 || t.image->height() < 1) continue;
+    const Eigen::Vector2f uv = t.uv_transform * mesh.uvs[v].homogeneous();
+    const auto wrap = [](float c, int size) {  // repeat; clamp-to-edge and mirror read alike at this scale
+      const float f = c - std::floor(c);
+      return std::clamp(static_cast<int>(f * static_cast<float>(size)), 0, size - 1);
+    };
+    const int x = wrap(uv.x(), t.image->width()), y = wrap(uv.y(), t.image->height());
+    for (int c = 0; c < 3; ++c) colours[v][c] = srgb_to_linear(t.image->at(x, y, c));
+  }
+  if (mesh.colors.size() == n)
+    for (std::size_t v = 0; v < n; ++v) colours[v] = colours[v].cwiseProduct(mesh.colors[v]);
+  mesh.colors = std::move(colours);
+}
+
+// Lighting baked into the vertex colours, as image-to-3D generators bake the
+// light of the images they learnt from into their colours (the renderer then
+// lights the object again). Each vertex's colour is multiplied by the
+// irradiance it gets from `directions` directional lights on a Fibonacci
+// sphere, each of weight sky + max(0, d . key)^4 + up * max(0, d_z), in the
+// vertex's own shadow: a vertex is lit from d where an orthographic depth map
+// seen from d reaches it (a shadow map, bias 1 % of the bounding box's
+// diagonal). The irradiance is divided by its 95th percentile over the
+// vertices and clamped to [floor, 1]. `key` is a unit vector in the mesh's
+// frame. Fails only where the renderer does.
+inline Status bake_lighting(const Model& model, Mesh& mesh, const Eigen::Vector3f& key, float sky = 0.3f,
+                            float up = 0.5f, float floor = 0.12f, int directions = 48, int size = 128) {
+  const std::size_t n = mesh.positions.size();
+  if (n == 0 || mesh.triangles.empty()) return Status::Ok();
+  Model lit = model;  // the renderer holds a reference: a copy with this mesh
+  lit.mesh = mesh;
+  if (lit.mesh.normals.size() != n) compute_vertex_normals(lit.mesh);
+  Result<std::unique_ptr<Renderer>> renderer = renderer_registry().create("embree");
+  if (!renderer.ok()) return renderer.status();
+  if (Status s = (*renderer)->set_model(lit); !s.ok()) return s;
+  ViewOptions vo;
+  vo.num_views = directions, vo.layout = ViewLayout::kFibonacci, vo.orthographic = true;
+  vo.width = vo.height = size;
+  Result<std::vector<Camera>> cameras = make_views(lit.mesh, vo);
+  if (!cameras.ok()) return cameras.status();
+  const Eigen::AlignedBox3d box = bounds(lit.mesh);
+  const double bias = 0.01 * box.diagonal().norm();
+  RenderOptions ro;
+  ro.shade = false, ro.material_buffers = false, ro.geometry_buffers = true;
+  std::vector<double> irradiance(n, 0.0);
+  double total = 0;
+  View view;
+  for (const Camera& camera : *cameras) {
+    const Eigen::Vector3d d = -camera.forward();  // towards the light
+    const double weight = sky + std::pow(std::max(0.0, d.dot(key.cast<double>())), 4.0) + up * std::max(0.0, d.z());
+    total += weight;
+    if (Status s = (*renderer)->render_into(camera, ro, view); !s.ok()) return s;
+    for (std::size_t v = 0; v < n; ++v) {
+      const double cosine = lit.mesh.normals[v].cast<double>().dot(d);
+      if (!(cosine > 0)) continue;
+      double depth = 0;
+      const Eigen::Vector2d px = camera.project(lit.mesh.positions[v].cast<double>(), &depth);
+      double nearest = std::numeric_limits<double>::infinity();  // the farthest of the 3x3 pixels: no
+      bool inside = false;                                       // self-shadow at silhouettes and edges
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = static_cast<int>(std::floor(px.x())) + dx, y = static_cast<int>(std::floor(px.y())) + dy;
+          if (x < 0 || y < 0 || x >= view.depth.width() || y >= view.depth.height()) continue;
+          const double z = view.depth.at(x, y, 0);
+          nearest = inside ? std::max(nearest, z) : z, inside = true;
+        }
+      if (!inside || depth <= nearest + bias) irradiance[v] += weight * cosine;
+    }
+  }
+  if (!(total > 0)) return Status::Ok();
+  std::vector<double> sorted = irradiance;
+  const std::size_t k = std::min(n - 1, static_cast<std::size_t>(0.95 * static_cast<double>(n)));
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
+  const double scale = sorted[k] > 0 ? 1.0 / sorted[k] : 0.0;
+  if (mesh.colors.size() != n) mesh.colors.assign(n, Eigen::Vector4f::Ones());
+  for (std::size_t v = 0; v < n; ++v) {
+    const float e = std::clamp(static_cast<float>(irradiance[v] * scale), floor, 1.f);
+    mesh.colors[v].head<3>() *= e;
+  }
+  return Status::Ok();
 }
 
 // The studio lights (studio_lights()) jittered, as photographs and baked

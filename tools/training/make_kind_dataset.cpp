@@ -7,8 +7,9 @@
 // `classifier` identifier sees objects (classifier_views: eight eye-level
 // views, each cropped to the object on grey). Copy 0 of a model is rendered
 // as it is; the other copies look like image-to-3D outputs: colour textures
-// flattened to their mean (a coarse bake) or the whole model grey, lumpy
-// surfaces, jittered lights, a random turn and elevation.
+// flattened to their mean (a coarse bake), sampled per vertex (vertex
+// colours) or the whole model grey, light and shadow baked into the colours,
+// lumpy surfaces, jittered lights, a random turn and elevation.
 //
 //   g2p_make_kind_dataset OUT LIBRARY... [--val data/mass-ranges/val.json]
 //       [--hold-out KatorLegaz] [--labels tools/training/kind_labels.json] [--copies 3]
@@ -204,7 +205,16 @@ int run(const Args& a) {
           // Looks of a generator's output: a coarse bake (the mean colour of
           // each texture), or no colour at all, on lumpy surfaces.
           const double look = u(rng);
+          // Half the coarse bakes keep their texture's colour per vertex
+          // instead of its mean (a generator that writes vertex colours).
+          const bool vertex_colours = look < 0.6 && u(rng) < 0.5;
+          if (vertex_colours) g2p::training::texture_to_vertex_colours(model, model.mesh);
           for (g2p::SourceMaterial& m : model.materials) {
+            if (vertex_colours) {
+              m.base_color_texture = g2p::Texture{};
+              m.metallic = 0.f, m.roughness = 0.5f + 0.5f * static_cast<float>(u(rng));
+              continue;
+            }
             if (look < 0.6 && !m.base_color_texture.empty())
               m.base_color.head<3>() =
                   m.base_color.head<3>().cwiseProduct(g2p::training::mean_linear_colour(m.base_color_texture));
@@ -213,6 +223,15 @@ int run(const Args& a) {
             m.metallic = 0.f, m.roughness = 0.5f + 0.5f * static_cast<float>(u(rng));
           }
           g2p::training::add_geometry_noise(model.mesh, 0.001 + 0.004 * u(rng), 0.3, rng());
+          // Half the copies have light and shadow baked into their colours,
+          // from a key light above the object at a random side.
+          if (u(rng) < 0.5) {
+            const double azimuth = 2 * M_PI * u(rng), elevation = (20 + 50 * u(rng)) * M_PI / 180;
+            const Eigen::Vector3f key_light(std::cos(elevation) * std::cos(azimuth),
+                                            std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+            if (g2p::Status s = g2p::training::bake_lighting(model, model.mesh, key_light); !s.ok())
+              std::cerr << "no baked light on " << key << ": " << s.message() << "\n";
+          }
           g2p::training::turn(model.mesh, 2 * M_PI * u(rng));
           o.elevation_deg = 5 + 25 * u(rng);
           o.lights = g2p::training::jittered_studio_lights(rng);

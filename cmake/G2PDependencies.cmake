@@ -34,6 +34,12 @@ find_library(G2P_WEBP_LIBRARY webp)
 g2p_require(G2P_WEBP_INCLUDE libwebp-dev)
 g2p_require(G2P_WEBP_LIBRARY libwebp-dev)
 
+# Compressed glTF (libg2p/src/io/gltf_decode.cpp): Draco meshes and meshopt buffer views.
+find_package(draco QUIET)
+g2p_require(draco_FOUND libdraco-dev)
+find_package(meshoptimizer QUIET)
+g2p_require(meshoptimizer_FOUND libmeshoptimizer-dev)
+
 find_package(embree 3 QUIET)
 g2p_require(embree_FOUND libembree-dev)
 

@@ -42,7 +42,7 @@ if(BUILD_SHARED_LIBS)
   set(G2P_STATIC_DEPENDENCIES "")
 else()
   set(G2P_STATIC_DEPENDENCIES
-      "find_dependency(assimp)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(CURL)\nfind_dependency(OpenCV COMPONENTS core imgproc dnn ml)\nfind_dependency(PNG)\nfind_dependency(JPEG)\nfind_dependency(TIFF)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)\nfind_dependency(urdfdom)\nfind_dependency(Qhull)")
+      "find_dependency(assimp)\nfind_dependency(draco)\nfind_dependency(meshoptimizer)\nfind_dependency(embree 3)\nfind_dependency(TBB)\nfind_dependency(CURL)\nfind_dependency(OpenCV COMPONENTS core imgproc dnn ml)\nfind_dependency(PNG)\nfind_dependency(JPEG)\nfind_dependency(TIFF)\nfind_dependency(nlohmann_json)\nfind_dependency(Threads)\nfind_dependency(urdfdom)\nfind_dependency(Qhull)")
   if(G2P_WITH_MUJOCO)
     string(APPEND G2P_STATIC_DEPENDENCIES "\nfind_dependency(mujoco 2.2)")
   endif()

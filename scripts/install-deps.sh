@@ -20,6 +20,7 @@ core=(
   build-essential cmake pkg-config ccache git
   libeigen3-dev libassimp-dev libembree-dev libtbb-dev
   libopencv-dev libpng-dev libjpeg-dev libwebp-dev libtiff-dev
+  libdraco-dev libmeshoptimizer-dev
   libcgal-dev libgmp-dev libmpfr-dev
   nlohmann-json3-dev libcli11-dev libcurl4-openssl-dev
   liburdfdom-dev libqhull-dev
@@ -57,12 +58,13 @@ if [ "$minimal" = 0 ] && ! { command -v node && command -v npm; } >/dev/null; th
 # libg2p/web (three.js and esbuild: summary.html's 3D view, bundled into libg2p
 # at build time; without them the page has no 3D view) and tests/validators
 # (the Khronos glTF validator; playwright-core, which drives Chromium in the
-# summary.html browser tests).
+# summary.html browser tests) and tests/compressors (glTF Transform and
+# gltfpack, which make the compressed variants the import tests read).
 install_npm() {
   [ "$minimal" = 1 ] && return 0
   local root dir
   root="$(cd "$(dirname "$0")/.." && pwd)"
-  for dir in "$root/libg2p/web" "$root/tests/validators"; do
+  for dir in "$root/libg2p/web" "$root/tests/validators" "$root/tests/compressors"; do
     if node -e 'const d = process.argv[1], fs = require("fs");
                 process.exit(Object.keys(require(d + "/package.json").dependencies)
                   .every((p) => fs.existsSync(d + "/node_modules/" + p + "/package.json")) ? 0 : 1)' "$dir"; then

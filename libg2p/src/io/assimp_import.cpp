@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <new>
 #include <set>
 #include <sstream>
@@ -24,6 +25,7 @@
 #include "core/srgb.h"
 #include "core/utf8.h"
 #include "g2p/io.h"
+#include "gltf_decode.h"
 #include "gltf_layout.h"
 #include "real_size.h"
 #include "scene_reader.h"
@@ -402,6 +404,39 @@ std::string read_gltf_json_bytes(const std::string& path) {
   return head + rest.str();
 }
 
+std::string read_file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::string bytes(in ? static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0)) : 0, '\0');
+  in.seekg(0);
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
+
+std::uint32_t read_u32_le(const std::string& b, std::size_t at) {
+  std::uint32_t v = 0;
+  if (b.size() >= at + 4) std::memcpy(&v, b.data() + at, 4);
+  return v;
+}
+
+// A glTF file as assimp can read it: the plan's notes go to `warnings`; a
+// file that uses compression, quantization, sparse accessors, instancing or
+// WebP/KTX2 textures is rewritten into `decoded` (a plain GLB), which then
+// also replaces `gltf_bytes` for the layout checks. `file_bytes` is only
+// called when the plan asks for a rewrite.
+Status plain_gltf(const std::function<std::string()>& file_bytes, const std::string& dir, std::string& gltf_bytes,
+                  std::string& decoded, std::vector<std::string>& warnings) {
+  const detail::GltfPlan plan = detail::plan_gltf(gltf_bytes);
+  warnings.insert(warnings.end(), plan.notes.begin(), plan.notes.end());
+  if (plan.rewrite.empty()) return Status::Ok();
+  Result<detail::DecodedGltf> plain = detail::decode_gltf(file_bytes(), dir);
+  if (!plain.ok()) return plain.status();
+  warnings.insert(warnings.end(), plain->notes.begin(), plain->notes.end());
+  decoded = std::move(plain->glb);
+  gltf_bytes = decoded.substr(0, 20 + std::size_t{read_u32_le(decoded, 12)});  // header and JSON chunk
+  return Status::Ok();
+}
+
 // Checks the glTF primitives assimp may have cut short, and replaces assimp's
 // compacted material numbering by the file's own.
 Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bool strict, Model& model) {
@@ -419,10 +454,6 @@ Status apply_gltf_layout(const aiScene& scene, const std::string& gltf_bytes, bo
                                   (layout.ok() ? std::string("count differs") : layout.status().message()) +
                                   "); material indices are assimp's, not the file's");
     return Status::Ok();
-  }
-  for (const std::string& ext : layout->extensions_required) {
-    if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
-      return Status::Unsupported("the file requires " + ext + ", which this build's assimp cannot decode");
   }
   // assimp lists a file's primitives in the order its nodes first reference
   // their meshes, not always in file order (2CylinderEngine), so each of its
@@ -653,15 +684,20 @@ Result<Model> load_model(const std::string& path, const ImportOptions& options) 
     ImportInfo info;
     detail::SceneSource source;
     source.path = path;
+    std::string dir = fs::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    std::string gltf_bytes = is_gltf(ext) ? read_gltf_json_bytes(path) : std::string();
+    std::string decoded;  // a compressed glTF made plain (gltf_decode.h), read from memory
+    if (is_gltf(ext)) {
+      G2P_RETURN_IF_ERROR(plain_gltf([&] { return read_file_bytes(path); }, dir, gltf_bytes, decoded, info.warnings));
+      if (!decoded.empty()) source = {std::string(), decoded.data(), decoded.size(), "glb"};
+    }
     Result<detail::ParsedScene> parsed =
         detail::parse_scene(source, kPostProcess, options.isolate_reader, info.warnings);
     if (!parsed.ok()) return parsed.status();
     const aiScene* scene = &parsed->scene();
     info.path = path;
     info.format = ext;
-    const std::string gltf_bytes = is_gltf(ext) ? read_gltf_json_bytes(path) : std::string();
-    std::string dir = fs::path(path).parent_path().string();
-    if (dir.empty()) dir = ".";
     if (ext == "obj") warn_missing_material_libraries(path, dir, info.warnings);
     return convert_scene(*scene, ext, dir, gltf_bytes, options, std::move(info));
   });
@@ -679,13 +715,18 @@ Result<Model> load_model_from_memory(const void* data, std::size_t size, const s
     source.data = data;
     source.size = size;
     source.hint = ext;
+    std::string gltf_bytes = is_gltf(ext) ? std::string(static_cast<const char*>(data), size) : std::string();
+    std::string decoded;
+    if (is_gltf(ext)) {
+      G2P_RETURN_IF_ERROR(plain_gltf([&] { return gltf_bytes; }, /*dir=*/"", gltf_bytes, decoded, info.warnings));
+      if (!decoded.empty()) source = {std::string(), decoded.data(), decoded.size(), "glb"};
+    }
     Result<detail::ParsedScene> parsed =
         detail::parse_scene(source, kPostProcess, options.isolate_reader, info.warnings);
     if (!parsed.ok()) return parsed.status();
     const aiScene* scene = &parsed->scene();
     info.path = "<memory>";
     info.format = ext;
-    const std::string gltf_bytes = is_gltf(ext) ? std::string(static_cast<const char*>(data), size) : std::string();
     return convert_scene(*scene, ext, /*model_dir=*/"", gltf_bytes, options, std::move(info));
   });
 }

@@ -98,6 +98,9 @@ bool encode(PngState& s, const ImageU8& image, std::vector<png_bytep>& rows) {
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_compression_level(png, 1);
   png_set_compression_strategy(png, 3);  // Z_RLE
+  // One filter, Paeth, instead of libpng's per-row trial of all five: 2.2-2.4x
+  // faster on a run's views and label maps, 1-2 % larger (docs/performance.md).
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_PAETH);
   png_write_info(png, info);
   rows.resize(static_cast<std::size_t>(image.height()));
   for (int y = 0; y < image.height(); ++y)

@@ -10,8 +10,8 @@ and left out) is copied under the file name its generator wrote
 are the generator's, not this set's ids. Then `g2p run` runs twice per model:
   - nosize: the file as it is (a normalised mesh may take its identified kind's size);
   - size:   with the annotated real size (--height or --longest-side).
-With --identify-only, `g2p identify --json` runs once instead (identification only, no mass; the
-EXTRA flags are g2p identify's).
+With --identify-only, `g2p identify --json` runs instead, once per condition (nosize unless
+--conditions says otherwise; identification only, no mass; the EXTRA flags are g2p identify's).
 From each run.json it reads the identification and the mass, and prints per model and overall:
   - identification top-1 and top-3: the identified kind (and the first three candidates) against
     data/generated/objects.json's kind and its acceptable alternatives, over the models whose kind
@@ -56,20 +56,25 @@ def accepted(annotation, names):
     return {w for w in words if w in names}
 
 
-def identify(g2p, path, extra):
+def size_flags(size):
+    """--height or --longest-side with the annotated real size; none without one."""
+    if not size:
+        return []
+    key, value = next(iter(size.items()))
+    return ["--height" if key == "height_m" else "--longest-side", str(value)]
+
+
+def identify(g2p, path, size, extra):
     """`g2p identify --json` alone (--identify-only): the identification, no mass."""
-    done = subprocess.run([g2p, "identify", path, "--json"] + extra, capture_output=True, text=True)
+    done = subprocess.run([g2p, "identify", path, "--json"] + size_flags(size) + extra, capture_output=True,
+                          text=True)
     if done.returncode != 0:
         return None, done.stderr.strip().splitlines()[-1:] if done.stderr else ["exit %d" % done.returncode]
     return {"identification": json.loads(done.stdout), "object": {"mass_kg": float("nan")}}, []
 
 
 def run(g2p, path, out, size, extra):
-    cmd = [g2p, "run", path, "-o", out, "--overwrite", "-q"]
-    if size:
-        key, value = next(iter(size.items()))
-        cmd += ["--height" if key == "height_m" else "--longest-side", str(value)]
-    cmd += extra
+    cmd = [g2p, "run", path, "-o", out, "--overwrite", "-q"] + size_flags(size) + extra
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         return None, done.stderr.strip().splitlines()[-1:] if done.stderr else ["exit %d" % done.returncode]
@@ -83,12 +88,12 @@ def main(argv=None):
     ap.add_argument("--g2p", default=os.path.join(ROOT, "build", "bin", "g2p"))
     ap.add_argument("--only", nargs="*")
     ap.add_argument("--json")
-    ap.add_argument("--conditions", default="nosize,size")
+    ap.add_argument("--conditions", default=None, help="nosize,size (default; --identify-only: nosize)")
     ap.add_argument("--identify-only", action="store_true",
-                    help="run `g2p identify --json` once per model (top-1 and top-3 only, no mass)")
+                    help="run `g2p identify --json` per condition (top-1 and top-3 only, no mass)")
     ap.add_argument("extra", nargs="*")
     a = ap.parse_args(argv)
-    conditions = ["nosize"] if a.identify_only else a.conditions.split(",")
+    conditions = (a.conditions or ("nosize" if a.identify_only else "nosize,size")).split(",")
     with open(os.path.join(SET, "manifest.json")) as f:
         manifest = json.load(f)["models"]
     with open(os.path.join(SET, "objects.json")) as f:
@@ -113,7 +118,7 @@ def main(argv=None):
                "range": ann["mass_kg"], "file": os.path.basename(named)}
         for cond in conditions:
             if a.identify_only:
-                result, err = identify(a.g2p, named, a.extra)
+                result, err = identify(a.g2p, named, ann["real_size"] if cond == "size" else None, a.extra)
             else:
                 result, err = run(a.g2p, named, os.path.join(a.out, cond, mid),
                                   ann["real_size"] if cond == "size" else None, a.extra)

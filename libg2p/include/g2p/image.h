@@ -7,30 +7,84 @@
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace g2p {
+
+namespace detail {
+
+// The storage of an Image: memory that comes zeroed from calloc, and elements
+// that a plain resize leaves as they are. A fresh image filled with zero then
+// costs nothing until a pixel is written: large blocks come straight from the
+// kernel, whose untouched pages read as zero and are never faulted in. On the
+// shared virtual machines this library runs on, faulting in a page costs more
+// than rendering it (docs/performance.md, "Fresh memory"), and a view's
+// material buffers or a label map's probabilities are mostly background.
+template <typename T>
+struct ZeroedAllocator {
+  static_assert(std::is_trivially_default_constructible_v<T> && std::is_trivially_destructible_v<T>,
+                "images hold plain values");
+  using value_type = T;
+  ZeroedAllocator() = default;
+  template <typename U>
+  ZeroedAllocator(const ZeroedAllocator<U>&) noexcept {}
+
+  T* allocate(std::size_t n) {
+    void* p = std::calloc(n == 0 ? 1 : n, sizeof(T));
+    if (p == nullptr) throw std::bad_alloc();
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t) noexcept { std::free(p); }
+  // Default-initialises: leaves calloc's zeros (or whatever was there) alone.
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+  template <typename U>
+  bool operator==(const ZeroedAllocator<U>&) const noexcept {
+    return true;
+  }
+  template <typename U>
+  bool operator!=(const ZeroedAllocator<U>&) const noexcept {
+    return false;
+  }
+};
+
+}  // namespace detail
 
 template <typename T>
 class Image {
  public:
   using value_type = T;
+  using Storage = std::vector<T, detail::ZeroedAllocator<T>>;
 
   Image() = default;
-  Image(int width, int height, int channels, T fill = T{})
-      : width_(width),
-        height_(height),
-        channels_(channels),
-        data_(static_cast<std::size_t>(width) * height * channels, fill) {
-    assert(width >= 0 && height >= 0 && channels >= 1);
-  }
+  Image(int width, int height, int channels, T fill = T{}) { reset(width, height, channels, fill); }
 
   // Gives the image a new shape, every value `fill`, reusing the storage it
   // already has when large enough (no fresh memory for repeated renders).
+  // Fresh storage filled with zero is left as calloc gave it: its pages are
+  // faulted in only where a value is written.
   void reset(int width, int height, int channels, T fill = T{}) {
     assert(width >= 0 && height >= 0 && channels >= 1);
     width_ = width, height_ = height, channels_ = channels;
-    data_.assign(static_cast<std::size_t>(width) * height * channels, fill);
+    const std::size_t n = static_cast<std::size_t>(width) * height * channels;
+    if (n > data_.capacity() && is_zero(fill)) {
+      Storage fresh;
+      fresh.resize(n);  // default-initialised: calloc's zeros
+      data_.swap(fresh);
+    } else {
+      data_.assign(n, fill);
+    }
   }
   // Empties the image (keeps the storage for a later reset).
   void clear() {
@@ -47,8 +101,8 @@ class Image {
 
   T* data() { return data_.data(); }
   const T* data() const { return data_.data(); }
-  std::vector<T>& storage() { return data_; }
-  const std::vector<T>& storage() const { return data_; }
+  Storage& storage() { return data_; }
+  const Storage& storage() const { return data_; }
 
   T* pixel(int x, int y) { return data_.data() + index(x, y, 0); }
   const T* pixel(int x, int y) const { return data_.data() + index(x, y, 0); }
@@ -66,10 +120,16 @@ class Image {
     return (static_cast<std::size_t>(y) * width_ + x) * channels_ + c;
   }
 
+  // All bits zero (so +0.0 but not -0.0): what calloc gives.
+  static bool is_zero(const T& v) {
+    const T zero{};
+    return std::memcmp(&v, &zero, sizeof(T)) == 0;
+  }
+
   int width_ = 0;
   int height_ = 0;
   int channels_ = 0;
-  std::vector<T> data_;
+  Storage data_;
 };
 
 using ImageU8 = Image<std::uint8_t>;   // colour, 0..255 per channel

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,10 +22,13 @@ std::unique_ptr<Identifier> make_vlm_identifier();         // vlm_identifier.cpp
 // level: photographs of objects are taken from about there, and views from
 // straight above or below are hard to read), width x height pixels, on a
 // background of grey `background` (0-255; -1 = the renderer's), lit by
-// `lights` (empty = studio_lights()). `who` names the backend in errors.
-Result<std::vector<View>> turntable_views(const Renderer& renderer, const Mesh& mesh, int width, int height,
-                                          int background, int count, double elevation_deg, const char* who,
-                                          const std::vector<CameraLight>& lights = {});
+// `lights` (empty = studio_lights()), each handed to `use` in turn (one View,
+// its memory reused); an error from `use` stops the loop and is returned.
+// `who` names the backend in errors.
+Status for_each_turntable_view(const Renderer& renderer, const Mesh& mesh, int width, int height, int background,
+                               int count, double elevation_deg, const char* who,
+                               const std::function<Status(const View&)>& use,
+                               const std::vector<CameraLight>& lights = {});
 
 // The box of the object's pixels in a view (its face IDs), {x1, y1, x2, y2}
 // with x2, y2 one past the last pixel; the whole view when it has no face

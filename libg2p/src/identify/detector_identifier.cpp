@@ -160,20 +160,19 @@ class DetectorIdentifier final : public Identifier {
     }
     const ObjectTable& table = in.table != nullptr ? *in.table : ObjectTable::shipped();
     const std::size_t k = card_.classes.size();
-    std::vector<View> own;
-    if (can_render) {
-      Result<std::vector<View>> rendered =
-          detail::turntable_views(*in.renderer, in.model->mesh, card_.width, card_.height, card_.background,
-                                  kTurntableViews, kTurntableElevationDeg, "detector");
-      if (!rendered.ok()) return rendered.status();
-      own = std::move(*rendered);
-    }
-    const std::vector<View>& views = own.empty() ? *in.views : own;
     std::vector<std::vector<double>> best;  // [view][class]
-    for (const View& view : views) {
+    auto score = [&](const View& view) {
       Result<std::vector<double>> scores = view_scores(view);
       if (!scores.ok()) return scores.status();
       if (!scores->empty()) best.push_back(std::move(*scores));
+      return Status::Ok();
+    };
+    if (can_render) {
+      G2P_RETURN_IF_ERROR(detail::for_each_turntable_view(*in.renderer, in.model->mesh, card_.width, card_.height,
+                                                          card_.background, kTurntableViews, kTurntableElevationDeg,
+                                                          "detector", score));
+    } else {
+      for (const View& view : *in.views) G2P_RETURN_IF_ERROR(score(view));
     }
     if (best.empty()) {
       id.notes.push_back("detector: no view shows the object");

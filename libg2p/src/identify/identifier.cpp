@@ -3,7 +3,9 @@
 // detector) and "none".
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <set>
 
@@ -174,9 +176,22 @@ class AutoIdentifier final : public Identifier {
     };
     join(*by_names);
     // A source that reads the views: its answer joined, a failure a warning.
+    // The detector and the classifier load, render and infer side by side
+    // (each loads its network on one core, and neither keeps both busy all
+    // the time); their answers are joined in a fixed order, so the result is
+    // the same as one after the other.
     const bool has_views = (in.views != nullptr && !in.views->empty()) || in.renderer != nullptr;
-    auto look = [&](const Identifier& source, const char* who) {
-      Result<Identification> seen = source.identify(in);
+    const bool detect = use_detector_ && has_views, classify = use_classifier_ && has_views;
+    auto run = [&in](const Identifier& source) -> Result<Identification> {
+      try {
+        return source.identify(in);
+      } catch (const std::exception& e) {
+        return Status::Internal(e.what());
+      }
+    };
+    std::future<Result<Identification>> classified;
+    if (detect && classify) classified = std::async(std::launch::async, run, std::cref(*classifier_));
+    auto look = [&](Result<Identification> seen, const char* who) {
       if (!seen.ok()) {
         id.warnings.push_back(std::string("the ") + who + " failed (" + seen.status().message() +
                               "); identified without it");
@@ -187,8 +202,8 @@ class AutoIdentifier final : public Identifier {
                            who + " " + seen->kind() + " (" + percent(seen->confidence()) + ")");
       join(*seen);
     };
-    if (use_detector_ && has_views) look(*detector_, "detector");
-    if (use_classifier_ && has_views) look(*classifier_, "classifier");
+    if (detect) look(run(*detector_), "detector");
+    if (classify) look(classified.valid() ? classified.get() : run(*classifier_), "classifier");
     for (auto& [kind, g] : joined) id.candidates.push_back(std::move(g));
     std::stable_sort(id.candidates.begin(), id.candidates.end(),
                      [](const KindGuess& a, const KindGuess& b) { return a.confidence > b.confidence; });

@@ -9,9 +9,10 @@
 
 namespace g2p {
 
-Result<std::vector<View>> detail::turntable_views(const Renderer& renderer, const Mesh& mesh, int width, int height,
-                                                  int background, int count, double elevation_deg, const char* who,
-                                                  const std::vector<CameraLight>& lights) {
+Status detail::for_each_turntable_view(const Renderer& renderer, const Mesh& mesh, int width, int height,
+                                       int background, int count, double elevation_deg, const char* who,
+                                       const std::function<Status(const View&)>& use,
+                                       const std::vector<CameraLight>& lights) {
   ViewOptions o;
   o.num_views = count;
   o.layout = ViewLayout::kTurntable;
@@ -24,10 +25,12 @@ Result<std::vector<View>> detail::turntable_views(const Renderer& renderer, cons
   r.material_buffers = r.geometry_buffers = false;
   r.lights = lights;
   if (background >= 0) r.background.fill(static_cast<std::uint8_t>(std::min(background, 255)));
-  std::vector<View> views(cameras->size());
-  for (std::size_t i = 0; i < views.size(); ++i)
-    G2P_RETURN_IF_ERROR(renderer.render_into((*cameras)[i], r, views[i]).with_context(std::string(who) + ": view"));
-  return views;
+  View view;  // one, reused: fresh memory costs more than rendering (performance.md)
+  for (const Camera& camera : *cameras) {
+    G2P_RETURN_IF_ERROR(renderer.render_into(camera, r, view).with_context(std::string(who) + ": view"));
+    G2P_RETURN_IF_ERROR(use(view));
+  }
+  return Status::Ok();
 }
 
 detail::PixelBox detail::object_box(const View& view) {
@@ -63,15 +66,16 @@ Result<std::vector<ImageU8>> classifier_views(const Renderer& renderer, const Me
                                               const ClassifierViewOptions& options) {
   if (options.size < 8 || options.size > 4096)
     return Status::InvalidArgument("classifier views: size " + std::to_string(options.size) + " is outside 8-4096");
-  Result<std::vector<View>> views =
-      detail::turntable_views(renderer, mesh, 2 * options.size, 2 * options.size, options.background, options.count,
-                              options.elevation_deg, "classifier views", options.lights);
-  if (!views.ok()) return views.status();
   std::vector<ImageU8> out;
-  for (const View& view : *views) {
-    ImageU8 crop = classifier_crop(view, options.size, options.background);
-    if (!crop.empty()) out.push_back(std::move(crop));
-  }
+  G2P_RETURN_IF_ERROR(detail::for_each_turntable_view(
+      renderer, mesh, 2 * options.size, 2 * options.size, options.background, options.count, options.elevation_deg,
+      "classifier views",
+      [&](const View& view) {
+        ImageU8 crop = classifier_crop(view, options.size, options.background);
+        if (!crop.empty()) out.push_back(std::move(crop));
+        return Status::Ok();
+      },
+      options.lights));
   return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include "core/file_util.h"
 #include "core/json_text.h"
+#include "core/parallel.h"
 #include "core/srgb.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
@@ -167,19 +168,14 @@ Status write_views(const std::string& dir, const std::vector<View>& views, const
   if (views.empty()) return Status::InvalidArgument("write_views: no views");
   G2P_RETURN_IF_ERROR(detail::ensure_directory(dir));
   const std::string base = dir + "/";
-  std::vector<Camera> cameras;
-  std::vector<const ImageU8*> rgb;
-  for (std::size_t i = 0; i < views.size(); ++i) {
+  // The views are encoded and written side by side (PNG encoding is most of the time).
+  const Status written = detail::parallel_each(views.size(), [&](std::size_t i) -> Status {
     const View& v = views[i];
-    cameras.push_back(v.camera);
-    if (!v.rgb.empty()) {
-      G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "rgb", "png"), v.rgb));
-      rgb.push_back(&v.rgb);
-    }
+    if (!v.rgb.empty()) G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "rgb", "png"), v.rgb));
     Result<ImageU8> ids = encode_face_ids(v.face_id);
     if (!ids.ok()) return ids.status().with_context(base + view_name(i, "faceid", "png"));
     G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "faceid", "png"), *ids));
-    if (!options.buffers) continue;
+    if (!options.buffers) return Status::Ok();
     if (!v.depth.empty())
       G2P_RETURN_IF_ERROR(
           detail::write_file_atomically(base + view_name(i, "depth", "npy"), detail::npy_float32(v.depth)));
@@ -197,7 +193,15 @@ Status write_views(const std::string& dir, const std::vector<View>& views, const
       G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "metallicroughness", "png"), to_u8(packed, 3, false)));
     }
     if (!v.transmission.empty())
-      G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "transmission", "png"), to_u8(v.transmission, 1, false)));
+      return write_image(base + view_name(i, "transmission", "png"), to_u8(v.transmission, 1, false));
+    return Status::Ok();
+  });
+  if (!written.ok()) return written;
+  std::vector<Camera> cameras;
+  std::vector<const ImageU8*> rgb;
+  for (const View& v : views) {
+    cameras.push_back(v.camera);
+    if (!v.rgb.empty()) rgb.push_back(&v.rgb);
   }
   G2P_RETURN_IF_ERROR(detail::write_file_atomically(base + "cameras.json", cameras_to_json(cameras)));
   if (!rgb.empty())

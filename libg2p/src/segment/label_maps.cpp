@@ -8,6 +8,7 @@
 
 #include "core/file_util.h"
 #include "core/json_text.h"
+#include "core/parallel.h"
 #include "g2p/io.h"
 #include "g2p/render.h"
 #include "g2p/segment.h"
@@ -57,13 +58,12 @@ Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& map
   G2P_RETURN_IF_ERROR(detail::ensure_directory(dir));
   const std::string base = dir + "/";
   ImageU8 legend = label_legend(table);
-  std::vector<ImageU8> coloured;
-  coloured.reserve(maps.size());
-  for (std::size_t i = 0; i < maps.size(); ++i) {
+  std::vector<ImageU8> coloured(maps.size());
+  // The views are encoded and written side by side (PNG encoding is most of the time).
+  const Status written = detail::parallel_each(maps.size(), [&](std::size_t i) -> Status {
     const LabelMap& map = maps[i];
     // Colour-coded labels with the legend on the right.
-    coloured.push_back(colorize_labels(map.labels, table));
-    ImageU8& colours = coloured.back();
+    ImageU8& colours = coloured[i] = colorize_labels(map.labels, table);
     ImageU8 sheet(colours.width() + legend.width(), std::max(colours.height(), legend.height()), 3);
     cv::Mat s = as_mat(sheet);
     s.setTo(cv::Scalar(255, 255, 255));
@@ -78,9 +78,10 @@ Status write_label_maps(const std::string& dir, const std::vector<LabelMap>& map
     }
     G2P_RETURN_IF_ERROR(write_image(base + view_name(i, "labels_index", "png"), index));
     if (!map.probabilities.empty())
-      G2P_RETURN_IF_ERROR(
-          detail::write_file_atomically(base + view_name(i, "probs", "npy"), detail::npy_float32(map.probabilities)));
-  }
+      return detail::write_file_atomically(base + view_name(i, "probs", "npy"), detail::npy_float32(map.probabilities));
+    return Status::Ok();
+  });
+  if (!written.ok()) return written;
   G2P_RETURN_IF_ERROR(write_image(base + "legend.png", legend));
   // All views at a glance, the legend as the last tile.
   std::vector<const ImageU8*> tiles;

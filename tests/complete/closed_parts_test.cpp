@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "complete/complete_fixtures.h"
 #include "g2p/complete.h"
@@ -165,6 +166,40 @@ TEST(ClosedParts, OpenOverlappingOrSelfIntersectingFacesAreNotKept) {
   ASSERT_TRUE(done.ok()) << done.status().message();
   EXPECT_EQ(done->parts[0].backend, "partition");
   EXPECT_EQ(done->kept_parts, 0);
+}
+
+TEST(ClosedParts, CopiesWithinTheWeldToleranceJoinAndNoOthers) {
+  // A cylinder with every triangle's own vertices, each copy moved by up to
+  // 0.45 of the weld distance in a random direction: any two copies of a
+  // corner lie within it, wherever they fall on the weld's grid.
+  const Mesh solid = cylinder_mesh(0.1f, 0.3f, 48);
+  const double tolerance = 1e-3;
+  const double eps = tolerance * bounds(solid).diagonal().norm();
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  auto moved = [&](double distance) {
+    Mesh m = split_vertices(solid);
+    for (auto& p : m.positions) {
+      Eigen::Vector3d d(unit(random), unit(random), unit(random));
+      p += (distance * d.normalized()).cast<float>();
+    }
+    return m;
+  };
+  const Mesh jittered = moved(0.45 * eps);
+  const Mesh kept = closed_part_surface(jittered, test::single_part(jittered, 1)[0], tolerance);
+  EXPECT_EQ(kept.num_faces(), solid.num_faces());
+  EXPECT_EQ(kept.num_vertices(), solid.num_vertices());
+  EXPECT_NEAR(exact_volume(kept) / exact_volume(solid), 1.0, 1e-3);
+
+  // Copies 1.1 weld distances apart along x do not join: the faces stay open.
+  Mesh apart = split_vertices(solid);
+  std::vector<int> copies(static_cast<std::size_t>(solid.num_vertices()), 0);
+  for (std::size_t f = 0; f < solid.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int n = copies[static_cast<std::size_t>(solid.triangles[f][k])]++;
+      apart.positions[3 * f + static_cast<std::size_t>(k)].x() += static_cast<float>(1.1 * eps * n);
+    }
+  EXPECT_EQ(closed_part_surface(apart, test::single_part(apart, 1)[0], tolerance).num_faces(), 0);
 }
 
 TEST(ClosedParts, OnlyTheOpenPartsAreCompleted) {

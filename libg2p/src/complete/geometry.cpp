@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace g2p::detail {
 
 using Eigen::Vector3d;
@@ -148,13 +151,15 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
     double offset = 0, tolerance = 0;
   };
   std::vector<Plane> planes(nf);
-  for (std::size_t t = 0; t < nf; ++t) {
-    const Vector3d a = tri(static_cast<int>(t), 0), b = tri(static_cast<int>(t), 1), c = tri(static_cast<int>(t), 2);
-    boxes[t].extend(a).extend(b).extend(c);
-    const Vector3d n = (b - a).cross(c - a);
-    const double length = n.norm();
-    if (length > 0) planes[t] = {n / length, n.dot(a) / length, 1e-9 * boxes[t].diagonal().norm()};
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t t = range.begin(); t != range.end(); ++t) {
+      const Vector3d a = tri(static_cast<int>(t), 0), b = tri(static_cast<int>(t), 1), c = tri(static_cast<int>(t), 2);
+      boxes[t].extend(a).extend(b).extend(c);
+      const Vector3d n = (b - a).cross(c - a);
+      const double length = n.norm();
+      if (length > 0) planes[t] = {n / length, n.dot(a) / length, 1e-9 * boxes[t].diagonal().norm()};
+    }
+  });
   // Whether all three `corners` lie strictly on one side of plane `p`
   // (never for a degenerate `p`, whose normal is zero).
   auto one_side = [&](const Plane& p, const Vector3d corners[3]) {
@@ -167,7 +172,8 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
     }
     return above == 3 || below == 3;
   };
-  for (long long c = 0; c < ncell && static_cast<int>(out.size()) < max_pairs; ++c) {
+  // The pairs found in cell c, in the order of its items.
+  auto pairs_in_cell = [&](long long c, std::vector<std::pair<int, int>>& found) {
     const int s0 = start_[static_cast<std::size_t>(c)], s1 = start_[static_cast<std::size_t>(c) + 1];
     for (int a = s0; a < s1; ++a) {
       const int ta = items_[static_cast<std::size_t>(a)];
@@ -189,8 +195,24 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
         const Vector3d t1[3] = {tri(tb, 0), tri(tb, 1), tri(tb, 2)};
         if (one_side(planes[static_cast<std::size_t>(ta)], t1) || one_side(planes[static_cast<std::size_t>(tb)], t0))
           continue;
-        if (triangles_intersect(t0, t1)) out.emplace_back(std::min(ta, tb), std::max(ta, tb));
+        if (triangles_intersect(t0, t1)) found.emplace_back(std::min(ta, tb), std::max(ta, tb));
       }
+    }
+  };
+  // Cells in waves searched side by side, joined in cell order: the pairs of
+  // whole cells until `max_pairs` is reached, as a loop over the cells in
+  // order gives, without searching far beyond the cell that reaches it.
+  constexpr long long kWave = 4096;
+  std::vector<std::vector<std::pair<int, int>>> wave(static_cast<std::size_t>(std::min(kWave, ncell)));
+  for (long long first = 0; first < ncell && static_cast<int>(out.size()) < max_pairs; first += kWave) {
+    const long long last = std::min(ncell, first + kWave);
+    tbb::parallel_for(tbb::blocked_range<long long>(first, last, 64), [&](const tbb::blocked_range<long long>& r) {
+      for (long long c = r.begin(); c != r.end(); ++c) pairs_in_cell(c, wave[static_cast<std::size_t>(c - first)]);
+    });
+    for (long long c = first; c < last; ++c) {
+      std::vector<std::pair<int, int>>& found = wave[static_cast<std::size_t>(c - first)];
+      if (static_cast<int>(out.size()) < max_pairs) out.insert(out.end(), found.begin(), found.end());
+      found.clear();
     }
   }
   return out;

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <numeric>
 
+#include <tbb/parallel_sort.h>
+
 #include "complete/geometry.h"
 #include "g2p/complete.h"
 
@@ -35,8 +37,8 @@ std::vector<int> opposite_half_edges(const Mesh& mesh) {
     const std::uint64_t key = (static_cast<std::uint64_t>(std::min(from, to)) << 32) | std::max(from, to);
     edges[h] = {key, static_cast<int>(h)};
   }
-  std::sort(edges.begin(), edges.end());
-  auto forward = [&](int h) {  // runs from the lower vertex index to the higher
+  tbb::parallel_sort(edges.begin(), edges.end());  // a total order: the same result as std::sort
+  auto forward = [&](int h) {                      // runs from the lower vertex index to the higher
     const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(h / 3)];
     return t[h % 3] < t[(h % 3 + 1) % 3];
   };

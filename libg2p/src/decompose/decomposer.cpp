@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
-#include <set>
 #include <sstream>
 
 #include "decompose/backends.h"
@@ -215,14 +214,17 @@ ConvexDecomposition decompose_one(const Completion& completion, const Decomposer
   DecomposeOptions own = options;
   if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * bounds(*object).diagonal().norm();
   if (object != nullptr && parts != nullptr && i < parts->size()) {
-    std::set<std::array<float, 3>> corners;  // the part's distinct vertex positions
+    std::vector<std::array<float, 3>> corners;  // the part's distinct vertex positions
+    corners.reserve((*parts)[i].faces.size() * 3);
     for (int f : (*parts)[i].faces)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3f& p =
             object->positions[static_cast<std::size_t>(object->triangles[static_cast<std::size_t>(f)][k])];
-        corners.insert({p.x(), p.y(), p.z()});
+        corners.push_back({p.x(), p.y(), p.z()});
       }
-    own.max_vertices_per_hull = std::clamp(static_cast<int>(corners.size()), 4, options.max_vertices_per_hull);
+    std::sort(corners.begin(), corners.end());
+    const auto distinct = std::unique(corners.begin(), corners.end()) - corners.begin();
+    own.max_vertices_per_hull = std::clamp(static_cast<int>(distinct), 4, options.max_vertices_per_hull);
   }
   Result<ConvexDecomposition> d = decompose_part(closed, decomposer, own);
   if (!d.ok()) {

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include <tbb/parallel_sort.h>
+
 #include "g2p/project.h"
 
 namespace g2p {
@@ -87,8 +89,11 @@ Result<FaceGraph> build_face_graph(const Mesh& mesh, double weld_tolerance) {
       edges.push_back({(lo << 32) | hi, static_cast<int>(f)});
     }
   }
-  std::sort(edges.begin(), edges.end(),
-            [](const EdgeRef& x, const EdgeRef& y) { return x.key != y.key ? x.key < y.key : x.face < y.face; });
+  // Elements that compare equal are equal (same key, same face): the parallel
+  // sort gives what std::sort gives.
+  tbb::parallel_sort(edges.begin(), edges.end(), [](const EdgeRef& x, const EdgeRef& y) {
+    return x.key != y.key ? x.key < y.key : x.face < y.face;
+  });
 
   // Count, then fill, the neighbour lists (compressed rows).
   std::vector<int> degree(nf, 0);

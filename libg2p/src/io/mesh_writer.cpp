@@ -3,9 +3,10 @@
 #include <cctype>
 #include <cstdint>
 #include <cstring>
-#include <sstream>
+#include <string>
 
 #include "core/file_util.h"
+#include "core/number_text.h"
 #include "g2p/io.h"
 
 namespace g2p {
@@ -20,12 +21,26 @@ void put(std::string& out, T value) {
 }
 
 std::string obj_text(const Mesh& mesh) {
-  std::ostringstream s;
-  s.precision(9);
-  s << "# libg2p mesh: " << mesh.num_vertices() << " vertices, " << mesh.num_faces() << " triangles, metres\n";
-  for (const auto& p : mesh.positions) s << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  for (const auto& t : mesh.triangles) s << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-  return s.str();
+  std::string s = "# libg2p mesh: " + std::to_string(mesh.num_vertices()) + " vertices, " +
+                  std::to_string(mesh.num_faces()) + " triangles, metres\n";
+  s.reserve(s.size() + mesh.positions.size() * 40 + mesh.triangles.size() * 24);
+  for (const auto& p : mesh.positions) {  // "v %.9g %.9g %.9g"
+    s += 'v';
+    for (int a = 0; a < 3; ++a) {
+      s += ' ';
+      detail::append_general(s, p[a], 9);
+    }
+    s += '\n';
+  }
+  for (const auto& t : mesh.triangles) {  // "f %d %d %d", from 1
+    s += 'f';
+    for (int a = 0; a < 3; ++a) {
+      s += ' ';
+      detail::append_integer(s, t[a] + 1);
+    }
+    s += '\n';
+  }
+  return s;
 }
 
 std::string ply_bytes(const Mesh& mesh) {

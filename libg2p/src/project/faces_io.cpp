@@ -10,6 +10,7 @@
 #include "core/csv.h"
 #include "core/file_util.h"
 #include "core/json_text.h"
+#include "core/number_text.h"
 #include "core/parallel.h"
 #include "g2p/project.h"
 #include "g2p/segment.h"
@@ -88,18 +89,26 @@ Status write_faces_csv(const std::string& path, const Model& model, const Projec
     std::string& out = blocks[b];
     const std::size_t end = std::min(nf, (b + 1) * kBlock);
     out.reserve((end - b * kBlock) * 64);
-    char numbers[96];
     for (std::size_t f = b * kBlock; f < end; ++f) {
       const FaceSource s = mesh.face_source.empty() ? FaceSource{} : mesh.face_source[f];
       const int label = projection.labels.label[f];
-      std::snprintf(numbers, sizeof(numbers), "%d,%d,%d,", s.mesh, s.face, s.material);
-      out += numbers;
+      // As "%d,%d,%d,<name>,<label>,%.4f,%.9g,%d\n".
+      detail::append_integer(out, s.mesh);
+      out += ',';
+      detail::append_integer(out, s.face);
+      out += ',';
+      detail::append_integer(out, s.material);
+      out += ',';
       out += csv_field(model.material_name(static_cast<int>(f)));
       out += ',';
-      out += table.valid_label(label) ? csv_field(table[label].name) : std::string();
-      std::snprintf(numbers, sizeof(numbers), ",%.4f,%.9g,%d\n", projection.labels.confidence[f],
-                    face_area(mesh, static_cast<int>(f)), projection.face_part[f]);
-      out += numbers;
+      if (table.valid_label(label)) out += csv_field(table[label].name);
+      out += ',';
+      detail::append_fixed(out, projection.labels.confidence[f], 4);
+      out += ',';
+      detail::append_general(out, face_area(mesh, static_cast<int>(f)), 9);
+      out += ',';
+      detail::append_integer(out, projection.face_part[f]);
+      out += '\n';
     }
     return Status::Ok();
   });

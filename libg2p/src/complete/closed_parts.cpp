@@ -21,6 +21,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "complete/closed_parts.h"
+#include "core/cell_index.h"
 #include "g2p/complete.h"
 
 namespace g2p {
@@ -60,52 +61,6 @@ Mesh welded_part(const Mesh& mesh, const Part& part, const std::vector<int>& rep
   return out;
 }
 
-// Grid cells keyed by their packed coordinates, each holding its vertices in
-// the order they were added (a list threaded through `next`): open addressing
-// with linear probing, one array, no allocation per cell.
-class CellLists {
- public:
-  explicit CellLists(std::size_t vertices) : next_(vertices, -1) {
-    std::size_t capacity = 16;
-    while (capacity < 2 * vertices) capacity *= 2;
-    slots_.assign(capacity, Slot{});
-  }
-  // The first vertex of cell `key`, or -1.
-  int first(std::uint64_t key) const {
-    for (std::size_t i = hash(key);; i = (i + 1) & (slots_.size() - 1)) {
-      const Slot& s = slots_[i];
-      if (s.head < 0) return -1;
-      if (s.key == key) return s.head;
-    }
-  }
-  int next(int v) const { return next_[static_cast<std::size_t>(v)]; }
-  void append(std::uint64_t key, int v) {
-    for (std::size_t i = hash(key);; i = (i + 1) & (slots_.size() - 1)) {
-      Slot& s = slots_[i];
-      if (s.head < 0) {
-        s = {key, v, v};
-        return;
-      }
-      if (s.key == key) {
-        next_[static_cast<std::size_t>(s.tail)] = v;
-        s.tail = v;
-        return;
-      }
-    }
-  }
-
- private:
-  struct Slot {
-    std::uint64_t key = 0;
-    int head = -1, tail = -1;
-  };
-  std::size_t hash(std::uint64_t key) const {
-    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & (slots_.size() - 1);
-  }
-  std::vector<Slot> slots_;
-  std::vector<int> next_;
-};
-
 // Vertex representatives: each vertex's first earlier vertex within `eps`
 // (a hash grid of cells 2 eps wide; of the 27 cells around a vertex's own,
 // only those nearer than eps along every axis can hold one, at most 8).
@@ -114,59 +69,50 @@ std::vector<int> weld(const Mesh& mesh, const Part& part, double eps) {
   std::iota(rep.begin(), rep.end(), 0);
   if (!(eps > 0)) return rep;
   const double cell = 2.0 * eps;
-  auto key = [](long long x, long long y, long long z) {
-    return (static_cast<std::uint64_t>(x) & 0x1FFFFF) | ((static_cast<std::uint64_t>(y) & 0x1FFFFF) << 21) |
-           ((static_cast<std::uint64_t>(z) & 0x1FFFFF) << 42);
-  };
   // A neighbour on the low (high) side along an axis is searched unless the
   // vertex lies in the high (low) half of its cell by more than rounding:
   // every point of that neighbour is then more than eps away.
   constexpr double kMargin = 1e-6;
-  std::size_t used = 0;
   std::vector<char> seen(mesh.positions.size(), 0);
+  std::vector<int> order;  // the part's vertices, in the order first met
+  order.reserve(part.faces.size());
   for (int f : part.faces)
     if (f >= 0 && f < mesh.num_faces())
       for (int c = 0; c < 3; ++c) {
-        char& s = seen[static_cast<std::size_t>(mesh.triangles[static_cast<std::size_t>(f)][c])];
-        used += s == 0;
-        s = 1;
+        const int v = mesh.triangles[static_cast<std::size_t>(f)][c];
+        if (!seen[static_cast<std::size_t>(v)]) order.push_back(v);
+        seen[static_cast<std::size_t>(v)] = 1;
       }
-  std::fill(seen.begin(), seen.end(), 0);
-  CellLists cells(std::max<std::size_t>(used, 1));
-  std::vector<int> order;  // cell lists hold positions in `order`: indices 0..used
-  order.reserve(used);
-  for (int f : part.faces) {
-    if (f < 0 || f >= mesh.num_faces()) continue;
-    for (int c = 0; c < 3; ++c) {
-      const int v = mesh.triangles[static_cast<std::size_t>(f)][c];
-      if (seen[static_cast<std::size_t>(v)]) continue;
-      seen[static_cast<std::size_t>(v)] = 1;
-      const Eigen::Vector3d p = mesh.positions[static_cast<std::size_t>(v)].cast<double>() / cell;
-      const Eigen::Vector3d lo = p.array().floor();
-      const Eigen::Vector3d frac = p - lo;
-      const long long x = static_cast<long long>(lo.x()), y = static_cast<long long>(lo.y()),
-                      z = static_cast<long long>(lo.z());
-      auto from = [&](int a) { return frac[a] > 0.5 + kMargin ? 0 : -1; };
-      auto to = [&](int a) { return frac[a] < 0.5 - kMargin ? 0 : 1; };
-      int found = -1;
-      for (int dz = from(2); dz <= to(2) && found < 0; ++dz)
-        for (int dy = from(1); dy <= to(1) && found < 0; ++dy)
-          for (int dx = from(0); dx <= to(0) && found < 0; ++dx)
-            for (int i = cells.first(key(x + dx, y + dy, z + dz)); i >= 0; i = cells.next(i)) {
-              const int r = order[static_cast<std::size_t>(i)];
-              if ((mesh.positions[static_cast<std::size_t>(r)] - mesh.positions[static_cast<std::size_t>(v)])
-                      .cast<double>()
-                      .norm() <= eps) {
-                found = r;
-                break;
-              }
-            }
-      if (found >= 0) {
-        rep[static_cast<std::size_t>(v)] = found;
-      } else {
-        cells.append(key(x, y, z), static_cast<int>(order.size()));
-        order.push_back(v);
-      }
+  // Each cell's representatives, newest first: `head` in the index, then
+  // `next` (by vertex); the search wants the earliest within eps in a cell.
+  detail::CellIndex cells(order.size());
+  std::vector<int> next(mesh.positions.size(), -1);
+  for (const int v : order) {
+    const Eigen::Vector3d p = mesh.positions[static_cast<std::size_t>(v)].cast<double>() / cell;
+    const Eigen::Vector3d lo = p.array().floor();
+    const Eigen::Vector3d frac = p - lo;
+    const long long x = static_cast<long long>(lo.x()), y = static_cast<long long>(lo.y()),
+                    z = static_cast<long long>(lo.z());
+    auto from = [&](int a) { return frac[a] > 0.5 + kMargin ? 0 : -1; };
+    auto to = [&](int a) { return frac[a] < 0.5 - kMargin ? 0 : 1; };
+    int found = -1;
+    for (int dz = from(2); dz <= to(2) && found < 0; ++dz)
+      for (int dy = from(1); dy <= to(1) && found < 0; ++dy)
+        for (int dx = from(0); dx <= to(0) && found < 0; ++dx) {
+          const int* head = cells.find(detail::CellIndex::key(x + dx, y + dy, z + dz));
+          if (head == nullptr) continue;
+          for (int r = *head; r >= 0; r = next[static_cast<std::size_t>(r)])
+            if ((mesh.positions[static_cast<std::size_t>(r)] - mesh.positions[static_cast<std::size_t>(v)])
+                    .cast<double>()
+                    .norm() <= eps)
+              found = r;  // the last found is the earliest added
+        }
+    if (found >= 0) {
+      rep[static_cast<std::size_t>(v)] = found;
+    } else {
+      int& head = cells.at(detail::CellIndex::key(x, y, z), -1);
+      next[static_cast<std::size_t>(v)] = head;
+      head = v;
     }
   }
   return rep;

@@ -12,10 +12,10 @@
 // (non-manifold edges link every pair of their faces).
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 #include <tbb/parallel_sort.h>
 
+#include "core/cell_index.h"
 #include "g2p/project.h"
 
 namespace g2p {
@@ -35,13 +35,9 @@ Result<FaceGraph> build_face_graph(const Mesh& mesh, double weld_tolerance) {
   } else {
     const double cell = 2.0 * eps;
     const Eigen::Vector3d origin = box.min();
-    auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
-      return (static_cast<std::uint64_t>(x) & 0x1FFFFF) | ((static_cast<std::uint64_t>(y) & 0x1FFFFF) << 21) |
-             ((static_cast<std::uint64_t>(z) & 0x1FFFFF) << 42);
-    };
-    std::unordered_map<std::uint64_t, int> head;  // cell -> first representative in it
-    std::vector<int> next(nv, -1);                // chain of representatives in a cell
-    head.reserve(nv);
+    auto key = &detail::CellIndex::key;
+    detail::CellIndex head(nv);     // cell -> first representative in it
+    std::vector<int> next(nv, -1);  // chain of representatives in a cell
     for (std::size_t v = 0; v < nv; ++v) {
       const Eigen::Vector3d p = (mesh.positions[v].cast<double>() - origin) / cell;
       const Eigen::Vector3d fl = p.array().floor();
@@ -50,10 +46,10 @@ Result<FaceGraph> build_face_graph(const Mesh& mesh, double weld_tolerance) {
       const int dir[3] = {p.x() - fl.x() < 0.5 ? -1 : 1, p.y() - fl.y() < 0.5 ? -1 : 1, p.z() - fl.z() < 0.5 ? -1 : 1};
       int rep = -1;
       for (int i = 0; i < 8 && rep < 0; ++i) {
-        const auto it =
+        const int* first =
             head.find(key(c[0] + ((i & 1) ? dir[0] : 0), c[1] + ((i & 2) ? dir[1] : 0), c[2] + ((i & 4) ? dir[2] : 0)));
-        if (it == head.end()) continue;
-        for (int r = it->second; r >= 0; r = next[static_cast<std::size_t>(r)]) {
+        if (first == nullptr) continue;
+        for (int r = *first; r >= 0; r = next[static_cast<std::size_t>(r)]) {
           if ((mesh.positions[static_cast<std::size_t>(r)] - mesh.positions[v]).cast<double>().norm() <= eps) {
             rep = r;
             break;
@@ -65,11 +61,9 @@ Result<FaceGraph> build_face_graph(const Mesh& mesh, double weld_tolerance) {
         continue;
       }
       g.welded_vertex[v] = static_cast<int>(v);
-      auto [it, inserted] = head.emplace(key(c[0], c[1], c[2]), static_cast<int>(v));
-      if (!inserted) {
-        next[v] = it->second;
-        it->second = static_cast<int>(v);
-      }
+      int& first = head.at(key(c[0], c[1], c[2]), -1);
+      next[v] = first;
+      first = static_cast<int>(v);
     }
   }
 

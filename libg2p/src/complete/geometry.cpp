@@ -151,10 +151,12 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
     double offset = 0, tolerance = 0;
   };
   std::vector<Plane> planes(nf);
+  std::vector<Eigen::Vector3i> low_cell(nf);  // the cell of each box's low corner
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t t = range.begin(); t != range.end(); ++t) {
       const Vector3d a = tri(static_cast<int>(t), 0), b = tri(static_cast<int>(t), 1), c = tri(static_cast<int>(t), 2);
       boxes[t].extend(a).extend(b).extend(c);
+      low_cell[t] = cell_of(boxes[t].min());
       const Vector3d n = (b - a).cross(c - a);
       const double length = n.norm();
       if (length > 0) planes[t] = {n / length, n.dot(a) / length, 1e-9 * boxes[t].diagonal().norm()};
@@ -188,8 +190,11 @@ std::vector<std::pair<int, int>> TriangleBins::intersecting_pairs(int max_pairs)
         const auto& ba = boxes[static_cast<std::size_t>(ta)];
         const auto& bb = boxes[static_cast<std::size_t>(tb)];
         if (!ba.intersects(bb)) continue;
-        // Test each pair once: in the cell holding the low corner of the boxes' overlap.
-        const Eigen::Vector3i low = cell_of(ba.intersection(bb).min());
+        // Test each pair once: in the cell holding the low corner of the
+        // boxes' overlap, the larger low corner on each axis (cell_of is
+        // monotone along each axis).
+        const Eigen::Vector3i low =
+            low_cell[static_cast<std::size_t>(ta)].cwiseMax(low_cell[static_cast<std::size_t>(tb)]);
         if (index(low.x(), low.y(), low.z()) != c) continue;
         const Vector3d t0[3] = {tri(ta, 0), tri(ta, 1), tri(ta, 2)};
         const Vector3d t1[3] = {tri(tb, 0), tri(tb, 1), tri(tb, 2)};

@@ -214,12 +214,15 @@ ConvexDecomposition decompose_one(const Completion& completion, const Decomposer
   DecomposeOptions own = options;
   if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * bounds(*object).diagonal().norm();
   if (object != nullptr && parts != nullptr && i < parts->size()) {
-    std::vector<std::array<float, 3>> corners;  // the part's distinct vertex positions
-    corners.reserve((*parts)[i].faces.size() * 3);
+    // The part's distinct vertex positions: those of its vertices, sorted.
+    std::vector<char> used(object->positions.size(), 0);
+    std::vector<std::array<float, 3>> corners;
     for (int f : (*parts)[i].faces)
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3f& p =
-            object->positions[static_cast<std::size_t>(object->triangles[static_cast<std::size_t>(f)][k])];
+        const auto v = static_cast<std::size_t>(object->triangles[static_cast<std::size_t>(f)][k]);
+        if (used[v]) continue;
+        used[v] = 1;
+        const Eigen::Vector3f& p = object->positions[v];
         corners.push_back({p.x(), p.y(), p.z()});
       }
     std::sort(corners.begin(), corners.end());

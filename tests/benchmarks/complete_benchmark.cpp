@@ -2,7 +2,8 @@
 // (40 k triangles) split 4-to-1 up to three times (2.56 M), one part per
 // source material. The reference in the same run is CGAL's alpha wrapping of
 // the same parts (the optional g2p::cgal component, when built), the approach
-// the partition completer replaces. docs/performance.md records the figures:
+// the partition completer replaces. BM_ClosedPartSurface times the check that
+// keeps a part already closed. docs/performance.md records the figures:
 //
 //   build/bin/g2p_complete_benchmark --benchmark_min_time=1
 #include <benchmark/benchmark.h>
@@ -95,6 +96,32 @@ BENCHMARK(BM_PartitionByResolution)
 // Partition without the simplification pass (the marching-tetrahedra surface as is).
 void BM_PartitionNoSimplify(benchmark::State& state) { run(state, "partition", {{"simplify", "0"}}, 1); }
 BENCHMARK(BM_PartitionNoSimplify)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Is a part already a solid? closed_part_surface (welding, the closed,
+// manifold and orientation checks, the self-intersection search) on a
+// sphere of 524,288 triangles, an octahedron split 4-to-1 eight times with
+// every vertex pushed onto the sphere: the check every kept part of a
+// million-triangle mesh goes through.
+void BM_ClosedPartSurface(benchmark::State& state) {
+  static const g2p::Mesh sphere = [] {
+    g2p::Mesh m;
+    m.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (int level = 0; level < 8; ++level) {
+      m = g2p::bench::subdivide(m);
+      for (auto& p : m.positions) p = 0.3f * p.normalized();
+    }
+    return m;
+  }();
+  g2p::Part part;
+  part.label = 0;
+  for (int f = 0; f < sphere.num_faces(); ++f) part.faces.push_back(f);
+  int kept = 0;
+  for (auto _ : state) kept = g2p::closed_part_surface(sphere, part).num_faces();
+  state.counters["triangles"] = sphere.num_faces();
+  state.counters["kept_triangles"] = kept;
+}
+BENCHMARK(BM_ClosedPartSurface)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 #ifdef G2P_BENCH_WITH_CGAL
 // Reference: CGAL alpha wrapping part by part, on the base chair only.

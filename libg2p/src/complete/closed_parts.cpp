@@ -168,12 +168,13 @@ bool edges_pair_up(const Mesh& m) {
       edges.push_back((static_cast<std::uint64_t>(static_cast<std::uint32_t>(t[e])) << 32) |
                       static_cast<std::uint32_t>(t[(e + 1) % 3]));
   tbb::parallel_sort(edges.begin(), edges.end());
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    if (i + 1 < edges.size() && edges[i + 1] == edges[i]) return false;
-    const std::uint64_t reverse = (edges[i] << 32) | (edges[i] >> 32);
-    if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
-  }
-  return true;
+  if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
+  // Without repeats, every edge's reverse is present exactly when the
+  // reversed edges are the same set: one more sort, not a search per edge.
+  std::vector<std::uint64_t> reversed(edges.size());
+  std::transform(edges.begin(), edges.end(), reversed.begin(), [](std::uint64_t e) { return (e << 32) | (e >> 32); });
+  tbb::parallel_sort(reversed.begin(), reversed.end());
+  return reversed == edges;
 }
 
 // Orients every component so that the winding number is 0 or 1 on both

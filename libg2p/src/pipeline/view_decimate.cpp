@@ -5,8 +5,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
-#include <unordered_set>
+#include <vector>
+
+#include "core/cell_index.h"
 
 namespace g2p::detail {
 namespace {
@@ -14,17 +15,19 @@ namespace {
 // The faces as they are, with only the vertices they use.
 ViewMesh extract(const Mesh& mesh, const std::vector<int>& faces) {
   ViewMesh out;
-  std::unordered_map<int, int> index;
-  index.reserve(faces.size() * 2);
+  std::vector<int> index(mesh.positions.size(), -1);  // each vertex's in `out`, -1 before it is met
   out.mesh.triangles.reserve(faces.size());
   out.source_face.reserve(faces.size());
   for (int f : faces) {
     Eigen::Vector3i t;
     for (int k = 0; k < 3; ++k) {
       const int v = mesh.triangles[static_cast<std::size_t>(f)][k];
-      auto [it, added] = index.emplace(v, static_cast<int>(out.mesh.positions.size()));
-      if (added) out.mesh.positions.push_back(mesh.positions[static_cast<std::size_t>(v)]);
-      t[k] = it->second;
+      int& i = index[static_cast<std::size_t>(v)];
+      if (i < 0) {
+        i = static_cast<int>(out.mesh.positions.size());
+        out.mesh.positions.push_back(mesh.positions[static_cast<std::size_t>(v)]);
+      }
+      t[k] = i;
     }
     out.mesh.triangles.push_back(t);
     out.source_face.push_back(f);
@@ -42,32 +45,37 @@ ViewMesh cluster(const Mesh& mesh, const std::vector<int>& faces, const Eigen::A
     return (c(0) << 42) | (c(1) << 21) | c(2);
   };
   ViewMesh out;
-  std::unordered_map<std::uint64_t, int> cluster_of;
+  // Flat tables (a million-triangle part is clustered several times):
+  // each cell's cluster, each vertex's cluster (-1 before it is met).
+  CellIndex cluster_of(3 * faces.size());
   std::vector<Eigen::Vector3d> sums;
   std::vector<int> counts;
-  std::unordered_map<int, int> vertex_cluster;
-  std::unordered_set<std::uint64_t> seen;
+  std::vector<int> vertex_cluster(mesh.positions.size(), -1);
+  CellIndex seen(faces.size());  // output triangles, by their sorted clusters
   for (int f : faces) {
     std::array<int, 3> t{};
     for (int k = 0; k < 3; ++k) {
       const int v = mesh.triangles[static_cast<std::size_t>(f)][k];
-      auto found = vertex_cluster.find(v);
-      if (found == vertex_cluster.end()) {
+      int& found = vertex_cluster[static_cast<std::size_t>(v)];
+      if (found < 0) {
         const Eigen::Vector3f& p = mesh.positions[static_cast<std::size_t>(v)];
-        auto [it, added] = cluster_of.emplace(key_of(p), static_cast<int>(sums.size()));
-        if (added) sums.emplace_back(Eigen::Vector3d::Zero()), counts.push_back(0);
-        sums[static_cast<std::size_t>(it->second)] += p.cast<double>();
-        ++counts[static_cast<std::size_t>(it->second)];
-        found = vertex_cluster.emplace(v, it->second).first;
+        found = cluster_of.at(key_of(p), static_cast<int>(sums.size()));
+        if (found == static_cast<int>(sums.size())) sums.emplace_back(Eigen::Vector3d::Zero()), counts.push_back(0);
+        sums[static_cast<std::size_t>(found)] += p.cast<double>();
+        ++counts[static_cast<std::size_t>(found)];
       }
-      t[static_cast<std::size_t>(k)] = found->second;
+      t[static_cast<std::size_t>(k)] = found;
     }
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
     std::array<int, 3> sorted = t;
     std::sort(sorted.begin(), sorted.end());
     const std::uint64_t id = (static_cast<std::uint64_t>(sorted[0]) << 42) ^
                              (static_cast<std::uint64_t>(sorted[1]) << 21) ^ static_cast<std::uint64_t>(sorted[2]);
-    if (sorted[2] < (1 << 21) && !seen.insert(id).second) continue;  // the same triangle twice
+    if (sorted[2] < (1 << 21)) {  // the same triangle twice
+      int& met = seen.at(id, 0);
+      if (met != 0) continue;
+      met = 1;
+    }
     out.mesh.triangles.emplace_back(t[0], t[1], t[2]);
     out.source_face.push_back(f);
   }

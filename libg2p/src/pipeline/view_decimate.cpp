@@ -47,11 +47,11 @@ ViewMesh cluster(const Mesh& mesh, const std::vector<int>& faces, const Eigen::A
   ViewMesh out;
   // Flat tables (a million-triangle part is clustered several times):
   // each cell's cluster, each vertex's cluster (-1 before it is met).
-  CellIndex cluster_of(3 * faces.size());
+  CellIndex cluster_of(std::min(3 * faces.size(), mesh.positions.size()) / 4);  // grows as needed
   std::vector<Eigen::Vector3d> sums;
   std::vector<int> counts;
   std::vector<int> vertex_cluster(mesh.positions.size(), -1);
-  CellIndex seen(faces.size());  // output triangles, by their sorted clusters
+  CellIndex seen(faces.size() / 4);  // output triangles, by their sorted clusters
   for (int f : faces) {
     std::array<int, 3> t{};
     for (int k = 0; k < 3; ++k) {

@@ -35,37 +35,41 @@ int find_root(std::vector<int>& parent, int x) {
   return x;
 }
 
-// The welded, compacted faces of `part`, without triangles that welding
-// collapsed.
-Mesh welded_part(const Mesh& mesh, const Part& part, const std::vector<int>& rep, std::vector<int>* source) {
-  Mesh out;
-  std::vector<int> index(mesh.positions.size(), -1);  // representative -> compacted vertex
-  auto vertex = [&](int v) {
-    const int r = rep[static_cast<std::size_t>(v)];
-    int& i = index[static_cast<std::size_t>(r)];
-    if (i < 0) {
-      i = static_cast<int>(out.positions.size());
-      out.positions.push_back(mesh.positions[static_cast<std::size_t>(r)]);
-    }
-    return i;
-  };
-  out.triangles.reserve(part.faces.size());
+// The part's faces with every vertex numbered in the order first met (no
+// array the size of the whole mesh: an object of a thousand parts is welded
+// a thousand times).
+struct LocalFaces {
+  std::vector<int> vertex;               // mesh vertex of each local one
+  std::vector<Eigen::Vector3i> corners;  // local corners of each face kept
+  std::vector<int> face;                 // its index in the mesh
+};
+
+LocalFaces local_faces(const Mesh& mesh, const Part& part) {
+  LocalFaces out;
+  detail::CellIndex local(part.faces.size());  // mesh vertex -> local vertex
+  out.corners.reserve(part.faces.size());
+  out.face.reserve(part.faces.size());
   for (int f : part.faces) {
     if (f < 0 || f >= mesh.num_faces()) continue;
-    const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(f)];
-    const Eigen::Vector3i w(vertex(t[0]), vertex(t[1]), vertex(t[2]));
-    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
-    out.triangles.push_back(w);
-    if (source != nullptr) source->push_back(f);
+    Eigen::Vector3i t;
+    for (int c = 0; c < 3; ++c) {
+      const int v = mesh.triangles[static_cast<std::size_t>(f)][c];
+      const int next = static_cast<int>(out.vertex.size());
+      t[c] = local.at(static_cast<std::uint64_t>(v), next);
+      if (t[c] == next) out.vertex.push_back(v);
+    }
+    out.corners.push_back(t);
+    out.face.push_back(f);
   }
   return out;
 }
 
-// Vertex representatives: each vertex's first earlier vertex within `eps`
-// (a hash grid of cells 2 eps wide; of the 27 cells around a vertex's own,
-// only those nearer than eps along every axis can hold one, at most 8).
-std::vector<int> weld(const Mesh& mesh, const Part& part, double eps) {
-  std::vector<int> rep(mesh.positions.size());
+// Local vertex representatives: each vertex's first earlier vertex within
+// `eps` (a hash grid of cells 2 eps wide; of the 27 cells around a vertex's
+// own, only those nearer than eps along every axis can hold one, at most 8).
+std::vector<int> weld(const Mesh& mesh, const LocalFaces& part, double eps) {
+  const std::size_t n = part.vertex.size();
+  std::vector<int> rep(n);
   std::iota(rep.begin(), rep.end(), 0);
   if (!(eps > 0)) return rep;
   const double cell = 2.0 * eps;
@@ -73,22 +77,15 @@ std::vector<int> weld(const Mesh& mesh, const Part& part, double eps) {
   // vertex lies in the high (low) half of its cell by more than rounding:
   // every point of that neighbour is then more than eps away.
   constexpr double kMargin = 1e-6;
-  std::vector<char> seen(mesh.positions.size(), 0);
-  std::vector<int> order;  // the part's vertices, in the order first met
-  order.reserve(part.faces.size());
-  for (int f : part.faces)
-    if (f >= 0 && f < mesh.num_faces())
-      for (int c = 0; c < 3; ++c) {
-        const int v = mesh.triangles[static_cast<std::size_t>(f)][c];
-        if (!seen[static_cast<std::size_t>(v)]) order.push_back(v);
-        seen[static_cast<std::size_t>(v)] = 1;
-      }
+  auto position = [&](int i) {
+    return mesh.positions[static_cast<std::size_t>(part.vertex[static_cast<std::size_t>(i)])];
+  };
   // Each cell's representatives, newest first: `head` in the index, then
-  // `next` (by vertex); the search wants the earliest within eps in a cell.
-  detail::CellIndex cells(order.size());
-  std::vector<int> next(mesh.positions.size(), -1);
-  for (const int v : order) {
-    const Eigen::Vector3d p = mesh.positions[static_cast<std::size_t>(v)].cast<double>() / cell;
+  // `next`; the search wants the earliest within eps in a cell.
+  detail::CellIndex cells(n);
+  std::vector<int> next(n, -1);
+  for (int v = 0; v < static_cast<int>(n); ++v) {
+    const Eigen::Vector3d p = position(v).cast<double>() / cell;
     const Eigen::Vector3d lo = p.array().floor();
     const Eigen::Vector3d frac = p - lo;
     const long long x = static_cast<long long>(lo.x()), y = static_cast<long long>(lo.y()),
@@ -102,10 +99,7 @@ std::vector<int> weld(const Mesh& mesh, const Part& part, double eps) {
           const int* head = cells.find(detail::CellIndex::key(x + dx, y + dy, z + dz));
           if (head == nullptr) continue;
           for (int r = *head; r >= 0; r = next[static_cast<std::size_t>(r)])
-            if ((mesh.positions[static_cast<std::size_t>(r)] - mesh.positions[static_cast<std::size_t>(v)])
-                    .cast<double>()
-                    .norm() <= eps)
-              found = r;  // the last found is the earliest added
+            if ((position(r) - position(v)).cast<double>().norm() <= eps) found = r;  // the last found is the earliest
         }
     if (found >= 0) {
       rep[static_cast<std::size_t>(v)] = found;
@@ -116,6 +110,30 @@ std::vector<int> weld(const Mesh& mesh, const Part& part, double eps) {
     }
   }
   return rep;
+}
+
+// The welded, compacted faces, without triangles that welding collapsed.
+Mesh welded_part(const Mesh& mesh, const LocalFaces& part, const std::vector<int>& rep, std::vector<int>* source) {
+  Mesh out;
+  std::vector<int> index(part.vertex.size(), -1);  // representative -> compacted vertex
+  auto vertex = [&](int v) {
+    const int r = rep[static_cast<std::size_t>(v)];
+    int& i = index[static_cast<std::size_t>(r)];
+    if (i < 0) {
+      i = static_cast<int>(out.positions.size());
+      out.positions.push_back(mesh.positions[static_cast<std::size_t>(part.vertex[static_cast<std::size_t>(r)])]);
+    }
+    return i;
+  };
+  out.triangles.reserve(part.corners.size());
+  for (std::size_t k = 0; k < part.corners.size(); ++k) {
+    const Eigen::Vector3i& t = part.corners[k];
+    const Eigen::Vector3i w(vertex(t[0]), vertex(t[1]), vertex(t[2]));
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
+    out.triangles.push_back(w);
+    if (source != nullptr) source->push_back(part.face[k]);
+  }
+  return out;
 }
 
 // Signed crossings of the ray from `p` along a fixed, slightly skewed
@@ -250,17 +268,21 @@ bool orient_components(Mesh& m, bool& turned) {
 
 }  // namespace
 
-Mesh detail::welded_part_faces(const Mesh& mesh, const Part& part, double weld_tolerance, std::vector<int>* source) {
-  if (source != nullptr) source->clear();
-  if (part.faces.empty() || mesh.num_faces() == 0) return {};
-  const double eps = std::max(0.0, weld_tolerance) * bounds(mesh).diagonal().norm();
-  return welded_part(mesh, part, weld(mesh, part, eps), source);
+double detail::weld_distance(const Mesh& mesh, double weld_tolerance) {
+  return std::max(0.0, weld_tolerance) * bounds(mesh).diagonal().norm();
 }
 
-Mesh detail::closed_part_surface_checked(const Mesh& mesh, const Part& part, double weld_tolerance,
+Mesh detail::welded_part_faces(const Mesh& mesh, const Part& part, double weld_distance_m, std::vector<int>* source) {
+  if (source != nullptr) source->clear();
+  if (part.faces.empty() || mesh.num_faces() == 0) return {};
+  const LocalFaces local = local_faces(mesh, part);
+  return welded_part(mesh, local, weld(mesh, local, weld_distance_m), source);
+}
+
+Mesh detail::closed_part_surface_checked(const Mesh& mesh, const Part& part, double weld_distance_m,
                                          MeshChecks& checks) {
   checks = MeshChecks();
-  Mesh closed = detail::welded_part_faces(mesh, part, weld_tolerance);
+  Mesh closed = detail::welded_part_faces(mesh, part, weld_distance_m);
   if (closed.num_faces() < 4 || !edges_pair_up(closed)) return {};
   checks = check_closed_mesh(closed);
   // Closed and oriented within each component; orientation between
@@ -276,7 +298,7 @@ Mesh detail::closed_part_surface_checked(const Mesh& mesh, const Part& part, dou
 
 Mesh closed_part_surface(const Mesh& mesh, const Part& part, double weld_tolerance) {
   MeshChecks checks;
-  return detail::closed_part_surface_checked(mesh, part, weld_tolerance, checks);
+  return detail::closed_part_surface_checked(mesh, part, detail::weld_distance(mesh, weld_tolerance), checks);
 }
 
 }  // namespace g2p

@@ -192,9 +192,10 @@ KeptParts find_kept_parts(const CompletionInput& input, const CompletionOptions&
   kept.meshes.resize(np);
   kept.parts.resize(np);
   if (!options.keep_closed_parts) return kept;
+  const double weld = detail::weld_distance(*input.mesh, options.weld_tolerance);  // once, not per part
   tbb::parallel_for(std::size_t{0}, np, [&](std::size_t p) {
     MeshChecks checks;  // closed_part_surface's, self-intersections included
-    Mesh closed = detail::closed_part_surface_checked(*input.mesh, (*input.parts)[p], options.weld_tolerance, checks);
+    Mesh closed = detail::closed_part_surface_checked(*input.mesh, (*input.parts)[p], weld, checks);
     if (closed.num_faces() == 0) return;
     CompletedPart& part = kept.parts[p];
     part.part = static_cast<int>(p);

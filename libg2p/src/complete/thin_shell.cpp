@@ -59,7 +59,7 @@ std::vector<int> edge_connected_pieces(const Mesh& m) {
 Mesh thin_part_shell(const Mesh& mesh, const std::vector<Part>& parts, std::size_t part, double weld_tolerance) {
   if (part >= parts.size()) return {};
   std::vector<int> source;  // the object's face of every patch face
-  const Mesh patch = detail::welded_part_faces(mesh, parts[part], weld_tolerance, &source);
+  const Mesh patch = detail::welded_part_faces(mesh, parts[part], detail::weld_distance(mesh, weld_tolerance), &source);
   const int nv = patch.num_vertices(), nf = patch.num_faces();
   if (nf == 0) return {};
 

@@ -202,9 +202,10 @@ Result<ConvexDecomposition> decompose_part(const Mesh& closed, const Decomposer&
 namespace {
 
 // Part i of the completion, as decompose_parts() describes.
+// `object_diagonal`: the length of `object`'s bounding-box diagonal (0 without one).
 ConvexDecomposition decompose_one(const Completion& completion, const Decomposer& decomposer,
                                   const DecomposeOptions& options, const std::string& backend, const Mesh* object,
-                                  const std::vector<Part>* parts, std::size_t i) {
+                                  double object_diagonal, const std::vector<Part>* parts, std::size_t i) {
   ConvexDecomposition out;
   const Mesh& closed = completion.parts[i].mesh;
   if (closed.num_faces() == 0) {
@@ -212,7 +213,7 @@ ConvexDecomposition decompose_one(const Completion& completion, const Decomposer
     return out;
   }
   DecomposeOptions own = options;
-  if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * bounds(*object).diagonal().norm();
+  if (object != nullptr && own.min_depth_m == 0) own.min_depth_m = 0.01 * object_diagonal;
   if (object != nullptr && parts != nullptr && i < parts->size()) {
     // The part's distinct vertex positions: those of its vertices, sorted.
     std::vector<char> used(object->positions.size(), 0);
@@ -236,7 +237,7 @@ ConvexDecomposition decompose_one(const Completion& completion, const Decomposer
   }
   out = std::move(*d);
   if (out.backend.empty()) out.backend = backend;
-  if (object != nullptr) out.coverage_tolerance_m = options.coverage_tolerance * bounds(*object).diagonal().norm();
+  if (object != nullptr) out.coverage_tolerance_m = options.coverage_tolerance * object_diagonal;
   return out;
 }
 
@@ -264,6 +265,7 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
                                                  const Mesh* object, const std::vector<Part>* parts,
                                                  const StageProgress& progress) {
   std::vector<ConvexDecomposition> out(completion.parts.size());
+  const double object_diagonal = object != nullptr ? bounds(*object).diagonal().norm() : 0.0;  // once, not per part
   std::mutex reporting;
   std::size_t finished = 0;
   Status stop;  // the first error progress returned; guarded by `reporting`
@@ -275,7 +277,7 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
       out[i].notes.push_back("not decomposed: " + stop.message());
       return;
     }
-    out[i] = decompose_one(completion, decomposer, options, backend, object, parts, i);
+    out[i] = decompose_one(completion, decomposer, options, backend, object, object_diagonal, parts, i);
     if (!progress) return;
     std::lock_guard<std::mutex> lock(reporting);
     ++finished;
@@ -325,7 +327,7 @@ std::vector<ConvexDecomposition> decompose_parts(const Completion& completion, c
     tbb::parallel_for(std::size_t{0}, round.size(), [&](std::size_t r) {
       DecomposeOptions raised = options;
       raised.max_hulls = round[r].second;
-      again[r] = decompose_one(completion, decomposer, raised, backend, object, parts, round[r].first);
+      again[r] = decompose_one(completion, decomposer, raised, backend, object, object_diagonal, parts, round[r].first);
     });
     for (std::size_t r = 0; r < round.size(); ++r) {
       const std::size_t i = round[r].first;

@@ -9,6 +9,8 @@
 #include <mutex>
 
 #include "g2p/identify.h"
+#include "identify/kind_properties.h"
+#include "properties/report.h"
 
 namespace g2p {
 namespace {
@@ -106,6 +108,18 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
                                                      const Completion& completion, const MaterialTable& table,
                                                      const PropertyEstimator& estimator, const ObjectKind& kind,
                                                      const std::vector<View>* views, const StageProgress& progress) {
+  Result<std::shared_ptr<const SurfaceRays>> object_rays = SurfaceRays::build(object);
+  if (!object_rays.ok()) return object_rays.status().with_context("properties");
+  return detail::estimate_properties_of_kind(object, parts, completion, table, estimator, kind, views, progress,
+                                             **object_rays);
+}
+
+Result<PropertiesReport> detail::estimate_properties_of_kind(const Mesh& object, const std::vector<Part>& parts,
+                                                             const Completion& completion, const MaterialTable& table,
+                                                             const PropertyEstimator& estimator, const ObjectKind& kind,
+                                                             const std::vector<View>* views,
+                                                             const StageProgress& progress,
+                                                             const SurfaceRays& object_rays) {
   // The body: the part with the largest closed volume.
   int body = -1;
   double largest = 0.0;
@@ -117,7 +131,8 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
     }
   }
   KindEstimator by_kind(estimator, kind, parts, body);
-  Result<PropertiesReport> report = estimate_properties(object, parts, completion, table, by_kind, views, progress);
+  Result<PropertiesReport> report =
+      detail::estimate_properties(object, parts, completion, table, by_kind, views, progress, object_rays);
   if (!report.ok() || kind.hidden.empty()) return report;
 
   double fraction = 0.0;
@@ -146,7 +161,8 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
   }
   // The cavity's volume: the contents' mass with the whole cavity at 1000 kg/m^3.
   by_kind.set_contents(1.0, 1000.0);
-  Result<PropertiesReport> probe = estimate_properties(object, parts, completion, table, by_kind, views, progress);
+  Result<PropertiesReport> probe =
+      detail::estimate_properties(object, parts, completion, table, by_kind, views, progress, object_rays);
   if (!probe.ok()) return probe.status();
   const PartReport* probed = part_report(*probe, body);
   const double cavity_m3 = probed != nullptr ? probed->contents.mass_kg / 1000.0 : 0.0;
@@ -162,7 +178,8 @@ Result<PropertiesReport> estimate_properties_of_kind(const Mesh& object, const s
   }
   density = std::min(density, kMaxHiddenDensity);
   by_kind.set_contents(fill, density);
-  Result<PropertiesReport> placed = estimate_properties(object, parts, completion, table, by_kind, views, progress);
+  Result<PropertiesReport> placed =
+      detail::estimate_properties(object, parts, completion, table, by_kind, views, progress, object_rays);
   if (!placed.ok()) return placed.status();
   const PartReport* held_by = part_report(*placed, body);
   const double held = held_by != nullptr ? held_by->contents.mass_kg : 0.0;

@@ -12,7 +12,9 @@
 
 #include "g2p/folder.h"
 #include "g2p/pipeline.h"
+#include "identify/kind_properties.h"
 #include "pipeline/stage_clock.h"
+#include "properties/report.h"
 #include "segment/backends.h"
 
 namespace g2p {
@@ -498,11 +500,15 @@ Status Pipeline::Impl::estimate(RunState& s) {
   const StageProgress progress = [&context](double fraction, const std::string& message) {
     return context.report(Stage::kProperties, fraction, message);
   };
+  // The object's rays, built once for every weighing below.
+  Result<std::shared_ptr<const SurfaceRays>> rays = SurfaceRays::build(mesh);
+  if (!rays.ok()) return rays.status().with_context("properties");
   Result<PropertiesReport> report =
       o.kind_properties && !r.kind.name.empty()
-          ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, views,
-                                        progress)
-          : estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views, progress);
+          ? detail::estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, chosen, r.kind, views,
+                                                progress, **rays)
+          : detail::estimate_properties(mesh, r.projection.parts, r.completion, r.table, chosen, views, progress,
+                                        **rays);
   if (!report.ok()) return report.status().with_context("properties");
   // The kind's mass (or, of an unknown kind, everyday objects' bulk density):
   // each part's structure chosen against it, weighed again where the choice
@@ -529,9 +535,10 @@ Status Pipeline::Impl::estimate(RunState& s) {
         std::unique_ptr<PropertyEstimator> by_posterior = make_posterior_estimator(chosen, *posterior);
         Result<PropertiesReport> again =
             o.kind_properties && of_kind
-                ? estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, *by_posterior, r.kind,
-                                              views, progress)
-                : estimate_properties(mesh, r.projection.parts, r.completion, r.table, *by_posterior, views, progress);
+                ? detail::estimate_properties_of_kind(mesh, r.projection.parts, r.completion, r.table, *by_posterior,
+                                                      r.kind, views, progress, **rays)
+                : detail::estimate_properties(mesh, r.projection.parts, r.completion, r.table, *by_posterior, views,
+                                              progress, **rays);
         if (!again.ok()) return again.status().with_context("properties");
         report = std::move(again);
       }

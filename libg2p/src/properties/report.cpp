@@ -5,6 +5,7 @@
 #include "core/json_text.h"
 #include "g2p/io.h"
 #include "g2p/properties.h"
+#include "properties/report.h"
 
 namespace g2p {
 
@@ -55,11 +56,21 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
   if (completion.parts.size() != parts.size())
     return Status::InvalidArgument("properties: " + std::to_string(completion.parts.size()) + " completed parts for " +
                                    std::to_string(parts.size()) + " parts");
-  PropertiesReport report;
-  std::vector<MassProperties> masses;
   // One ray structure of the object for every part's wall measurement.
   Result<std::shared_ptr<const SurfaceRays>> object_rays = SurfaceRays::build(object);
   if (!object_rays.ok()) return object_rays.status().with_context("properties");
+  return detail::estimate_properties(object, parts, completion, table, estimator, views, progress, **object_rays);
+}
+
+Result<PropertiesReport> detail::estimate_properties(const Mesh& object, const std::vector<Part>& parts,
+                                                     const Completion& completion, const MaterialTable& table,
+                                                     const PropertyEstimator& estimator, const std::vector<View>* views,
+                                                     const StageProgress& progress, const SurfaceRays& object_rays) {
+  if (completion.parts.size() != parts.size())
+    return Status::InvalidArgument("properties: " + std::to_string(completion.parts.size()) + " completed parts for " +
+                                   std::to_string(parts.size()) + " parts");
+  PropertiesReport report;
+  std::vector<MassProperties> masses;
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (progress && i > 0)
       G2P_RETURN_IF_ERROR(progress(static_cast<double>(i) / static_cast<double>(parts.size()),
@@ -68,7 +79,7 @@ Result<PropertiesReport> estimate_properties(const Mesh& object, const std::vect
     PartReport r;
     r.part = static_cast<int>(i);
     r.completed_ok = completed.ok;
-    PropertyInput in{&object, &parts[i], &completed, &table, views, &parts, &completion, object_rays->get()};
+    PropertyInput in{&object, &parts[i], &completed, &table, views, &parts, &completion, &object_rays};
     Result<PartProperties> p = estimator.estimate(in);
     if (!p.ok()) return p.status().with_context("part " + std::to_string(i));
     r.properties = std::move(*p);

@@ -104,7 +104,12 @@ TEST(ContactScale, TheRuleAndItsOverridesReachTheMjcf) {
   EXPECT_NE(small.find("timestep=\"0.00062"), std::string::npos) << small;
   EXPECT_NE(small.find("solref=\"0.00125"), std::string::npos) << small;
   EXPECT_NE(small.find("condim=\"6\""), std::string::npos);  // fabric: torsional and rolling friction
-  EXPECT_NE(small.find("friction=\"0.5 0.02 0.005\""), std::string::npos);
+  EXPECT_NE(small.find("friction=\"0.5 0.02 0.02\""), std::string::npos) << small;  // a cushion's 2 cm lever
+  // Friction as hard as the contact is soft (#62: balls stop on sloping seats).
+  EXPECT_NE(small.find("cone=\"elliptic\" impratio=\"10\""), std::string::npos) << small;
+  const std::string tyre =
+      test::read_file(cube_mjcf(0.01, "Rubber", ExportOptions{}, test::scratch_dir("ContactScaleRubber")));
+  EXPECT_NE(tyre.find("friction=\"0.5 0.02 0.005\""), std::string::npos) << tyre;  // rubber rolls: 5 mm
   ExportOptions fixed;
   fixed.timestep_s = 0.001;
   const std::string overridden = test::read_file(cube_mjcf(0.01, "Fabric", fixed, dir));
@@ -148,6 +153,7 @@ TEST(ContactScale, BallStaysOnTheSofasSeat) {
   ContactCheckOptions o;
   o.grid = 0;
   o.points = {{-0.6, 0.1}, {0.6, 0.1}};
+  o.places = false;
   o.ball_radius_m = 0.01;
   o.seconds = 2.0;
   Result<ContactCheck> c = check_contacts_in_mujoco(dir + "/" + asset.name + ".xml", o);

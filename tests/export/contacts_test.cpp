@@ -53,6 +53,12 @@ ContactCheck check(const std::string& mjcf, std::vector<Eigen::Vector2d> points,
   options.grid = grid;
   options.points = std::move(points);
   options.ball_radius_m = radius;
+  options.places = false;  // only the balls asked for (resting_places_test.cpp and seats_test.cpp drop the rest)
+  // Balls that stop rolling on a level hard surface (2 mm of rolling
+  // friction): these fixtures test the hulls' shape. A user's ball, MuJoCo's
+  // default, keeps rolling on level Plastic as a marble on a table does
+  // (seats_test.cpp drops those on real seats).
+  options.ball_rolling_friction_m = 0.002;
   Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, options);
   EXPECT_TRUE(c.ok()) << c.status().to_string();
   return c.ok() ? *c : ContactCheck{};
@@ -169,10 +175,14 @@ TEST(Contacts, BadInputIsReported) {
   EXPECT_EQ(check_contacts_in_mujoco("/nonexistent/x.xml").status().code(), StatusCode::kNotFound);
   ContactCheckOptions none;
   none.grid = 0;
+  none.places = false;
   const std::string mjcf = export_fixture(test::u_channel_mesh(0.02f), "channel", "hull");
   Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, none);
   ASSERT_FALSE(c.ok());
   EXPECT_NE(c.status().message().find("--balls"), std::string::npos) << c.status().to_string();
+  ContactCheckOptions rolling;
+  rolling.ball_rolling_friction_m = -1;
+  EXPECT_EQ(check_contacts_in_mujoco(mjcf, rolling).status().code(), StatusCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "export/export_fixtures.h"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "g2p/segment.h"
@@ -34,6 +36,21 @@ TruthExport export_with_truth(const std::string& model_path, const std::string& 
 
 TruthExport export_shared_asset(const std::string& name) {
   return export_with_truth(asset_path(name), name, read_file(labels_json_path()));
+}
+
+std::vector<const PlaceProbe*> seats(const ContactCheck& c) {
+  std::vector<const PlaceProbe*> band;
+  const double floor = c.object_bounds.min().z(), height = c.object_bounds.sizes().z();
+  for (const PlaceProbe& p : c.places)
+    if (p.place.kind == RestingPlaceKind::kSurface && p.place.z_m - floor > 0.25 * height &&
+        p.place.z_m - floor < 0.75 * height)
+      band.push_back(&p);
+  double largest = 0.0;
+  for (const PlaceProbe* p : band) largest = std::max(largest, p->place.area_m2);
+  std::vector<const PlaceProbe*> out;
+  for (const PlaceProbe* p : band)
+    if (p->place.area_m2 >= 0.5 * largest) out.push_back(p);
+  return out;
 }
 
 }  // namespace g2p::test

@@ -31,4 +31,11 @@ TruthExport export_with_truth(const std::string& model_path, const std::string& 
 // A shared asset (../shared/assets/NAME) with its labels.json ground truth.
 TruthExport export_shared_asset(const std::string& name);
 
+// The seats among a contact check's resting places: the largest upward-facing
+// surface between a quarter and three quarters of the object's height above
+// the floor (a chair's or a sofa's seat, not its backrest's top or its feet),
+// and any other there at least half as large (a sofa's second cushion, not an
+// armrest).
+std::vector<const PlaceProbe*> seats(const ContactCheck& check);
+
 }  // namespace g2p::test

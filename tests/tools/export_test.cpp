@@ -91,7 +91,8 @@ TEST(ToolValidate, ContactCheckDropsBallsAndWritesJson) {
   const std::string dir = test::scratch_dir("ToolValidateContact");
   ToolRun r = export_hammer(dir, " --format mjcf");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 2 --json " + quote(dir + "/contact.json"));
+  r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 2 --no-places --json " +
+               quote(dir + "/contact.json"));
   if (r.err.find("without MuJoCo") != std::string::npos) GTEST_SKIP() << "libg2p built without MuJoCo";
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("4 balls"), std::string::npos) << r.out;
@@ -103,9 +104,11 @@ TEST(ToolValidate, ContactCheckDropsBallsAndWritesJson) {
   }
   EXPECT_TRUE(j["drop"]["object_above_plane"].get<bool>());
 
-  r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 0");
+  EXPECT_TRUE(j["places"].empty()) << j["places"];
+  r = run_tool("validate " + quote(dir + "/out") + " --contact --balls 0 --no-places");
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find("--balls"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--no-places"), std::string::npos) << r.err;
   r = run_tool("validate " + quote(dir + "/missing"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no such folder"), std::string::npos) << r.err;

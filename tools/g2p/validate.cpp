@@ -16,7 +16,7 @@ namespace {
 struct ValidateArgs {
   std::string dir;
   double height = 0.2, seconds = 2.0;
-  bool contact = false, fail_on_unstable = false;
+  bool contact = false, fail_on_unstable = false, no_places = false;
   ContactCheckOptions contact_options;
   std::vector<std::string> at;  // --at X,Y
   std::string json;
@@ -35,6 +35,7 @@ int run_contact_check(const ValidateArgs& args, const std::string& mjcf) {
     options.points.emplace_back(x, y);
   }
   options.drop_height_m = args.height;
+  options.places = !args.no_places;
   Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, options);
   if (!c.ok()) {
     const int code = fail("validate", c.status());
@@ -87,9 +88,12 @@ void add_validate_command(CLI::App& app, Command& run) {
       ->check(finite_number(0.0, 100.0));
   v->add_option("--seconds", vargs->seconds, "Simulated time, s (default 2)")->check(finite_number(0.0, 600.0, true));
   v->add_flag("--contact", vargs->contact,
-              "Contact check: fix the object, drop probe balls onto a grid over it and report where they rest");
+              "Contact check: fix the object, drop probe balls onto a grid over it and onto its seats, table tops and "
+              "cavities, and report where they rest");
   v->add_option("--balls", vargs->contact_options.grid,
-                "--contact: balls per side of a grid over the object (default 5; 0: only --at)");
+                "--contact: balls per side of a grid over the object (default 5; 0: only --at and the resting places)");
+  v->add_flag("--no-places", vargs->no_places,
+              "--contact: drop no balls over the seats, table tops and cavities seen from above");
   v->add_option("--at", vargs->at, "--contact: also drop a ball over X,Y (metres, object's frame; repeatable)");
   v->add_option("--ball-radius", vargs->contact_options.ball_radius_m,
                 "--contact: ball radius, m (default 2 % of the object's longest side, at least 5 mm)");

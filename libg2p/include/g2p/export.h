@@ -18,6 +18,7 @@
 #include "g2p/model.h"
 #include "g2p/project.h"
 #include "g2p/properties.h"
+#include "g2p/resting_places.h"
 #include "g2p/status.h"
 #include "g2p/visibility.h"
 
@@ -94,11 +95,17 @@ struct PartContact {
   bool scaled = false;  // solref/solimp from the rule (false: the properties' own)
 };
 struct MujocoContacts {
-  double timestep_s = 0.002;       // MJCF <option timestep>
-  double smallest_side_m = 0.0;    // of the collision geometry's bounds
-  double height_m = 0.0;           // its extent along +Z: the drop height of the rule
-  double impact_speed_m_s = 0.0;   // sqrt(2 g height)
-  double timeconst_s = 0.02;       // the rule's contact time constant, s
+  double timestep_s = 0.002;      // MJCF <option timestep>
+  double smallest_side_m = 0.0;   // of the collision geometry's bounds
+  double height_m = 0.0;          // its extent along +Z: the drop height of the rule
+  double impact_speed_m_s = 0.0;  // sqrt(2 g height)
+  double timeconst_s = 0.02;      // the rule's contact time constant, s
+  // MJCF <option cone="elliptic" impratio>: friction as hard as the contact
+  // is soft, so that a ball on a gently sloping seat stops instead of
+  // creeping and rolling off (MuJoCo's default pyramidal cone with impratio 1
+  // lets it slip; docs/formats.md#contacts-scaled-to-the-object). Set by the rule.
+  bool elliptic_cone = false;
+  double impratio = 1.0;
   std::vector<PartContact> parts;  // one per SimulationAsset::parts, same order
 };
 // The contact rule (docs/formats.md#contacts-scaled-to-the-object). With the object's smallest
@@ -191,16 +198,29 @@ G2P_API Result<EngineCheck> check_in_mujoco(const std::string& mjcf_path, double
 // Probe balls dropped onto the object, fixed in place, to see where an engine
 // lets things rest on it: in a bowl, on a seat, in a channel.
 struct ContactCheckOptions {
-  int grid = 5;  // balls per side of a grid over the object's top view (0: only `points`)
+  int grid = 5;  // balls per side of a grid over the object's top view (0: only `points` and the places)
   // Further start positions (x, y) in the object's frame, metres: a ball
   // over a bowl's centre, say.
   std::vector<Eigen::Vector2d> points;
+  // Also drop balls over each resting place (resting_places.h: the seats,
+  // table tops and cavities seen from above) and report per place how many
+  // stayed.
+  bool places = true;
+  RestingPlaceOptions place_options;   // probe_clearance_m is set to the ball's radius
   double ball_radius_m = 0.0;          // 0: 2 % of the object's longest side, at least 5 mm
   double ball_density_kg_m3 = 1000.0;  // water
-  double ball_friction = 0.5;          // sliding friction of the balls (MuJoCo combines with the max)
-  double seconds = 3.0;                // simulated time, s
-  double rest_speed_m_s = 0.005;       // a ball slower than this at the end is at rest
-  double drop_height_m = 0.2;          // the free object's drop onto a plane (check_in_mujoco)
+  // The balls are a user's: MuJoCo's default sphere geom (sliding friction 1,
+  // torsional 0.005 m, rolling 0.0001 m, condim 3, default solref and
+  // solimp), so what holds them is the object's contact parameters. The
+  // floor, the check's own, adds rolling friction so that a ball on it stops.
+  double ball_friction = 1.0;  // sliding friction of the balls (MuJoCo combines with the max)
+  // Rolling friction of the balls, m: 0 keeps MuJoCo's default ball (condim 3,
+  // 0.0001 m); more gives them condim 6 and that lever, so that a ball on a
+  // hard level surface stops rolling (what the check did before #62).
+  double ball_rolling_friction_m = 0.0;
+  double seconds = 3.0;           // simulated time, s
+  double rest_speed_m_s = 0.005;  // a ball slower than this at the end is at rest
+  double drop_height_m = 0.2;     // the free object's drop onto a plane (check_in_mujoco)
 };
 
 // One ball: where it started and where it came to rest.
@@ -213,10 +233,21 @@ struct BallProbe {
   bool at_rest = false;    // final speed under ContactCheckOptions::rest_speed_m_s
   bool on_object = false;  // touching one of the object's collision geoms at the end
   bool on_floor = false;   // touching the floor at the end
+  int place = -1;          // ContactCheck::places index it was dropped over; -1: the grid or a point
+  int rests_in = -1;       // the place it is in at the end, touching the object; -1: none
+};
+
+// One resting place and what the balls dropped over it did.
+struct PlaceProbe {
+  RestingPlace place;
+  int dropped = 0;  // balls dropped over it
+  int stayed = 0;   // of those, in it at the end and at rest
 };
 
 struct ContactCheck {
   std::vector<BallProbe> balls;
+  std::vector<PlaceProbe> places;     // ContactCheckOptions::places: cavities, then surfaces
+  HeightMap height_map;               // the collision geometry seen from above (the places' cells)
   Eigen::AlignedBox3d object_bounds;  // of the collision geometry, object's frame, m
   EngineCheck drop;                   // the free object dropped onto a plane (not run when the MJCF is --fixed)
   bool object_above_plane = false;    // after the drop, nothing of it more than 1 cm below the plane

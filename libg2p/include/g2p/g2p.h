@@ -22,6 +22,7 @@
 #include "g2p/regions.h"
 #include "g2p/registry.h"
 #include "g2p/render.h"
+#include "g2p/resting_places.h"
 #include "g2p/segment.h"
 #include "g2p/status.h"
 #include "g2p/version.h"

@@ -195,7 +195,7 @@ std::string mjcf_text(const SimulationAsset& a, const ExportOptions& options) {
   x << "  <compiler angle=\"radian\" meshdir=\"meshes\" inertiafromgeom=\"false\"/>\n"
     << "  <option gravity=\"0 0 -9.81\""
     << (options.scale_contacts || options.timestep_s > 0 ? " timestep=\"" + num(contacts.timestep_s) + "\"" : "")
-    << "/>\n"
+    << (contacts.elliptic_cone ? " cone=\"elliptic\" impratio=\"" + num(contacts.impratio) + "\"" : "") << "/>\n"
     << "  <default>\n"
     << "    <default class=\"g2p_collision\"><geom type=\"mesh\" group=\"3\" contype=\"1\" "
        "conaffinity=\"1\"/></default>\n"

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
+#include <initializer_list>
 #include <string>
 
 #include "g2p/export.h"
@@ -15,22 +17,33 @@ constexpr double kMujocoTimeconst_s = 0.02;  // MuJoCo's default solref time con
 constexpr double kMujocoTimestep_s = 0.002;  // MuJoCo's default <option timestep>
 constexpr double kMinTimeconst_s = 0.0005;   // below this, the time step would be 0.25 ms or less
 constexpr double kSolmix = 1000.0;           // the object's solref/solimp win over a default floor's
-// Soft classes (a cushion, a leather seat, a rubber mat): a ball pressed into
-// them meets a lever of a few millimetres against rolling and twisting.
-// libg2p estimates, chosen so that a 2 cm ball dropped onto SheenChair's and
-// GlamVelvetSofa's seats stays there (docs/formats.md#contacts-scaled-to-the-object).
+// Friction constraints ten times as hard as the contact's normal: MuJoCo's
+// documentation suggests larger values "to prevent slip"; 10 holds balls of
+// 1 to 5 cm on SheenChair's and GlamVelvetSofa's seats (formats.md).
+constexpr double kImpratio = 10.0;
+// Soft classes: a ball pressed into them meets a lever against rolling and
+// twisting. Upholstery (a cushion, a leather seat, foam) holds it in the
+// dimple it presses: 2 cm, enough for a ball of 5 cm to stop on a seat that
+// slopes 20 degrees or less, and a lever no tyre should have; rubber (a
+// tyre, a mat) 5 mm, a rolling resistance of 0.017 for a 30 cm wheel. libg2p
+// estimates, chosen on the shared and generated seats
+// (docs/formats.md#contacts-scaled-to-the-object).
 constexpr double kSoftTorsional_m = 0.02;
-constexpr double kSoftRolling_m = 0.005;
+constexpr double kCushionRolling_m = 0.02;
+constexpr double kRubberRolling_m = 0.005;
 constexpr double kTorsional_m = 0.005;  // MuJoCo's defaults for the others
 constexpr double kRolling_m = 0.0001;
 
-bool is_soft_class(const std::string& name) {
-  std::string n;
-  for (unsigned char c : name) n += static_cast<char>(std::tolower(c));
-  for (const char* soft : {"fabric", "leather", "rubber", "foam"})
-    if (n == soft) return true;
+// Whether the class is one of `names` (lower case), whatever the case.
+bool is_one_of(const std::string& name, std::initializer_list<const char*> names) {
+  for (const char* n : names)
+    if (std::equal(name.begin(), name.end(), n, n + std::strlen(n),
+                   [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; }))
+      return true;
   return false;
 }
+bool is_cushion_class(const std::string& name) { return is_one_of(name, {"fabric", "leather", "foam"}); }
+bool is_soft_class(const std::string& name) { return is_cushion_class(name) || is_one_of(name, {"rubber"}); }
 
 Eigen::AlignedBox3d collision_bounds(const SimulationAsset& asset) {
   Eigen::AlignedBox3d box;
@@ -59,6 +72,10 @@ MujocoContacts mujoco_contacts(const SimulationAsset& asset, const ExportOptions
   // per unit mass, b = 2 / (dmax tc), weighted by the impedance d ~ dmax).
   out.timeconst_s = std::clamp(std::exp(1.0) * sink * out.smallest_side_m / (out.impact_speed_m_s * std::sqrt(dmax)),
                                kMinTimeconst_s, kMujocoTimeconst_s);
+  if (options.scale_contacts) {
+    out.elliptic_cone = true;
+    out.impratio = kImpratio;
+  }
   double shortest = kMujocoTimeconst_s;
   for (const AssetPart& p : asset.parts) {
     const PartProperties& pp = p.properties;
@@ -70,7 +87,7 @@ MujocoContacts mujoco_contacts(const SimulationAsset& asset, const ExportOptions
       c.soft = is_soft_class(p.material);
       if (c.soft) {
         c.friction[1] = kSoftTorsional_m;
-        c.friction[2] = kSoftRolling_m;
+        c.friction[2] = is_cushion_class(p.material) ? kCushionRolling_m : kRubberRolling_m;
         c.condim = 6;
       }
       c.scaled = pp.contact_source == ValueSource::kTable;

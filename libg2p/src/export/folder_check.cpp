@@ -93,7 +93,24 @@ std::string contact_check_json(const ContactCheck& c, const std::string& mjcf) {
                           {"final_speed_m_s", b.final_speed_m_s},
                           {"at_rest", b.at_rest},
                           {"on_object", b.on_object},
-                          {"on_floor", b.on_floor}});
+                          {"on_floor", b.on_floor},
+                          {"place", b.place < 0 ? nlohmann::json(nullptr) : nlohmann::json(b.place)},
+                          {"rests_in", b.rests_in < 0 ? nlohmann::json(nullptr) : nlohmann::json(b.rests_in)}});
+  j["places"] = nlohmann::json::array();
+  for (const PlaceProbe& p : c.places) {
+    nlohmann::json probes = nlohmann::json::array();
+    for (const Eigen::Vector2d& at : p.place.probes) probes.push_back({at.x(), at.y()});
+    j["places"].push_back({{"name", p.place.name},
+                           {"kind", resting_place_kind_name(p.place.kind)},
+                           {"z_m", p.place.z_m},
+                           {"area_m2", p.place.area_m2},
+                           {"depth_m", p.place.depth_m},
+                           {"slope_deg", p.place.slope_deg},
+                           {"inner_radius_m", p.place.inner_radius_m},
+                           {"probes_m", probes},
+                           {"dropped", p.dropped},
+                           {"stayed", p.stayed}});
+  }
   j["drop"] = {{"dropped", c.drop.dropped},
                {"resting_lowest_m", c.drop.resting_lowest_m},
                {"final_speed_m_s", c.drop.final_speed_m_s},
@@ -159,14 +176,31 @@ std::string contact_check_text(const ContactCheck& c, const std::string& mjcf, c
                     radius, hi.z() + 2 * radius, options.seconds));
   add(std::snprintf(line, sizeof line, "  %9s %9s %12s %12s %11s  %s\n", "start x", "start y", "rests at z",
                     "above floor", "speed m/s", "where"));
-  for (const BallProbe& b : c.balls)
+  for (const BallProbe& b : c.balls) {
+    std::string where = b.on_object ? "on the object" : b.on_floor ? "on the floor" : "touching nothing";
+    if (b.rests_in >= 0 && b.rests_in < static_cast<int>(c.places.size())) {
+      const RestingPlace& r = c.places[static_cast<std::size_t>(b.rests_in)].place;
+      where = (r.kind == RestingPlaceKind::kCavity ? "in " : "on ") + r.name;
+    }
+    if (b.place >= 0 && b.place < static_cast<int>(c.places.size()))
+      where += " (dropped over " + c.places[static_cast<std::size_t>(b.place)].place.name + ")";
     add(std::snprintf(line, sizeof line, "  %9.4f %9.4f %12.4f %12.4f %11.2e  %s%s\n", b.start.x(), b.start.y(),
-                      b.rest.z(), b.height_above_floor_m, b.final_speed_m_s,
-                      b.on_object  ? "on the object"
-                      : b.on_floor ? "on the floor"
-                                   : "touching nothing",
+                      b.rest.z(), b.height_above_floor_m, b.final_speed_m_s, where.c_str(),
                       b.at_rest ? "" : ", still moving"));
+  }
   add(std::snprintf(line, sizeof line, "  %d of %zu at rest, %d on the object\n", resting, c.balls.size(), on_object));
+  for (const PlaceProbe& p : c.places) {
+    const RestingPlace& r = p.place;
+    if (r.kind == RestingPlaceKind::kCavity)
+      add(std::snprintf(line, sizeof line,
+                        "  %s (bottom at z %.3g m, %.3g m deep, %.3g m^2): %d of %d balls at rest inside it\n",
+                        r.name.c_str(), r.rim_z_m - r.depth_m, r.depth_m, r.area_m2, p.stayed, p.dropped));
+    else
+      add(std::snprintf(line, sizeof line,
+                        "  %s (at z %.3g m, %.3g m^2, sloping %.0f degrees): %d of %d balls at rest on it\n",
+                        r.name.c_str(), r.z_m, r.area_m2, r.slope_deg, p.stayed, p.dropped));
+  }
+  if (c.places.empty() && options.places) out += "  no seat, table top or cavity seen from above\n";
   if (c.drop.dropped)
     add(std::snprintf(line, sizeof line, "  object dropped from %.3g m: rests %.4g m above the plane (%s)\n",
                       options.drop_height_m, c.drop.resting_lowest_m,

@@ -34,10 +34,15 @@ function decode(base64, Type) {
   return new Type(bytes.buffer, 0, bytes.byteLength / Type.BYTES_PER_ELEMENT);
 }
 
+// Positions come quantized to 16 bits over the mesh's bounds, indices as 16
+// or 32 bits (summary_viewer.cpp's mesh_json).
 function geometryOf(mesh) {
   const g = new BufferGeometry();
-  g.setAttribute('position', new BufferAttribute(decode(mesh.positions, Float32Array), 3));
-  g.setIndex(new BufferAttribute(decode(mesh.indices, Uint32Array), 1));
+  const q = decode(mesh.positions, Uint16Array);
+  const positions = new Float32Array(q.length);
+  for (let i = 0; i < q.length; ++i) positions[i] = mesh.position_min[i % 3] + q[i] * mesh.position_step[i % 3];
+  g.setAttribute('position', new BufferAttribute(positions, 3));
+  g.setIndex(new BufferAttribute(decode(mesh.indices, mesh.index_bits === 16 ? Uint16Array : Uint32Array), 1));
   g.computeVertexNormals();
   return g;
 }

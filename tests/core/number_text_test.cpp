@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -73,6 +75,27 @@ TEST(NumberText, ReadsAsPrintfWroteIt) {
     detail::append_integer(text, n);
     EXPECT_EQ(text, std::to_string(n));
   }
+}
+
+// The mesh writer's vertex coordinates: the shortest text reads back as the
+// same float (strtof) and is never longer than "%.9g" of it.
+TEST(NumberText, ShortestFloatReadsBackAsTheSameFloat) {
+  std::mt19937_64 random(12);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-8, 4);
+  std::vector<float> values = {0.0f, -0.0f, 1.0f, -0.20738289f, 0.1f, 1e-7f, 3.4e38f, -1.17549435e-38f};
+  for (int i = 0; i < 40000; ++i) values.push_back(static_cast<float>(unit(random) * std::pow(10.0, exponent(random))));
+  std::size_t shorter = 0;
+  for (float x : values) {
+    std::string text;
+    detail::append_shortest(text, x);
+    const float back = std::strtof(text.c_str(), nullptr);
+    EXPECT_EQ(std::memcmp(&back, &x, sizeof x), 0) << text << " for " << printf_text("%.9g", x);
+    const std::string nine = printf_text("%.9g", x);
+    EXPECT_LE(text.size(), nine.size()) << text << " against " << nine;
+    shorter += text.size() < nine.size() ? 1 : 0;
+  }
+  EXPECT_GT(shorter, values.size() / 2);  // most coordinates need fewer than 9 digits
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "decompose/decompose_fixtures.h"
@@ -108,6 +109,32 @@ TEST(Contacts, BallRestsOnTheCupsBottom) {
   EXPECT_TRUE(b.on_object);
   EXPECT_LT(b.rest.z() - b.radius_m - 0.008, b.radius_m) << "rests at z " << b.rest.z();
   expect_settled(c);
+}
+
+// A user's balls (MuJoCo's default geom, no rolling friction of their own)
+// dropped over the cavity the check finds in a bowl and in a mug with a
+// handle: nine each, of 1 and 2 cm across, all at rest inside.
+TEST(Contacts, UsersBallsDroppedIntoTheBowlAndTheMugRestInside) {
+  const std::pair<const char*, Mesh> fixtures[] = {{"bowl", test::bowl_mesh(0.1, 0.012)}, {"mug", test::mug_mesh()}};
+  for (const auto& [name, mesh] : fixtures) {
+    const std::string mjcf = export_fixture(mesh, name, "voxel-cut");
+    for (const double radius : {0.005, 0.01}) {
+      ContactCheckOptions o;
+      o.grid = 0;
+      o.ball_radius_m = radius;
+      Result<ContactCheck> c = check_contacts_in_mujoco(mjcf, o);
+      ASSERT_TRUE(c.ok()) << c.status().to_string();
+      const PlaceProbe* cavity = nullptr;
+      for (const PlaceProbe& p : c->places)
+        if (p.place.kind == RestingPlaceKind::kCavity && cavity == nullptr) cavity = &p;
+      ASSERT_NE(cavity, nullptr) << name << ": no cavity\n" << contact_check_text(*c, mjcf, o);
+      EXPECT_EQ(cavity->dropped, 9) << name;
+      EXPECT_EQ(cavity->stayed, cavity->dropped) << name << ", balls of radius " << radius << "\n"
+                                                 << contact_check_text(*c, mjcf, o);
+      std::printf("%s, balls %.0f mm across: %s %.3f m deep, %d of %d at rest inside\n", name, 2000 * radius,
+                  cavity->place.name.c_str(), cavity->place.depth_m, cavity->stayed, cavity->dropped);
+    }
+  }
 }
 
 TEST(Contacts, BallRestsOnTheSeat) {

@@ -66,6 +66,35 @@ std::vector<double> how_it_is_read(const json& info) {
   return v;
 }
 
+// The bytes of each image of a glTF file: from the GLB's binary chunk, or the
+// files a .gltf names.
+std::vector<std::string> image_bytes(const std::string& path) {
+  const std::string file = test::read_file(path);
+  const json doc = glb_json(path);
+  std::vector<std::string> out;
+  if (!doc.contains("images")) return out;
+  std::string bin;
+  if (file.compare(0, 4, "glTF") == 0) {
+    std::uint32_t json_length = 0, bin_length = 0;
+    std::memcpy(&json_length, file.data() + 12, 4);
+    const std::size_t at = 20 + json_length;
+    if (at + 8 <= file.size()) {
+      std::memcpy(&bin_length, file.data() + at, 4);
+      bin = file.substr(at + 8, bin_length);
+    }
+  }
+  for (const json& image : doc["images"]) {
+    if (image.contains("uri")) {
+      const std::string dir = path.substr(0, path.find_last_of('/') + 1);
+      out.push_back(test::read_file(dir + image["uri"].get<std::string>()));
+    } else {
+      const json& view = doc["bufferViews"][image["bufferView"].get<std::size_t>()];
+      out.push_back(bin.substr(view.value("byteOffset", std::size_t{0}), view["byteLength"].get<std::size_t>()));
+    }
+  }
+  return out;
+}
+
 struct Look {
   std::string name;
   std::string input;  // a glTF file
@@ -117,6 +146,17 @@ TEST_P(GlbLook, TheGlbCarriesEveryTextureWithItsUvSetTransformAndFactors) {
           << where;
   }
   EXPECT_EQ(compared, GetParam().textures);
+
+  // Each image is one of the input's, byte for byte (PNG and JPEG are
+  // copied as stored), with its type.
+  const std::vector<std::string> in_images = image_bytes(input), out_images = image_bytes(out);
+  ASSERT_FALSE(out_images.empty());
+  for (std::size_t k = 0; k < out_images.size(); ++k) {
+    EXPECT_NE(std::find(in_images.begin(), in_images.end(), out_images[k]), in_images.end())
+        << "image " << k << " of " << out << " (" << out_images[k].size() << " bytes) is none of the input's";
+    const bool png = out_images[k].compare(0, 4, "\x89PNG") == 0;
+    EXPECT_EQ(out_doc["images"][k]["mimeType"], png ? "image/png" : "image/jpeg");
+  }
 
   // Read back: the same images, pixel for pixel, the same maps.
   Result<Model> back = load_model(out);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <regex>
 
@@ -15,6 +16,24 @@
 
 namespace g2p {
 namespace {
+
+// The bytes of base64 text (RFC 4648, with padding).
+std::string base64_bytes(const std::string& text) {
+  static const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  unsigned bits = 0;
+  int count = 0;
+  for (char c : text) {
+    if (c == '=') break;
+    bits = (bits << 6) | static_cast<unsigned>(alphabet.find(c));
+    count += 6;
+    if (count >= 8) {
+      count -= 8;
+      out.push_back(static_cast<char>((bits >> count) & 0xFF));
+    }
+  }
+  return out;
+}
 
 PipelineOptions quick_options() {
   PipelineOptions o;
@@ -130,9 +149,31 @@ TEST(SummaryHtml, CarriesEachPartsGeometryHullsAndPropertiesForThe3DView) {
     const nlohmann::json& p = data["parts"][i];
     const std::size_t faces = p["faces"];
     EXPECT_EQ(p["faces_drawn"], faces);
-    // base64 of uint32 indices (12 bytes a triangle) and one sRGB colour a triangle.
-    EXPECT_EQ(p["visual"]["indices"].get<std::string>().size(), 16 * faces);
+    // base64 of uint16 indices (6 bytes a triangle) and one sRGB colour a triangle.
+    EXPECT_EQ(p["visual"]["index_bits"], 16);
+    EXPECT_EQ(p["visual"]["indices"].get<std::string>().size(), 4 * ((6 * faces + 2) / 3));
     EXPECT_EQ(p["visual"]["look"].get<std::string>().size(), 4 * faces);
+    // Positions quantized to 16 bits over the part's bounds: decoded, they
+    // span the part's visual mesh's bounds to within half a step.
+    const std::string q = base64_bytes(p["visual"]["positions"].get<std::string>());
+    ASSERT_EQ(q.size() % 6, 0u);
+    Eigen::AlignedBox3d drawn;
+    for (std::size_t v = 0; v < q.size() / 6; ++v) {
+      Eigen::Vector3d x;
+      for (int a = 0; a < 3; ++a) {
+        std::uint16_t code = 0;
+        std::memcpy(&code, q.data() + 6 * v + 2 * static_cast<std::size_t>(a), 2);
+        x[a] = p["visual"]["position_min"][a].get<double>() + code * p["visual"]["position_step"][a].get<double>();
+      }
+      drawn.extend(x);
+    }
+    Eigen::AlignedBox3d visual;
+    for (const Eigen::Vector3f& v : r.asset.parts[i].visual.positions) visual.extend(v.cast<double>());
+    for (int a = 0; a < 3; ++a) {
+      const double half_step = 0.5 * p["visual"]["position_step"][a].get<double>() + 1e-7;
+      EXPECT_NEAR(drawn.min()[a], visual.min()[a], half_step) << "part " << i;
+      EXPECT_NEAR(drawn.max()[a], visual.max()[a], half_step) << "part " << i;
+    }
     EXPECT_EQ(p["hulls"].size(), r.asset.parts[i].collision.hulls.size());
     EXPECT_GT(p["hulls"].size(), 0u);
     EXPECT_NEAR(p["mass_kg"].get<double>(), r.properties.parts[i].mass.mass_kg, 1e-12);

@@ -23,6 +23,11 @@ enum class WrapMode { kRepeat, kClampToEdge, kMirroredRepeat };
 struct Texture {
   std::string uri;                       // file path, or "*N" for the N-th embedded image
   std::shared_ptr<const ImageU8> image;  // RGBA, 4 channels; null if absent or undecodable
+  // The image as the file stored it, when those bytes are a PNG or a JPEG
+  // (the formats glTF carries): the GLB writer copies them instead of
+  // encoding `image` again, which keeps a JPEG's bytes and the file's
+  // compression. Null otherwise (a WebP, a BMP, texels given uncompressed).
+  std::shared_ptr<const std::string> encoded;
   // Which UV set it reads (glTF texCoord, or KHR_texture_transform's texCoord
   // override): 0 = Mesh::uvs, 1 = Mesh::uvs1. The renderer samples set 0.
   int uv_set = 0;

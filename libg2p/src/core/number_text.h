@@ -22,6 +22,14 @@ inline void append_general(std::string& out, double value, int digits) {
   out.append(text, end);
 }
 
+// The shortest text that reads back as the same float (std::to_chars'
+// round-trip guarantee): at most 9 significant digits, usually fewer.
+inline void append_shortest(std::string& out, float value) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+  out.append(text, end);
+}
+
 // As "%.<decimals>f", for values below 1e30.
 inline void append_fixed(std::string& out, double value, int decimals) {
   char text[64];

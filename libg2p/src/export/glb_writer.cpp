@@ -1,4 +1,5 @@
 // write_glb: the object as a binary glTF 2.0 with its physical properties.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -56,23 +57,39 @@ class GlbBuilder {
     doc["accessors"].push_back(a);
     return static_cast<int>(doc["accessors"].size()) - 1;
   }
+  // Indices as 16-bit integers where every one fits (half the bytes), else 32-bit.
   int indices(const std::vector<std::uint32_t>& idx) {
-    const int v = view(idx.data(), idx.size() * sizeof(std::uint32_t), 34963);
-    doc["accessors"].push_back({{"bufferView", v}, {"componentType", 5125}, {"count", idx.size()}, {"type", "SCALAR"}});
+    const bool short_ok = std::all_of(idx.begin(), idx.end(), [](std::uint32_t i) { return i < 65535u; });
+    int v = 0;
+    if (short_ok) {
+      const std::vector<std::uint16_t> shorts(idx.begin(), idx.end());
+      v = view(shorts.data(), shorts.size() * sizeof(std::uint16_t), 34963);
+    } else {
+      v = view(idx.data(), idx.size() * sizeof(std::uint32_t), 34963);
+    }
+    doc["accessors"].push_back(
+        {{"bufferView", v}, {"componentType", short_ok ? 5123 : 5125}, {"count", idx.size()}, {"type", "SCALAR"}});
     return static_cast<int>(doc["accessors"].size()) - 1;
   }
-  // A decoded texture: its image as PNG once per image, a texture and sampler
-  // once per image and wrap modes.
+  // A decoded texture: its image once per image (the bytes the file stored
+  // it as when they are a PNG or a JPEG, else encoded as PNG), a texture and
+  // sampler once per image and wrap modes.
   Result<int> texture(const Texture& t) {
     const auto key = std::make_tuple(t.image.get(), t.wrap_u, t.wrap_v);
     auto found = textures_.find(key);
     if (found != textures_.end()) return found->second;
     auto image = images_.find(t.image.get());
     if (image == images_.end()) {
-      Result<std::string> png = detail::encode_png(*t.image);
-      if (!png.ok()) return png.status();
-      const int v = view(png->data(), png->size(), 0);
-      doc["images"].push_back({{"bufferView", v}, {"mimeType", "image/png"}});
+      const char* mime = t.encoded ? detail::gltf_image_mime_type(*t.encoded) : nullptr;
+      if (mime != nullptr) {
+        const int v = view(t.encoded->data(), t.encoded->size(), 0);
+        doc["images"].push_back({{"bufferView", v}, {"mimeType", mime}});
+      } else {
+        Result<std::string> png = detail::encode_png(*t.image);
+        if (!png.ok()) return png.status();
+        const int v = view(png->data(), png->size(), 0);
+        doc["images"].push_back({{"bufferView", v}, {"mimeType", "image/png"}});
+      }
       image = images_.emplace(t.image.get(), static_cast<int>(doc["images"].size()) - 1).first;
     }
     auto wrap = [](WrapMode w) {

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <thread>
+#include <tuple>
 
 #include "assimp_convert.h"
 #include "core/utf8.h"
@@ -41,7 +42,7 @@ class TextureCache {
     std::vector<std::string> todo;
     for (const std::string& u : uris)
       if (!cache_.count(u) && std::find(todo.begin(), todo.end(), u) == todo.end()) todo.push_back(u);
-    std::vector<std::optional<Result<ImageU8>>> results(todo.size());
+    std::vector<std::optional<Result<Loaded>>> results(todo.size());
     std::atomic<std::size_t> next{0};
     auto worker = [&] {
       for (std::size_t i = next++; i < todo.size(); i = next++) results[i] = load(todo[i]);
@@ -54,48 +55,67 @@ class TextureCache {
     for (std::size_t i = 0; i < todo.size(); ++i) store(todo[i], std::move(*results[i]));
   }
 
-  // Returns the decoded image or null, with the reason in `error`.
-  std::shared_ptr<const ImageU8> get(const std::string& uri, std::string& error) {
+  // The decoded image (null, with the reason in `error`) and the bytes it
+  // was decoded from when they are a PNG or a JPEG (Texture::encoded).
+  std::pair<std::shared_ptr<const ImageU8>, std::shared_ptr<const std::string>> get(const std::string& uri,
+                                                                                    std::string& error) {
     auto it = cache_.find(uri);
-    if (it != cache_.end()) {
-      error = it->second.second;
-      return it->second.first;
-    }
-    const auto& entry = store(uri, load(uri));
-    error = entry.second;
-    return entry.first;
+    if (it == cache_.end()) it = store(uri, load(uri));
+    error = it->second.error;
+    return {it->second.image, it->second.encoded};
   }
 
  private:
-  using Entry = std::pair<std::shared_ptr<const ImageU8>, std::string>;  // image or error
+  struct Loaded {
+    ImageU8 image;
+    std::string encoded;  // the PNG or JPEG bytes it came from; empty otherwise
+  };
+  struct Entry {
+    std::shared_ptr<const ImageU8> image;
+    std::shared_ptr<const std::string> encoded;
+    std::string error;
+  };
 
-  const Entry& store(const std::string& uri, Result<ImageU8> image) {
+  std::map<std::string, Entry>::iterator store(const std::string& uri, Result<Loaded> loaded) {
     Entry entry;
-    if (image.ok())
-      entry.first = std::make_shared<const ImageU8>(std::move(*image));
-    else
-      entry.second = image.status().message();
-    return cache_.emplace(uri, std::move(entry)).first->second;
+    if (loaded.ok()) {
+      entry.image = std::make_shared<const ImageU8>(std::move(loaded->image));
+      if (gltf_image_mime_type(loaded->encoded) != nullptr)
+        entry.encoded = std::make_shared<const std::string>(std::move(loaded->encoded));
+    } else {
+      entry.error = loaded.status().message();
+    }
+    return cache_.emplace(uri, std::move(entry)).first;
   }
 
   // Thread-safe: reads the scene and the file system only.
-  Result<ImageU8> load(const std::string& uri) {
+  Result<Loaded> load(const std::string& uri) {
+    Loaded out;
     if (const aiTexture* embedded = scene_.GetEmbeddedTexture(uri.c_str())) {
-      if (embedded->mHeight == 0) return decode_image_rgba(embedded->pcData, embedded->mWidth);
+      if (embedded->mHeight == 0) {
+        Result<ImageU8> image = decode_image_rgba(embedded->pcData, embedded->mWidth);
+        if (!image.ok()) return image.status();
+        out.image = std::move(*image);
+        out.encoded.assign(reinterpret_cast<const char*>(embedded->pcData), embedded->mWidth);
+        return out;
+      }
       // Uncompressed texels, BGRA8.
-      ImageU8 image(static_cast<int>(embedded->mWidth), static_cast<int>(embedded->mHeight), 4);
+      out.image = ImageU8(static_cast<int>(embedded->mWidth), static_cast<int>(embedded->mHeight), 4);
       for (std::size_t i = 0; i < static_cast<std::size_t>(embedded->mWidth) * embedded->mHeight; ++i) {
         const aiTexel& t = embedded->pcData[i];
-        std::uint8_t* p = image.data() + 4 * i;
+        std::uint8_t* p = out.image.data() + 4 * i;
         p[0] = t.r, p[1] = t.g, p[2] = t.b, p[3] = t.a;
       }
-      return image;
+      return out;
     }
     if (!uri.empty() && uri[0] == '*') return Status::NotFound("embedded texture " + uri + " is missing");
     if (dir_.empty()) return Status::NotFound("an external file cannot be resolved for a model read from memory");
     std::filesystem::path path(uri);
     if (path.is_relative()) path = std::filesystem::path(dir_) / path;
-    return read_image_rgba(path.lexically_normal().string());
+    Result<ImageU8> image = read_image_rgba(path.lexically_normal().string(), &out.encoded);
+    if (!image.ok()) return image.status();
+    out.image = std::move(*image);
+    return out;
   }
 
   const aiScene& scene_;
@@ -116,7 +136,7 @@ Texture read_texture(const aiMaterial& mat, aiTextureType type, TextureCache* ca
   if (mat.Get(AI_MATKEY_UVWSRC(type, 0), uv_set) == AI_SUCCESS) tex.uv_set = uv_set;
   if (cache == nullptr) return tex;  // textures not requested
   std::string error;
-  tex.image = cache->get(tex.uri, error);
+  std::tie(tex.image, tex.encoded) = cache->get(tex.uri, error);
   if (!tex.image)
     warnings.push_back(what + " texture '" + tex.uri + "' not loaded (" + error + "); using the factor alone");
   return tex;

@@ -60,16 +60,24 @@ Result<ImageU8> decode_image_rgba(const void* data, std::size_t size) {
 
 Result<std::string> encode_png(const ImageU8& image) { return encode_png_bytes(image); }
 
-Result<ImageU8> read_image_rgba(const std::string& path) {
+Result<ImageU8> read_image_rgba(const std::string& path, std::string* bytes_out) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return Status::NotFound(path + ": no such image file");
   std::ifstream in(path, std::ios::binary);
   std::stringstream bytes;
   if (!in || !(bytes << in.rdbuf())) return Status::IoError(path + ": cannot read it");
-  const std::string data = bytes.str();
+  std::string data = bytes.str();
   Result<ImageU8> image = decode_image_rgba(data.data(), data.size());
   if (!image.ok()) return image.status().with_context(path);
+  if (bytes_out != nullptr) *bytes_out = std::move(data);
   return image;
+}
+
+const char* gltf_image_mime_type(const std::string& bytes) {
+  const auto* b = reinterpret_cast<const std::uint8_t*>(bytes.data());
+  if (starts_with(b, bytes.size(), "\x89PNG\r\n\x1a\n", 8)) return "image/png";
+  if (starts_with(b, bytes.size(), "\xFF\xD8\xFF", 3)) return "image/jpeg";
+  return nullptr;
 }
 
 }  // namespace detail

@@ -24,11 +24,11 @@ std::string obj_text(const Mesh& mesh) {
   std::string s = "# libg2p mesh: " + std::to_string(mesh.num_vertices()) + " vertices, " +
                   std::to_string(mesh.num_faces()) + " triangles, metres\n";
   s.reserve(s.size() + mesh.positions.size() * 40 + mesh.triangles.size() * 24);
-  for (const auto& p : mesh.positions) {  // "v %.9g %.9g %.9g"
+  for (const auto& p : mesh.positions) {  // "v x y z", each the shortest text of its float
     s += 'v';
     for (int a = 0; a < 3; ++a) {
       s += ' ';
-      detail::append_general(s, p[a], 9);
+      detail::append_shortest(s, p[a]);
     }
     s += '\n';
   }

@@ -1,6 +1,7 @@
 #include "pipeline/summary_viewer.h"
 #include "core/json_text.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -25,16 +26,43 @@ std::string base64_of(const std::vector<T>& values) {
   return base64_encode(std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)));
 }
 
-// Positions (float32 x, y, z) and triangles (uint32), little-endian, base64.
-nlohmann::json mesh_json(const Mesh& mesh) {
-  std::vector<float> positions;
-  positions.reserve(mesh.positions.size() * 3);
-  for (const Eigen::Vector3f& p : mesh.positions) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-  std::vector<std::uint32_t> indices;
-  indices.reserve(mesh.triangles.size() * 3);
+// The triangles' corners as one array of `Index`.
+template <typename Index>
+std::vector<Index> flat_indices(const Mesh& mesh) {
+  std::vector<Index> out;
+  out.reserve(mesh.triangles.size() * 3);
   for (const Eigen::Vector3i& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) indices.push_back(static_cast<std::uint32_t>(t[k]));
-  return {{"positions", base64_of(positions)}, {"indices", base64_of(indices)}};
+    for (int k = 0; k < 3; ++k) out.push_back(static_cast<Index>(t[k]));
+  return out;
+}
+
+// Positions quantized to 16 bits over the mesh's bounds (x = min + q * step:
+// within 1/131070 of the mesh's size of where they are, far below a pixel)
+// and triangles as 16-bit indices where every index fits, else 32-bit;
+// little-endian, base64 (viewer.js's geometryOf reads them).
+nlohmann::json mesh_json(const Mesh& mesh) {
+  Eigen::Vector3f lo = Eigen::Vector3f::Zero(), step = Eigen::Vector3f::Zero();
+  if (!mesh.positions.empty()) {
+    lo = mesh.positions.front();
+    Eigen::Vector3f hi = lo;
+    for (const Eigen::Vector3f& p : mesh.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    step = (hi - lo) / 65535.0f;
+  }
+  std::vector<std::uint16_t> positions;
+  positions.reserve(mesh.positions.size() * 3);
+  for (const Eigen::Vector3f& p : mesh.positions)
+    for (int a = 0; a < 3; ++a)
+      positions.push_back(
+          step[a] > 0 ? static_cast<std::uint16_t>(std::clamp(std::lround((p[a] - lo[a]) / step[a]), 0l, 65535l))
+                      : std::uint16_t{0});
+  nlohmann::json out = {{"positions", base64_of(positions)},
+                        {"position_min", {lo.x(), lo.y(), lo.z()}},
+                        {"position_step", {step.x(), step.y(), step.z()}}};
+  const bool short_indices = mesh.positions.size() <= 65535;
+  out["indices"] =
+      short_indices ? base64_of(flat_indices<std::uint16_t>(mesh)) : base64_of(flat_indices<std::uint32_t>(mesh));
+  out["index_bits"] = short_indices ? 16 : 32;
+  return out;
 }
 
 // The input's own colour of each drawn face, as the renderer sees it at the

@@ -1,5 +1,7 @@
 // The project stage's files: faces.csv and a labelled PLY.
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -92,7 +94,7 @@ Status write_faces_csv(const std::string& path, const Model& model, const Projec
     for (std::size_t f = b * kBlock; f < end; ++f) {
       const FaceSource s = mesh.face_source.empty() ? FaceSource{} : mesh.face_source[f];
       const int label = projection.labels.label[f];
-      // As "%d,%d,%d,<name>,<label>,%.4f,%.9g,%d\n".
+      // As "%d,%d,%d,<name>,<label>,%.4f,%.6g,%d\n".
       detail::append_integer(out, s.mesh);
       out += ',';
       detail::append_integer(out, s.face);
@@ -105,7 +107,7 @@ Status write_faces_csv(const std::string& path, const Model& model, const Projec
       out += ',';
       detail::append_fixed(out, projection.labels.confidence[f], 4);
       out += ',';
-      detail::append_general(out, face_area(mesh, static_cast<int>(f)), 9);
+      detail::append_general(out, face_area(mesh, static_cast<int>(f)), 6);
       out += ',';
       detail::append_integer(out, projection.face_part[f]);
       out += '\n';
@@ -127,17 +129,27 @@ Status write_labelled_ply(const std::string& path, const Mesh& mesh, const std::
                           const MaterialTable& table) {
   if (face_labels.size() != mesh.triangles.size())
     return Status::InvalidArgument(path + ": one label per face is needed");
+  // Vertex indices as 16-bit integers where every one fits (a third of the file less).
+  const bool short_indices = mesh.positions.size() <= 65535;
   std::ostringstream header;
   header << "ply\nformat binary_little_endian 1.0\ncomment libg2p face labels (" << table.name() << ")\n"
          << "element vertex " << mesh.positions.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
-         << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\n"
+         << "element face " << mesh.triangles.size() << "\nproperty list uchar " << (short_indices ? "ushort" : "int")
+         << " vertex_indices\n"
          << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
   std::string out = header.str();
   out.reserve(out.size() + mesh.positions.size() * 12 + mesh.triangles.size() * 16);
   for (const Eigen::Vector3f& p : mesh.positions) out.append(reinterpret_cast<const char*>(p.data()), 12);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     out.push_back(3);
-    out.append(reinterpret_cast<const char*>(mesh.triangles[f].data()), 12);
+    if (short_indices) {
+      const std::array<std::uint16_t, 3> t{static_cast<std::uint16_t>(mesh.triangles[f][0]),
+                                           static_cast<std::uint16_t>(mesh.triangles[f][1]),
+                                           static_cast<std::uint16_t>(mesh.triangles[f][2])};
+      out.append(reinterpret_cast<const char*>(t.data()), 6);
+    } else {
+      out.append(reinterpret_cast<const char*>(mesh.triangles[f].data()), 12);
+    }
     const int l = face_labels[f];
     const std::array<std::uint8_t, 3> c = table.valid_label(l) ? table[l].color : std::array<std::uint8_t, 3>{0, 0, 0};
     out.append(reinterpret_cast<const char*>(c.data()), 3);

@@ -42,6 +42,7 @@
 #include <sstream>
 
 #include "augment.h"
+#include "core/ascii.h"
 #include "core/csv.h"
 #include "g2p/g2p.h"
 
@@ -49,11 +50,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 // Class of one material: overrides first (per model, then per name), then the
 // lexicon: one class at full strength (>= 0.9) and no other above 0.5.
@@ -67,7 +63,7 @@ int label_material(const g2p::SourceMaterial& m, const std::string& model_key, c
   if (overrides.contains("models") && overrides["models"].contains(model_key) &&
       overrides["models"][model_key].contains(m.name))
     return from_override(overrides["models"][model_key][m.name], "override (model)");
-  const std::string name = lower(m.name);
+  const std::string name = g2p::detail::lower_case(m.name);
   if (overrides.contains("names") && overrides["names"].contains(name))
     return from_override(overrides["names"][name], "override (name)");
   std::string text = m.name;
@@ -167,7 +163,7 @@ int run(const Args& a) {
     const std::string split = test_libraries.count(library) ? "test" : "train";
     std::vector<fs::path> objs;
     for (const auto& e : fs::recursive_directory_iterator(library_dir))
-      if (e.is_regular_file() && lower(e.path().extension().string()) == ".obj") objs.push_back(e.path());
+      if (e.is_regular_file() && g2p::detail::lower_case(e.path().extension().string()) == ".obj") objs.push_back(e.path());
     std::sort(objs.begin(), objs.end());
     if (a.max_models > 0 && static_cast<int>(objs.size()) > a.max_models) objs.resize(a.max_models);
     auto& split_stats = stats[split];

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/ascii.h"
 #include "core/csv.h"
 #include "g2p/batch.h"
 #include "g2p/io.h"
@@ -20,11 +21,6 @@ namespace g2p {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 std::string trim(const std::string& s) {
   const auto begin = s.find_first_not_of(" \t\r\n");
@@ -114,7 +110,7 @@ Result<std::vector<BatchAsset>> read_csv_manifest(std::istream& in, const std::s
     if (header.empty()) {
       header = *fields;
       for (std::string& column : header) {
-        column = lower(column);
+        column = detail::lower_case(column);
         G2P_RETURN_IF_ERROR(check_column(column, where));
       }
       if (std::find(header.begin(), header.end(), "path") == header.end())
@@ -202,7 +198,7 @@ Result<std::vector<BatchAsset>> read_batch_manifest(const std::string& path) {
   std::ifstream in(path);
   if (!in) return Status::IoError(path + ": cannot read the manifest");
   const fs::path dir = fs::path(path).parent_path();
-  const std::string ext = lower(fs::path(path).extension().string());
+  const std::string ext = detail::lower_case(fs::path(path).extension().string());
   if (ext == ".jsonl" || ext == ".ndjson") return read_jsonl_manifest(in, path, dir);
   if (ext == ".csv") return read_csv_manifest(in, path, dir);
   return Status::Unsupported(path + ": a manifest is .csv (with a header row) or .jsonl (one JSON object a line)");

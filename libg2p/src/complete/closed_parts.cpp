@@ -22,18 +22,11 @@
 
 #include "complete/closed_parts.h"
 #include "core/cell_index.h"
+#include "core/union_find.h"
 #include "g2p/complete.h"
 
 namespace g2p {
 namespace {
-
-int find_root(std::vector<int>& parent, int x) {
-  while (parent[static_cast<std::size_t>(x)] != x) {
-    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-    x = parent[static_cast<std::size_t>(x)];
-  }
-  return x;
-}
 
 // The part's faces with every vertex numbered in the order first met (no
 // array the size of the whole mesh: an object of a thousand parts is welded
@@ -200,16 +193,15 @@ bool edges_pair_up(const Mesh& m) {
 // `turned` says whether any component was turned.
 bool orient_components(Mesh& m, bool& turned) {
   const int nv = m.num_vertices();
-  std::vector<int> parent(static_cast<std::size_t>(nv));
-  std::iota(parent.begin(), parent.end(), 0);
+  detail::UnionFind sets(static_cast<std::size_t>(nv));
   for (const auto& t : m.triangles) {
-    parent[static_cast<std::size_t>(find_root(parent, t[0]))] = find_root(parent, t[1]);
-    parent[static_cast<std::size_t>(find_root(parent, t[1]))] = find_root(parent, t[2]);
+    sets.unite(t[0], t[1]);
+    sets.unite(t[1], t[2]);
   }
   std::unordered_map<int, int> component_of_root;
   std::vector<std::vector<int>> faces;
   for (int f = 0; f < m.num_faces(); ++f) {
-    const int root = find_root(parent, m.triangles[static_cast<std::size_t>(f)][0]);
+    const int root = sets.find(m.triangles[static_cast<std::size_t>(f)][0]);
     auto [it, inserted] = component_of_root.emplace(root, static_cast<int>(faces.size()));
     if (inserted) faces.emplace_back();
     faces[static_cast<std::size_t>(it->second)].push_back(f);

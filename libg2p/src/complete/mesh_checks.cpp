@@ -6,19 +6,12 @@
 #include <tbb/parallel_sort.h>
 
 #include "complete/geometry.h"
+#include "core/union_find.h"
 #include "g2p/complete.h"
 
 namespace g2p {
 
 namespace {
-
-int find_root(std::vector<int>& parent, int x) {
-  while (parent[static_cast<std::size_t>(x)] != x) {
-    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-    x = parent[static_cast<std::size_t>(x)];
-  }
-  return x;
-}
 
 constexpr int kNoOpposite = -1;   // a boundary edge
 constexpr int kBadOpposite = -2;  // more than two faces on the edge, or two wound the same way
@@ -61,17 +54,16 @@ std::vector<int> opposite_half_edges(const Mesh& mesh) {
 // counts the edge-connected pieces (over the edges that do) in `num_components`.
 bool closed_and_oriented(int nf, const std::vector<int>& opposite, int& num_components) {
   bool closed = true;
-  std::vector<int> parent(static_cast<std::size_t>(nf));
-  std::iota(parent.begin(), parent.end(), 0);
+  detail::UnionFind sets(static_cast<std::size_t>(nf));
   for (std::size_t h = 0; h < opposite.size(); ++h) {
     const int g = opposite[h];
     if (g < 0) {
       closed = false;
       continue;
     }
-    parent[static_cast<std::size_t>(find_root(parent, static_cast<int>(h / 3)))] = find_root(parent, g / 3);
+    sets.unite(static_cast<int>(h / 3), g / 3);
   }
-  for (int f = 0; f < nf; ++f) num_components += find_root(parent, f) == f;
+  for (int f = 0; f < nf; ++f) num_components += sets.find(f) == f;
   return closed;
 }
 

@@ -34,6 +34,7 @@
 
 #include "complete/backends.h"
 #include "complete/geometry.h"
+#include "core/distance_transform.h"
 #include "core/segment_tester.h"
 #include "core/settings.h"
 #include "core/simplify.h"
@@ -63,72 +64,11 @@ struct Grid {
   }
 };
 
-// Squared distances along one line: d[q] = min_p (q - p)^2 + f[p] over the
-// finite samples, with the part of the minimising sample.
-void transform_line(const float* f, const int* label, int n, float* d, int* label_out, int* v, double* z) {
-  int k = -1;
-  for (int q = 0; q < n; ++q) {
-    if (!(f[q] < kInf)) continue;
-    const double fq = f[q] + static_cast<double>(q) * q;
-    double s = -std::numeric_limits<double>::infinity();
-    while (k >= 0) {
-      const int p = v[k];
-      s = (fq - (f[p] + static_cast<double>(p) * p)) / (2.0 * (q - p));
-      if (s <= z[k]) {
-        --k;
-        s = -std::numeric_limits<double>::infinity();
-      } else {
-        break;
-      }
-    }
-    ++k;
-    v[k] = q;
-    z[k] = s;
-    z[k + 1] = std::numeric_limits<double>::infinity();
-  }
-  if (k < 0) {
-    std::fill(d, d + n, kInf);
-    return;
-  }
-  int j = 0;
-  for (int q = 0; q < n; ++q) {
-    while (z[j + 1] < q) ++j;
-    const int p = v[j];
-    d[q] = static_cast<float>(static_cast<double>(q - p) * (q - p) + f[p]);
-    if (label_out != nullptr) label_out[q] = label[p];
-  }
-}
-
 // In place: f (squared distance in cells^2, infinity where no sample) becomes
 // the squared distance to the nearest sample plus its value; `label`, if
-// given, the nearest sample's label.
+// given, the nearest sample's label (core/distance_transform.h).
 void distance_transform(const Grid& g, std::vector<float>& f, std::vector<int>* label) {
-  const int dims[3] = {g.nx, g.ny, g.nz};
-  const std::size_t strides[3] = {1, static_cast<std::size_t>(g.nx), static_cast<std::size_t>(g.nx) * g.ny};
-  for (int axis = 0; axis < 3; ++axis) {
-    const int n = dims[axis];
-    const int a1 = axis == 0 ? 1 : 0, a2 = axis == 2 ? 1 : 2;
-    const int lines = dims[a1] * dims[a2];
-    tbb::parallel_for(tbb::blocked_range<int>(0, lines, 64), [&](const tbb::blocked_range<int>& r) {
-      std::vector<float> in(static_cast<std::size_t>(n)), out(static_cast<std::size_t>(n));
-      std::vector<int> lin(static_cast<std::size_t>(n)), lout(static_cast<std::size_t>(n)),
-          v(static_cast<std::size_t>(n));
-      std::vector<double> z(static_cast<std::size_t>(n) + 1);
-      for (int line = r.begin(); line != r.end(); ++line) {
-        const std::size_t base = static_cast<std::size_t>(line % dims[a1]) * strides[a1] +
-                                 static_cast<std::size_t>(line / dims[a1]) * strides[a2];
-        const std::size_t s = strides[axis];
-        for (int q = 0; q < n; ++q) in[static_cast<std::size_t>(q)] = f[base + q * s];
-        if (label != nullptr)
-          for (int q = 0; q < n; ++q) lin[static_cast<std::size_t>(q)] = (*label)[base + q * s];
-        transform_line(in.data(), lin.data(), n, out.data(), label != nullptr ? lout.data() : nullptr, v.data(),
-                       z.data());
-        for (int q = 0; q < n; ++q) f[base + q * s] = out[static_cast<std::size_t>(q)];
-        if (label != nullptr)
-          for (int q = 0; q < n; ++q) (*label)[base + q * s] = lout[static_cast<std::size_t>(q)];
-      }
-    });
-  }
+  detail::squared_distance_transform<float>({g.nx, g.ny, g.nz}, f, label);
 }
 
 void atomic_min(std::uint64_t* target, std::uint64_t value) {

@@ -11,6 +11,7 @@
 
 #include "core/file_util.h"
 #include "core/json_text.h"
+#include "core/physical_limits.h"
 #include "g2p/materials.h"
 
 namespace g2p {
@@ -49,6 +50,9 @@ Status check_class(const MaterialClass& c) {
   if (!(c.density_min_kg_m3 > 0.0 && c.density_min_kg_m3 <= c.density_kg_m3 && c.density_kg_m3 <= c.density_max_kg_m3))
     return bad("density range [" + fmt(c.density_min_kg_m3) + ", " + fmt(c.density_max_kg_m3) +
                "] must be positive and contain density_kg_m3 " + fmt(c.density_kg_m3));
+  if (c.density_max_kg_m3 > detail::kMaxDensity_kg_m3)
+    return bad("density range up to " + fmt(c.density_max_kg_m3) + " kg/m^3: nothing is denser than " +
+               fmt(detail::kMaxDensity_kg_m3) + " (osmium, the densest element, is 22590)");
   if (c.friction_static < 0.0 || c.friction_dynamic < 0.0) return bad("friction must be >= 0");
   if (c.restitution < 0.0 || c.restitution > 1.0)
     return bad("restitution must lie in [0, 1], got " + fmt(c.restitution));

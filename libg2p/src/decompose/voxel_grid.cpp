@@ -1,6 +1,8 @@
 // Voxelisation of closed meshes and the Euclidean distance transform.
 #include "decompose/voxel_grid.h"
 
+#include "core/distance_transform.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -128,77 +130,12 @@ long fill_enclosed(VoxelGrid& g) {
   return filled;
 }
 
-namespace {
-
-// Squared distance transform of one line (f: 0 at sites, +inf elsewhere).
-void transform_line(std::vector<double>& f, std::vector<double>& d, std::vector<int>& v, std::vector<double>& z) {
-  const int n = static_cast<int>(f.size());
-  const double inf = std::numeric_limits<double>::infinity();
-  int k = -1;
-  for (int q = 0; q < n; ++q) {
-    if (f[q] == inf) continue;
-    for (;;) {
-      if (k < 0) {
-        v[0] = q;
-        z[0] = -inf;
-        z[1] = inf;
-        k = 0;
-        break;
-      }
-      const double s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * (q - v[k]));
-      if (s <= z[k]) {
-        --k;
-        continue;
-      }
-      ++k;
-      v[k] = q;
-      z[k] = s;
-      z[k + 1] = inf;
-      break;
-    }
-  }
-  if (k < 0) {
-    std::fill(d.begin(), d.end(), inf);
-    return;
-  }
-  int j = 0;
-  for (int q = 0; q < n; ++q) {
-    while (z[j + 1] < q) ++j;
-    d[q] = (q - v[j]) * (q - v[j]) + f[v[j]];
-  }
-}
-
-}  // namespace
-
 std::vector<float> distance_to_occupied(const VoxelGrid& g) {
   const double inf = std::numeric_limits<double>::infinity();
   const std::size_t total = g.occupied.size();
   std::vector<double> sq(total);
   for (std::size_t c = 0; c < total; ++c) sq[c] = g.occupied[c] ? 0.0 : inf;
-  const int n_max = g.size.maxCoeff();
-  std::vector<double> f(static_cast<std::size_t>(n_max)), d(static_cast<std::size_t>(n_max)), z(n_max + 1);
-  std::vector<int> v(static_cast<std::size_t>(n_max));
-  for (int axis = 0; axis < 3; ++axis) {
-    const int n = g.size[axis];
-    f.resize(static_cast<std::size_t>(n));
-    d.resize(static_cast<std::size_t>(n));
-    const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-    for (int p = 0; p < g.size[a1]; ++p)
-      for (int q = 0; q < g.size[a2]; ++q) {
-        Eigen::Vector3i c;
-        c[a1] = p;
-        c[a2] = q;
-        for (int t = 0; t < n; ++t) {
-          c[axis] = t;
-          f[static_cast<std::size_t>(t)] = sq[g.index(c.x(), c.y(), c.z())];
-        }
-        transform_line(f, d, v, z);
-        for (int t = 0; t < n; ++t) {
-          c[axis] = t;
-          sq[g.index(c.x(), c.y(), c.z())] = d[static_cast<std::size_t>(t)];
-        }
-      }
-  }
+  squared_distance_transform<double>({g.size.x(), g.size.y(), g.size.z()}, sq, nullptr);
   std::vector<float> out(total);
   for (std::size_t c = 0; c < total; ++c) out[c] = static_cast<float>(std::sqrt(sq[c]) * g.cell_m);
   return out;

@@ -39,7 +39,7 @@ long fill_enclosed(VoxelGrid& grid);
 
 // Per cell, the distance from its centre to the nearest occupied cell's
 // centre in metres (0 for occupied cells): an exact Euclidean distance
-// transform (Felzenszwalb and Huttenlocher 2012), separable along the axes.
+// transform (core/distance_transform.h).
 std::vector<float> distance_to_occupied(const VoxelGrid& grid);
 
 }  // namespace g2p::detail

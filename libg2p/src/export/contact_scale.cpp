@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstring>
 #include <initializer_list>
 #include <string>
 
+#include "core/ascii.h"
 #include "g2p/export.h"
 
 namespace g2p {
@@ -36,10 +36,9 @@ constexpr double kRolling_m = 0.0001;
 
 // Whether the class is one of `names` (lower case), whatever the case.
 bool is_one_of(const std::string& name, std::initializer_list<const char*> names) {
-  for (const char* n : names)
-    if (std::equal(name.begin(), name.end(), n, n + std::strlen(n),
-                   [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; }))
-      return true;
+  const std::string n = detail::lower_case(name);
+  for (const char* candidate : names)
+    if (n == candidate) return true;
   return false;
 }
 bool is_cushion_class(const std::string& name) { return is_one_of(name, {"fabric", "leather", "foam"}); }

@@ -39,6 +39,7 @@
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/ascii.h"
 #include "core/model_files.h"
 #include "core/settings.h"
 #include "identify/backends.h"
@@ -58,11 +59,6 @@ std::string trim(const std::string& s) {
   while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
   while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
   return s.substr(a, b - a);
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 // One class of the network as its labels file names it.
@@ -135,7 +131,7 @@ int kind_of(const ClassLabel& l, const ObjectTable& table) {
     }
   }
   for (const std::string& w : l.words) {
-    const std::string want = lower(w);
+    const std::string want = detail::lower_case(w);
     for (const TextMatch& m : table.match(w))
       if (m.term == want) return m.kind;  // the whole label, not a word inside it ("tiger" of "tiger shark")
   }

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/ascii.h"
 #include "g2p/identify.h"
 #include "identify/text_words.h"
 
@@ -36,16 +37,11 @@ Result<std::array<double, 2>> read_range(const json& k, const char* key, const s
   return std::array<double, 2>{lo, hi};
 }
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 Result<ObjectKind> read_kind(const json& k, const std::string& where, std::size_t index) {
   ObjectKind kind;
   if (!k.is_object() || !k.contains("name") || !k["name"].is_string() || k["name"].get<std::string>().empty())
     return Status::ParseError(where + ": kinds[" + std::to_string(index) + "] needs a 'name'");
-  kind.name = lower(k["name"].get<std::string>());
+  kind.name = detail::lower_case(k["name"].get<std::string>());
   const std::string& n = kind.name;
   auto strings = [&](const char* key, std::vector<std::string>& out, bool required) -> Status {
     if (!k.contains(key)) return required ? field_error(where, n, std::string("needs '") + key + "'") : Status::Ok();
@@ -193,7 +189,7 @@ const ObjectTable& ObjectTable::shipped() {
 }
 
 int ObjectTable::find(const std::string& name) const {
-  const std::string n = lower(name);
+  const std::string n = detail::lower_case(name);
   for (std::size_t i = 0; i < kinds_.size(); ++i)
     if (kinds_[i].name == n) return static_cast<int>(i);
   return -1;

@@ -22,6 +22,7 @@
 #include <unordered_set>
 
 #include "assimp_convert.h"
+#include "core/ascii.h"
 #include "core/srgb.h"
 #include "core/utf8.h"
 #include "g2p/io.h"
@@ -38,13 +39,8 @@ namespace fs = std::filesystem;
 
 constexpr int kMaxNodeDepth = 1024;  // deeper scene graphs are treated as malformed
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
 std::string extension_of(const std::string& path) {
-  std::string ext = lower(fs::path(path).extension().string());
+  std::string ext = detail::lower_case(fs::path(path).extension().string());
   return ext.empty() ? ext : ext.substr(1);
 }
 
@@ -666,7 +662,7 @@ bool is_supported_extension(const std::string& extension) {
   if (extension.empty()) return false;
   const std::string ext = extension[0] == '.' ? extension : "." + extension;
   Assimp::Importer importer;
-  return importer.IsExtensionSupported(lower(ext).c_str());
+  return importer.IsExtensionSupported(detail::lower_case(ext).c_str());
 }
 
 Result<Model> load_model(const std::string& path, const ImportOptions& options) {
@@ -705,7 +701,8 @@ Result<Model> load_model(const std::string& path, const ImportOptions& options) 
 
 Result<Model> load_model_from_memory(const void* data, std::size_t size, const std::string& format_hint,
                                      const ImportOptions& options) {
-  const std::string ext = lower(format_hint.empty() || format_hint[0] != '.' ? format_hint : format_hint.substr(1));
+  const std::string ext =
+      detail::lower_case(format_hint.empty() || format_hint[0] != '.' ? format_hint : format_hint.substr(1));
   return guarded("<memory>." + ext, [&]() -> Result<Model> {
     G2P_RETURN_IF_ERROR(check_options(options));
     if (data == nullptr || size == 0) return Status::InvalidArgument("no data");
@@ -739,7 +736,7 @@ Result<double> parse_unit(const std::string& unit) {
       {"in", 0.0254},   {"inch", 0.0254},      {"inches", 0.0254},     {"ft", 0.3048},        {"foot", 0.3048},
       {"feet", 0.3048}, {"km", 1000.0},
   };
-  const std::string u = lower(unit);
+  const std::string u = detail::lower_case(unit);
   for (const auto& [name, scale] : kUnits)
     if (u == name) return scale;
   // Metres per unit as a number ("0.001"), as output manifests record it.

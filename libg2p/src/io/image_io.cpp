@@ -3,6 +3,7 @@
 // signature, not the file name, and each goes to its codec (image_codecs.h).
 // Images are exchanged as 8-bit RGBA when read; written from 1, 3 or 4 channels.
 #include "image_io.h"
+#include "core/ascii.h"
 
 #include <cctype>
 #include <cstring>
@@ -20,11 +21,6 @@ namespace {
 
 bool starts_with(const std::uint8_t* b, std::size_t size, const char* magic, std::size_t n) {
   return size >= n && std::memcmp(b, magic, n) == 0;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 }  // namespace
@@ -91,7 +87,7 @@ Status write_image(const std::string& path, const ImageU8& image) {
     return Status::InvalidArgument(path + ": cannot write an image with " + std::to_string(c) + " channels");
   // Encoded in memory, then written beside the target and renamed, so a
   // failure never leaves half a file and its message is the system's.
-  const std::string extension = detail::lower(std::filesystem::path(path).extension().string());
+  const std::string extension = detail::lower_case(std::filesystem::path(path).extension().string());
   if (extension != ".png" && extension != ".jpg" && extension != ".jpeg" && extension != ".bmp")
     return Status::InvalidArgument(path + ": unknown image extension '" + extension + "' (png, jpg, bmp)");
   const Result<std::string> bytes = extension == ".png"   ? detail::encode_png_bytes(image)

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/ascii.h"
 #include "core/file_util.h"
 #include "core/number_text.h"
 #include "g2p/io.h"
@@ -79,8 +80,7 @@ std::string stl_bytes(const Mesh& mesh) {
 Status write_mesh(const std::string& path, const Mesh& mesh) {
   G2P_RETURN_IF_ERROR(validate(mesh));
   const std::size_t dot = path.find_last_of('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = detail::lower_case(dot == std::string::npos ? "" : path.substr(dot + 1));
   if (ext == "obj") return detail::write_file_atomically(path, obj_text(mesh));
   if (ext == "ply") return detail::write_file_atomically(path, ply_bytes(mesh));
   if (ext == "stl") return detail::write_file_atomically(path, stl_bytes(mesh));

@@ -2,6 +2,7 @@
 // parts, and their application to labels (before complete) and to properties
 // (an estimator that wraps another). docs/pipeline.md#overrides.
 #include "g2p/overrides.h"
+#include "core/physical_limits.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,8 +17,7 @@ namespace {
 
 using nlohmann::json;
 
-// No material is denser than osmium (22,590 kg/m^3); anything above this is a typo.
-constexpr double kMaxDensity = 30000.0;
+constexpr double kMaxDensity = detail::kMaxDensity_kg_m3;
 
 std::string entry_name(std::size_t i) { return "entry " + std::to_string(i + 1); }
 
@@ -126,7 +126,10 @@ Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& 
   if (e.contains("density_kg_m3")) {
     const json& d = e["density_kg_m3"];
     if (!positive_finite(d) || d.get<double>() > kMaxDensity)
-      return entry_error(origin, i, "'density_kg_m3' must be a positive density up to 30000 kg/m^3, not " + d.dump());
+      return entry_error(origin, i,
+                         "'density_kg_m3' must be a positive density up to 23000 kg/m^3 (osmium, the densest element, "
+                         "is 22590), not " +
+                             d.dump());
     o.density_kg_m3 = d.get<double>();
   }
   if (e.contains("contents")) {
@@ -148,7 +151,9 @@ Result<Override> parse_entry(const json& e, std::size_t i, const MaterialTable& 
       const json& d = c["density_kg_m3"];
       if (!positive_finite(d) || d.get<double>() > kMaxDensity)
         return entry_error(origin, i,
-                           "'contents' density_kg_m3 must be a positive density up to 30000 kg/m^3, not " + d.dump());
+                           "'contents' density_kg_m3 must be a positive density up to 23000 kg/m^3 (osmium, the "
+                           "densest element, is 22590), not " +
+                               d.dump());
       o.contents_density_kg_m3 = d.get<double>();
     }
     if (o.set_structure && o.structure == Structure::kSolid && o.contents_fill > 0)

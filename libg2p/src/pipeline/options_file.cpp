@@ -1,6 +1,7 @@
 // Options files (g2p/options_file.h): one writer, and one reader that lays a
 // file's keys over a base and names the key path of anything it refuses.
 #include "g2p/options_file.h"
+#include "core/ascii.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,11 +19,6 @@ namespace g2p {
 namespace {
 
 using nlohmann::json;
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 // A backend's settings as written: a URL's credentials and query values
 // (`user:pw@`, `?key=`) as ***, since secrets are never written.
@@ -287,7 +283,7 @@ const char* to_string(UpAxis up) {
 
 Result<UpAxis> parse_up_axis(const std::string& text) {
   for (UpAxis a : {UpAxis::kAuto, UpAxis::kX, UpAxis::kY, UpAxis::kZ})
-    if (lower(text) == to_string(a)) return a;
+    if (detail::lower_case(text) == to_string(a)) return a;
   return Status::InvalidArgument("unknown up axis '" + text + "' (auto, x, y, z)");
 }
 
@@ -301,15 +297,15 @@ const char* to_string(ViewLayout layout) {
 
 Result<ViewLayout> parse_view_layout(const std::string& text) {
   for (ViewLayout l : {ViewLayout::kSphere, ViewLayout::kFibonacci, ViewLayout::kTurntable})
-    if (lower(text) == to_string(l)) return l;
+    if (detail::lower_case(text) == to_string(l)) return l;
   return Status::InvalidArgument("unknown view layout '" + text + "' (sphere, fibonacci, turntable)");
 }
 
 const char* to_string(VoteMode mode) { return mode == VoteMode::kSoft ? "soft" : "hard"; }
 
 Result<VoteMode> parse_vote_mode(const std::string& text) {
-  if (lower(text) == "hard") return VoteMode::kHard;
-  if (lower(text) == "soft") return VoteMode::kSoft;
+  if (detail::lower_case(text) == "hard") return VoteMode::kHard;
+  if (detail::lower_case(text) == "soft") return VoteMode::kSoft;
   return Status::InvalidArgument("unknown vote '" + text + "' (hard, soft)");
 }
 

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "core/json_text.h"
+#include "core/physical_limits.h"
 #include "g2p/io.h"
 #include "g2p/properties.h"
 #include "properties/report.h"
@@ -24,8 +25,9 @@ void add_contents(PartReport& r, const Mesh& closed, bool closed_ok, std::vector
     bad << "the fill " << pp.contents_fill << " is not a share of the cavity from 0 to 1 (80 % is 0.8)";
     return skip(bad.str());
   }
-  if (!(pp.contents_density_kg_m3 > 0.0 && pp.contents_density_kg_m3 <= 30000.0)) {
-    bad << "the fill's density " << pp.contents_density_kg_m3 << " kg/m^3 is not between 0 and 30000";
+  if (!(pp.contents_density_kg_m3 > 0.0 && pp.contents_density_kg_m3 <= detail::kMaxDensity_kg_m3)) {
+    bad << "the fill's density " << pp.contents_density_kg_m3 << " kg/m^3 is not between 0 and "
+        << detail::kMaxDensity_kg_m3;
     return skip(bad.str());
   }
   if (pp.structure != Structure::kHollow)

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/physical_limits.h"
 #include "core/settings.h"
 #include "g2p/project.h"
 #include "io/image_io.h"
@@ -18,8 +19,8 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kMinDensity = 10.0;     // kg/m^3, below aerogels and foams this is no solid
-constexpr double kMaxDensity = 23000.0;  // osmium, the densest element
+constexpr double kMinDensity = detail::kMinSolidDensity_kg_m3;
+constexpr double kMaxDensity = detail::kMaxDensity_kg_m3;
 
 class VlmEstimator final : public PropertyEstimator {
  public:

@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/ascii.h"
 #include "core/json_text.h"
 #include "core/utf8.h"
 #include "g2p/vlm.h"
@@ -80,9 +81,8 @@ std::size_t on_header(char* ptr, std::size_t size, std::size_t n, void* user) {
   const std::string line(ptr, size * n);
   const std::string key = "retry-after:";
   if (line.size() > key.size()) {
-    std::string lower = line.substr(0, key.size());
-    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (lower == key) *static_cast<double*>(user) = std::atof(line.c_str() + key.size());
+    if (detail::lower_case(line.substr(0, key.size())) == key)
+      *static_cast<double*>(user) = std::atof(line.c_str() + key.size());
   }
   return size * n;
 }

@@ -14,20 +14,11 @@
 #include <queue>
 
 #include "core/srgb.h"
+#include "core/union_find.h"
 #include "g2p/regions.h"
 
 namespace g2p {
-namespace {
-
-int find(std::vector<int>& parent, int x) {
-  while (parent[static_cast<std::size_t>(x)] != x) {
-    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-    x = parent[static_cast<std::size_t>(x)];
-  }
-  return x;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 FaceColours face_colours(const Mesh& mesh, const std::vector<View>& views) {
   const std::size_t nf = static_cast<std::size_t>(mesh.num_faces());
@@ -85,8 +76,7 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
   const float min_cos =
       options.crease_deg >= 180.0 ? -2.f : static_cast<float>(std::cos(options.crease_deg * M_PI / 180.0));
   const float step2 = static_cast<float>(options.colour_step * options.colour_step);
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
+  detail::UnionFind pieces(n);
   for (int f = 0; f < nf; ++f)
     for (int i = graph.offsets[static_cast<std::size_t>(f)]; i < graph.offsets[static_cast<std::size_t>(f) + 1]; ++i) {
       const int g = graph.neighbors[static_cast<std::size_t>(i)];
@@ -98,7 +88,7 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
       if (f_seen &&
           (colours.rgb[static_cast<std::size_t>(f)] - colours.rgb[static_cast<std::size_t>(g)]).squaredNorm() > step2)
         continue;
-      parent[static_cast<std::size_t>(find(parent, f))] = find(parent, g);
+      pieces.unite(f, g);
     }
 
   // Number the components, then merge the small ones.
@@ -106,7 +96,7 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
   std::vector<int> root_region(n, -1);
   int count = 0;
   for (int f = 0; f < nf; ++f) {
-    const int r = find(parent, f);
+    const int r = pieces.find(f);
     if (root_region[static_cast<std::size_t>(r)] < 0) root_region[static_cast<std::size_t>(r)] = count++;
     region[static_cast<std::size_t>(f)] = root_region[static_cast<std::size_t>(r)];
   }
@@ -116,8 +106,7 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
   // joins the neighbour with the longest border (borders counted once over
   // the current roots).
   const double min_area = options.min_area_fraction * total_area;
-  std::vector<int> merged(static_cast<std::size_t>(count));
-  std::iota(merged.begin(), merged.end(), 0);
+  detail::UnionFind merged(static_cast<std::size_t>(count));
   if (min_area > 0.0 && count > 1) {
     std::vector<std::vector<int>> faces_of(static_cast<std::size_t>(count));
     for (int f = 0; f < nf; ++f) faces_of[static_cast<std::size_t>(region[static_cast<std::size_t>(f)])].push_back(f);
@@ -130,14 +119,13 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
     std::vector<double> border(static_cast<std::size_t>(count), 0.0);
     std::vector<int> touched;
     for (const int r0 : order) {
-      const int r = find(merged, r0);
+      const int r = merged.find(r0);
       if (r != r0 || region_area[static_cast<std::size_t>(r)] >= min_area) continue;  // already grown
       touched.clear();
       for (const int f : faces_of[static_cast<std::size_t>(r)])
         for (int i = graph.offsets[static_cast<std::size_t>(f)]; i < graph.offsets[static_cast<std::size_t>(f) + 1];
              ++i) {
-          const int other =
-              find(merged, region[static_cast<std::size_t>(graph.neighbors[static_cast<std::size_t>(i)])]);
+          const int other = merged.find(region[static_cast<std::size_t>(graph.neighbors[static_cast<std::size_t>(i)])]);
           if (other == r) continue;
           if (border[static_cast<std::size_t>(other)] == 0.0) touched.push_back(other);
           border[static_cast<std::size_t>(other)] += graph.shared_edge_m[static_cast<std::size_t>(i)] + 1e-12;
@@ -149,7 +137,7 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
           best = o;
       for (const int o : touched) border[static_cast<std::size_t>(o)] = 0.0;
       if (best < 0) continue;  // a separate small piece: stays
-      merged[static_cast<std::size_t>(r)] = best;
+      merged.unite(r, best);
       region_area[static_cast<std::size_t>(best)] += region_area[static_cast<std::size_t>(r)];
       std::vector<int>& into = faces_of[static_cast<std::size_t>(best)];
       std::vector<int>& from = faces_of[static_cast<std::size_t>(r)];
@@ -162,7 +150,7 @@ Result<Regions> find_regions(const Mesh& mesh, const FaceGraph& graph, const Fac
   out.face_region.assign(n, -1);
   std::vector<int> number(static_cast<std::size_t>(count), -1);
   for (int f = 0; f < nf; ++f) {
-    const int r = find(merged, region[static_cast<std::size_t>(f)]);
+    const int r = merged.find(region[static_cast<std::size_t>(f)]);
     if (number[static_cast<std::size_t>(r)] < 0) {
       number[static_cast<std::size_t>(r)] = static_cast<int>(out.regions.size());
       out.regions.emplace_back();

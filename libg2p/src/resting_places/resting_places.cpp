@@ -56,7 +56,8 @@ std::vector<double> filled_levels(const Grid& g, const std::vector<double>& grou
     }
   }
   while (!open.empty()) {
-    const auto [lv, i] = open.top();
+    const double lv = open.top().first;  // not a structured binding: lambdas capture it only from C++20
+    const int i = open.top().second;
     open.pop();
     for_each_neighbour4(g, i, [&](int j) {
       if (done[static_cast<std::size_t>(j)]) return;

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "complete/cgal/cgal_mesh.h"
+#include "core/union_find.h"
 #include "g2p/complete_cgal.h"
 
 namespace g2p {
@@ -68,23 +69,17 @@ Holes find_holes(const Mesh& patch) {
       const auto b = static_cast<std::uint64_t>(id[static_cast<std::size_t>(t[(k + 1) % 3])]);
       if (a != b) ++uses[std::min(a, b) << 32 | std::max(a, b)];
     }
-  std::vector<int> parent(where.size());
-  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-  const auto root = [&parent](int v) {
-    while (parent[static_cast<std::size_t>(v)] != v)
-      v = parent[static_cast<std::size_t>(v)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
-    return v;
-  };
+  detail::UnionFind loops_of(where.size());
   std::vector<bool> on_border(where.size(), false);
   for (const auto& [edge, n] : uses) {
     if (n != 1) continue;
     const int a = static_cast<int>(edge >> 32), b = static_cast<int>(edge & 0xffffffffu);
     on_border[static_cast<std::size_t>(a)] = on_border[static_cast<std::size_t>(b)] = true;
-    parent[static_cast<std::size_t>(root(a))] = root(b);
+    loops_of.unite(a, b);
   }
   std::unordered_map<int, Eigen::AlignedBox3d> loops;
   for (std::size_t v = 0; v < where.size(); ++v)
-    if (on_border[v]) loops[root(static_cast<int>(v))].extend(where[v]);
+    if (on_border[v]) loops[loops_of.find(static_cast<int>(v))].extend(where[v]);
   Holes holes;
   holes.count = static_cast<int>(loops.size());
   for (const auto& [r, box] : loops) holes.widest = std::max(holes.widest, box.diagonal().norm());

@@ -121,7 +121,9 @@ TEST(Exporters, AFolderCheckComparesTheEngineWithTheReport) {
   EXPECT_FALSE(wrong->pass());
   EXPECT_EQ(check_folder_in_mujoco(dir + "/none").status().code(), StatusCode::kNotFound);
   // The drop's line says whether the body came to rest: 0.1 s after its
-  // release from 0.2 m the hammer is still falling; after 4 s it lies still.
+  // release from 0.2 m the hammer is still falling; after 8 s it lies still
+  // (3 s in the release build; the sanitizer build's hulls, a few micrometres
+  // apart, leave it rocking on its handle until 5 s with the elliptic cone).
   auto drop = [&](double seconds, bool at_rest) {
     Result<FolderCheck> check = check_folder_in_mujoco(dir, 0.2, seconds);
     ASSERT_TRUE(check.ok());
@@ -132,7 +134,7 @@ TEST(Exporters, AFolderCheckComparesTheEngineWithTheReport) {
     EXPECT_EQ(text.find("--seconds longer") != std::string::npos, !at_rest) << text;
   };
   drop(0.1, false);
-  drop(4.0, true);
+  drop(8.0, true);
 }
 
 // |angular acceleration| of the hammer hinged on a horizontal axis (body y)

@@ -115,7 +115,7 @@ Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path, cons
       starts.emplace_back(lo.x() + (hi.x() - lo.x()) * (i + 0.5) / o.grid,
                           lo.y() + (hi.y() - lo.y()) * (j + 0.5) / o.grid);
   std::vector<int> start_place(starts.size(), -1);
-  if (o.places) {
+  if (o.places && out.height_map.width > 0 && out.height_map.height > 0) {  // a map: the top view has an area
     RestingPlaceOptions po = o.place_options;
     po.probe_clearance_m = std::max(po.probe_clearance_m, r);
     Result<std::vector<RestingPlace>> places = find_resting_places(out.height_map, po);

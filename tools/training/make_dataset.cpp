@@ -163,7 +163,8 @@ int run(const Args& a) {
     const std::string split = test_libraries.count(library) ? "test" : "train";
     std::vector<fs::path> objs;
     for (const auto& e : fs::recursive_directory_iterator(library_dir))
-      if (e.is_regular_file() && g2p::detail::lower_case(e.path().extension().string()) == ".obj") objs.push_back(e.path());
+      if (e.is_regular_file() && g2p::detail::lower_case(e.path().extension().string()) == ".obj")
+        objs.push_back(e.path());
     std::sort(objs.begin(), objs.end());
     if (a.max_models > 0 && static_cast<int>(objs.size()) > a.max_models) objs.resize(a.max_models);
     auto& split_stats = stats[split];

@@ -3,7 +3,7 @@ in Blender with a window (Xvfb), through the interactive path (the modal
 operator and its worker thread). Not a ctest; run from the repository root:
 
   BLENDER_USER_CONFIG=$(mktemp -d) G2P_PYTHON=build/python xvfb-run -a -s "-screen 0 1600x1000x24" \
-      blender --enable-event-simulate --python tests/blender/panel_screenshot.py
+      blender --enable-event-simulate --python scripts/docs/blender_panel_screenshot.py
 
 (a fresh user config without a splash: the script saves one on its first start and asks to be run
 again). Event simulation clicks the sidebar's g2p tab at the position it has on a 1600x1000 screen."""

@@ -75,7 +75,8 @@ Result<ContactCheck> check_contacts_in_mujoco(const std::string& mjcf_path, cons
   if (!(o.ball_radius_m >= 0) || !(o.seconds > 0) || !(o.ball_density_kg_m3 > 0) || !(o.rest_speed_m_s > 0) ||
       !(o.ball_rolling_friction_m >= 0) || !(o.ball_friction >= 0))
     return Status::InvalidArgument(
-        "contact check: the ball radius must be >= 0 m, the time, the density and the rest speed > 0");
+        "contact check: the ball radius, friction and rolling friction must be >= 0, the time, the density and the "
+        "rest speed > 0");
   Result<std::string> text = detail::mjcf_with_absolute_meshdir(mjcf_path);
   if (!text.ok()) return text.status();
   std::string xml = *text;
